@@ -3,11 +3,12 @@
 from ._grid import (Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
                     make_grid, rest_is_goal, right_box)
 from ._kinematics import arm_corners, joints, link_corners
+from ._polygon import polygon_distance, polygon_distances
 from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
                         load_scenario, max_cells, parse_scenario)
 
 __all__ = [
     "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
     "Variant", "arm_corners", "exact_n", "joints", "link_corners", "exact_tf", "joint_points", "left_angles", "left_box", "load_scenario",
-    "make_grid", "max_cells", "parse_scenario", "rest_is_goal", "right_box",
+    "make_grid", "max_cells", "parse_scenario", "polygon_distance", "polygon_distances", "rest_is_goal", "right_box",
 ]
