@@ -1,0 +1,12 @@
+"""The reference planner: kinematics, swept regions, BuiltDR, searchoptpath (clear first)."""
+
+from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
+                       left_regions, right_regions)
+from ._kinematics import link_reach, link_rectangles
+from ._regions import convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
+
+__all__ = [
+    "ContainmentReport", "LeftRegions", "RightRegions", "build_dr", "check_containment",
+    "convex_hull", "lattice_range", "left_regions", "link_reach", "link_rectangles", "naive_hull",
+    "right_regions", "sweep_margin", "swept_region",
+]

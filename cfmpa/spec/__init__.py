@@ -1,14 +1,15 @@
 """The paper's definitions, triples and properties as executable predicates (imports no impl)."""
 
-from ._grid import (Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
+from ._grid import (EPS, Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
                     make_grid, rest_is_goal, right_box)
+from ._certificate import Certificate, certificate_json, certify, require_clear
 from ._kinematics import arm_corners, joints, link_corners
 from ._polygon import polygon_distance, polygon_distances
 from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
                         load_scenario, max_cells, parse_scenario)
 
 __all__ = [
-    "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
+    "ANGLE_TOLERANCE", "Certificate", "certificate_json", "certify", "require_clear", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
     "Variant", "arm_corners", "exact_n", "joints", "link_corners", "exact_tf", "joint_points", "left_angles", "left_box", "load_scenario",
     "make_grid", "max_cells", "parse_scenario", "polygon_distance", "polygon_distances", "rest_is_goal", "right_box",
 ]

@@ -27,7 +27,11 @@ __all__ = [
     "left_box",
     "right_box",
     "rest_is_goal",
+    "EPS",
 ]
+
+#: A cell is free only when the regions' Euclidean distance exceeds this (metres), DESIGN §4.
+EPS = 1e-9
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -124,14 +128,14 @@ def left_box(s: Scenario, variant: Variant | str, k: int) -> tuple[Pair2, Pair2]
     for q in range(2):
         w = s.left.omega[q] * dt
         if v is Variant.ORIGINAL:
-            out.append((a[q] - w, a[q] + w))
+            out.append((float(a[q] - w), float(a[q] + w)))
         elif v is Variant.MODIFIED:
             sign = 1.0 if s.left.goal[q] > s.left.start[q] else -1.0
             ends = (a[q], a[q] + sign * w)
-            out.append((min(ends), max(ends)))
+            out.append((float(min(ends)), float(max(ends))))
         else:
             b = left_angles(s, (k + 1) * dt)[q]
-            out.append((min(a[q], b), max(a[q], b)))
+            out.append((float(min(a[q], b)), float(max(a[q], b))))
     return (out[0], out[1])
 
 
