@@ -8,6 +8,7 @@ from typing import Any
 __all__ = [
     "CfmpaError",
     "InputError",
+    "MISSING",
     "ContractViolation",
     "CertificateViolation",
 ]
@@ -17,6 +18,14 @@ class CfmpaError(Exception):
     """Root of the project's own errors; the CLI turns these into exit codes, never tracebacks."""
 
     exit_code = 1
+
+
+class _Missing:
+    def __repr__(self) -> str:
+        return "<missing>"
+
+
+MISSING = _Missing()
 
 
 class InputError(CfmpaError):
@@ -40,7 +49,8 @@ class InputError(CfmpaError):
         where = ""
         if self.source is not None:
             where = f"{self.source}:{self.line}: " if self.line is not None else f"{self.source}: "
-        return f"{where}error: {self.field} {self.message}, got {self.value!r}"
+        got = "" if self.value is MISSING else f", got {self.value!r}"
+        return f"{where}error: {self.field} {self.message}{got}"
 
 
 class ContractViolation(CfmpaError):

@@ -16,7 +16,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from ..errors import InputError
+from ..errors import MISSING, InputError
 
 __all__ = [
     "Arm",
@@ -138,7 +138,7 @@ class _Reader:
               prefix: str = "") -> dict[str, Any]:
         field = f"{prefix}{key}"
         if key not in doc:
-            raise self.fail(field, None, "is required")
+            raise self.fail(field, MISSING, "is required")
         value = doc[key]
         if not isinstance(value, dict):
             raise self.fail(field, value, "must be a table")
@@ -152,7 +152,7 @@ class _Reader:
                                 f"is not a known key (known: {', '.join(sorted(allowed))})")
         for key in sorted(required):
             if key not in doc:
-                raise self.fail(f"{prefix}{key}", None, "is required")
+                raise self.fail(f"{prefix}{key}", MISSING, "is required")
 
     def number(self, value: Any, field: str, *, positive: bool = False) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):

@@ -1,0 +1,89 @@
+"""The command line: ``cfmpa`` -> ``main(argv)`` -> one function per subcommand returning the exit code.
+
+Exit codes: 0 success, 1 a check failed (a violation, a failed proof), 2 bad input or usage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from . import __version__
+from .errors import CfmpaError, InputError
+
+__all__ = ["main"]
+
+
+def _variant(value: str) -> str:
+    from .spec import Variant
+
+    try:
+        return Variant(value).value
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--variant must be one of {', '.join(v.value for v in Variant)}, got {value!r}") from None
+
+
+def cmd_dr(args: argparse.Namespace) -> int:
+    """Build D_R for one scenario and variant; write DIR/dr.npy."""
+    from ._io import save_npy_atomic
+    from .impl import build_dr
+    from .spec import load_scenario, make_grid
+
+    s = load_scenario(args.scenario)
+    g = make_grid(s)
+    t0 = time.perf_counter()
+    dr = build_dr(s, args.variant, g)
+    seconds = time.perf_counter() - t0
+    out = save_npy_atomic(Path(args.out) / "dr.npy", dr)
+    free = 1.0 - float(dr.mean())
+    print(f"scenario  {s.name} ({args.scenario})")
+    print(f"variant   {args.variant}")
+    print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad"
+          f"  shape={tuple(dr.shape)}")
+    print(f"free      {free:.4%} of cells")
+    print(f"time      {seconds:.3f} s")
+    print(f"wrote     {out}")
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="cfmpa", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    d = sub.add_parser("dr", help="build the collision-state database D_R (BuiltDR)")
+    d.add_argument("scenario", help="scenario TOML file")
+    d.add_argument("--variant", type=_variant, default="modified",
+                   help="original | modified | tight (default: modified)")
+    d.add_argument("--out", required=True, help="output folder (dr.npy is written there)")
+    d.set_defaults(func=cmd_dr)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code (errors become messages, never tracebacks)."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except InputError as exc:
+        print(exc.render(), file=sys.stderr)
+        return exc.exit_code
+    except CfmpaError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except OSError as exc:
+        name = exc.filename if exc.filename is not None else "file"
+        print(f"{name}: error: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Shared test set-up: tests/ is on sys.path, so test modules can `import factory`."""

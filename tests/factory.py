@@ -1,0 +1,39 @@
+"""Small scenarios for tests: a coarse default workcell with overrides (not part of the package)."""
+
+from __future__ import annotations
+
+import copy
+from typing import Any
+
+from cfmpa.spec import Scenario, parse_scenario
+
+BASE_DOC: dict[str, Any] = {
+    "name": "tiny",
+    "purpose": "a coarse workcell for tests",
+    "dt": 0.25,
+    "left": {"base": [0.0, 0.0], "links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0],
+             "start": [0.3, 0.8], "goal": [1.6, 2.2]},
+    "right": {"base": [0.6, 0.0], "links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0],
+              "limits": [[0.0, 6.283185307179586], [0.0, 6.283185307179586]],
+              "start_cell": [3, 8], "goal_cell": [12, 5]},
+}
+
+
+def doc(**changes: Any) -> dict[str, Any]:
+    """A copy of BASE_DOC; keys like ``right__omega`` set nested fields, ``None`` deletes."""
+    d = copy.deepcopy(BASE_DOC)
+    for key, value in changes.items():
+        parts = key.split("__")
+        target = d
+        for p in parts[:-1]:
+            target = target[p]
+        if value is None:
+            target.pop(parts[-1], None)
+        else:
+            target[parts[-1]] = value
+    return d
+
+
+def scenario(**changes: Any) -> Scenario:
+    """A validated tiny scenario (grid 27 x 27, 6 layers) with ``changes`` applied."""
+    return parse_scenario(doc(**changes), check_budget=False)

@@ -1,0 +1,62 @@
+"""The command line as a user runs it: exit codes, messages without tracebacks, atomic output."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cfmpa.cli import main
+from cfmpa.spec import load_scenario, make_grid
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture
+def tiny_file(tmp_path):
+    text = (ROOT / "scenarios" / "default.toml").read_text()
+    p = tmp_path / "tiny.toml"
+    p.write_text(text.replace("dt = 0.02", "dt = 0.25").replace("start_cell = [40, 100]",
+                 "start_cell = [3, 8]").replace("goal_cell = [150, 60]", "goal_cell = [12, 5]"))
+    return p
+
+
+def test_dr_writes_the_array_and_reports_the_grid(tiny_file, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["dr", str(tiny_file), "--variant", "tight", "--out", str(out)]) == 0
+    dr = np.load(out / "dr.npy")
+    g = make_grid(load_scenario(tiny_file))
+    assert dr.shape == (g.N + 1, g.m, g.n) and dr.dtype == np.uint8
+    text = capsys.readouterr().out
+    assert f"N={g.N} m={g.m} n={g.n}" in text and "free" in text and "time" in text
+    assert not list(out.glob(".*tmp"))  # no temporary left behind
+
+
+def test_bad_scenario_exits_2_with_file_line_message(tiny_file, tmp_path, capsys):
+    tiny_file.write_text(tiny_file.read_text().replace("omega = [1.0, 1.0]\nlimits",
+                                                       "omega = [1.0, -1.0]\nlimits"))
+    out = tmp_path / "out"
+    assert main(["dr", str(tiny_file), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "error: right.omega[1] must be > 0, got -1.0" in err
+    assert err.startswith(f"{tiny_file}:")
+    assert "Traceback" not in err
+    assert not out.exists()
+
+
+def test_unknown_variant_and_missing_file_exit_2(tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["dr", "x.toml", "--variant", "sideways", "--out", str(tmp_path)])
+    assert info.value.code == 2
+    assert main(["dr", str(tmp_path / "missing.toml"), "--out", str(tmp_path)]) == 2
+    assert "cannot be read" in capsys.readouterr().err
+
+
+def test_console_script_runs_without_traceback(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "cfmpa", "dr", str(tmp_path / "nope.toml"),
+                           "--out", str(tmp_path)], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr and "error:" in proc.stderr
