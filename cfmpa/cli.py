@@ -50,6 +50,37 @@ def cmd_dr(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy and DIR/plan.json."""
+    from .proofs._plan import plan, write_plan
+    from .spec import load_scenario
+
+    s = load_scenario(args.scenario)
+    p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample)
+    dr_path, plan_path = write_plan(p, args.out)
+    g, r, t = p.grid, p.search, p.timings_s
+    print(f"scenario  {s.name} ({args.scenario})")
+    print(f"variant   {p.variant}")
+    print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad")
+    print(f"free      {p.free_fraction:.4%} of cells")
+    if r.reason is None:
+        print(f"status    {r.status}: J1={r.J1} J2={r.J2} length={len(r.path)} cells")
+    else:
+        print(f"status    {r.status}: {r.reason}")
+    if p.certificate is not None:
+        c = p.certificate
+        verdict = "clear" if c.clear else "NOT CLEAR"
+        print(f"clearance {verdict}: min {c.min_clearance_m * 1000:.3f} mm at t={c.t_min_s:.4f} s "
+              f"({c.intervals} intervals)")
+    if p.contracts is not None:
+        n_bad = len(p.contracts.get("violations", []))
+        print(f"contracts {p.contracts.get('mode')}: {p.contracts.get('checked')} checks, "
+              f"{n_bad} violations")
+    print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()))
+    print(f"wrote     {dr_path}, {plan_path}")
+    return 0
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="cfmpa", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
@@ -61,6 +92,18 @@ def _parser() -> argparse.ArgumentParser:
                    help="original | modified | tight (default: modified)")
     d.add_argument("--out", required=True, help="output folder (dr.npy is written there)")
     d.set_defaults(func=cmd_dr)
+
+    pl = sub.add_parser("plan", help="plan the subordinate's path; write dr.npy and plan.json")
+    pl.add_argument("scenario", help="scenario TOML file")
+    pl.add_argument("--variant", type=_variant, default="modified",
+                    help="original | modified | tight (default: modified)")
+    pl.add_argument("--out", required=True, help="output folder")
+    pl.add_argument("--contracts", choices=["off", "sampled", "full"], default="sampled",
+                    help="contract checking of BuiltDR and searchoptpath (default: sampled)")
+    pl.add_argument("--seed", type=int, default=0, help="seed of the sampled contracts")
+    pl.add_argument("--sample", type=int, default=None,
+                    help="cells checked by sampled contracts (default: the mode's own)")
+    pl.set_defaults(func=cmd_plan)
     return p
 
 

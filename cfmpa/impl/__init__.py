@@ -3,10 +3,11 @@
 from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
                        left_regions, right_regions)
 from ._kinematics import link_reach, link_rectangles
+from ._search import search_opt_path
 from ._regions import convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
 
 __all__ = [
     "ContainmentReport", "LeftRegions", "RightRegions", "build_dr", "check_containment",
     "convex_hull", "lattice_range", "left_regions", "link_reach", "link_rectangles", "naive_hull",
-    "right_regions", "sweep_margin", "swept_region",
+    "right_regions", "search_opt_path", "sweep_margin", "swept_region",
 ]
