@@ -60,3 +60,42 @@ def test_console_script_runs_without_traceback(tmp_path):
                            "--out", str(tmp_path)], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and "error:" in proc.stderr
+
+
+def _without_timings(path: Path) -> str:
+    import json
+
+    doc = json.loads(path.read_text())
+    doc.pop("timings_s")
+    return json.dumps(doc, sort_keys=True)
+
+
+def test_plan_writes_stable_json_and_a_summary(tiny_file, tmp_path, capsys):
+    outs = [tmp_path / "a", tmp_path / "b"]
+    for out in outs:
+        assert main(["plan", str(tiny_file), "--variant", "modified", "--out", str(out),
+                     "--contracts", "off"]) == 0
+    text = capsys.readouterr().out
+    for word in ("variant", "grid", "free", "status", "time"):
+        assert word in text
+    a, b = (_without_timings(o / "plan.json") for o in outs)
+    assert a == b
+    import json
+
+    doc = json.loads((outs[0] / "plan.json").read_text())
+    for key in ("scenario", "scenario_sha256", "variant", "grid", "status", "reason", "path",
+                "angles", "J1", "J2", "clearance", "contracts", "timings_s", "versions"):
+        assert key in doc
+    assert set(doc["grid"]) >= {"N", "m", "n", "dt", "lo", "h"}
+    assert np.load(outs[0] / "dr.npy").shape == (doc["grid"]["N"] + 1, doc["grid"]["m"],
+                                                 doc["grid"]["n"])
+    if doc["status"] == "found":
+        assert doc["path"][0] == [3, 8] and doc["path"][-1] == [12, 5]
+        assert len(doc["angles"]) == len(doc["path"])
+
+
+def test_plan_into_an_unwritable_place_exits_2(tiny_file, tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert main(["plan", str(tiny_file), "--out", str(blocker / "x"), "--contracts", "off"]) == 2
+    assert "error" in capsys.readouterr().err

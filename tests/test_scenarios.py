@@ -1,0 +1,80 @@
+"""What the bundled scenarios exist to show: the paper's is_path flaw, its Section IV.B claim,
+and that the optimum never worsens from original to modified to tight."""
+
+from __future__ import annotations
+
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+from cfmpa.impl import build_dr, search_opt_path
+from cfmpa.spec import Variant, load_scenario, make_grid
+from cfmpa.spec._certificate import certify
+from cfmpa.spec._paths import J1, J2, SearchStatus, is_path, is_path_paper, path_violations
+
+ROOT = Path(__file__).resolve().parents[1] / "scenarios"
+SCENARIOS = sorted(p.stem for p in ROOT.glob("*.toml"))
+ORDER = (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT)
+
+
+@cache
+def planned(name: str, variant: Variant):
+    s = load_scenario(ROOT / f"{name}.toml")
+    g = make_grid(s)
+    dr = build_dr(s, variant, g)
+    return s, g, dr, search_opt_path(dr, s.right.start_cell, s.right.goal_cell)
+
+
+def test_early_arrival_path_passes_the_papers_is_path_but_collides():
+    s, g, dr, best = planned("early-arrival", Variant.MODIFIED)
+    start, goal = s.right.start_cell, s.right.goal_cell
+    # The shortest list: straight along theta1 to the goal, arriving at step 4 of N = 41.
+    early = [(start[0] + k, start[1]) for k in range(goal[0] - start[0] + 1)]
+    assert len(early) < g.N
+    assert is_path_paper(early, dr, start, goal)
+    assert not is_path(early, dr, start, goal)
+    first = path_violations(early, dr, start, goal)[0]
+    assert first.clause == "blocked" and first.cell == goal and first.step >= len(early)
+    # Executed (waiting at the goal after the list ends), the arms really touch.
+    cert = certify(s, g, early)
+    assert not cert.clear and cert.contact is not None
+    assert cert.contact[0] > (len(early) - 1) * g.dt  # after the list ended
+    # The fixed search goes around and waits elsewhere; its motion is certified clear.
+    assert best.status is SearchStatus.FOUND
+    assert is_path(best.path, dr, start, goal)
+    assert (best.J1, best.J2) > (J1(early), J2(early))
+    assert certify(s, g, best.path).clear
+
+
+def test_original_finds_no_path_where_modified_finds_one():
+    _, _, _, orig = planned("original-fails", Variant.ORIGINAL)
+    _, _, dr, mod = planned("original-fails", Variant.MODIFIED)
+    assert orig.status is SearchStatus.NO_PATH
+    assert orig.reason == "goal blocked in the rest layer"
+    assert mod.status is SearchStatus.FOUND
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_optimum_never_worsens_from_original_to_modified_to_tight(name):
+    results = [planned(name, v) for v in ORDER]
+    costs = [(r.J1, r.J2) for *_, r in results if r.status is SearchStatus.FOUND]
+    found = [r.status is SearchStatus.FOUND for *_, r in results]
+    # Once a variant finds a path, every less conservative one does too.
+    assert found == sorted(found)
+    assert costs == sorted(costs, reverse=True)
+    # A path valid under original stays valid under modified and tight.
+    s, _, _, orig = results[0]
+    if orig.status is SearchStatus.FOUND:
+        for _, _, dr, _ in results[1:]:
+            assert is_path(orig.path, dr, s.right.start_cell, s.right.goal_cell)
+
+
+@pytest.mark.parametrize("name", SCENARIOS)
+def test_found_paths_are_valid_and_certified(name):
+    for v in ORDER:
+        s, g, dr, r = planned(name, v)
+        if r.status is SearchStatus.FOUND:
+            assert is_path(r.path, dr, s.right.start_cell, s.right.goal_cell)
+            assert (J1(r.path), J2(r.path)) == (r.J1, r.J2)
+            assert certify(s, g, r.path).clear
