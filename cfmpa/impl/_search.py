@@ -41,6 +41,7 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell) -> Sea
     the same continuations at the same costs. A path ends at the goal; holding the goal up to
     step N costs nothing (the J2 term |0 - d_last| is paid either way), so the finished paths are
     the states (N, goal, d) plus a final J2 term |d|_1. The returned list drops trailing waits.
+    At the capped step waits are dropped too: wait-then-move costs |p| + |d| >= |d - p| in J2.
 
     Ties (deterministic): walking back from the goal, the last move is the smallest in MOVES order
     among optimal ones; each state's predecessor is, among optimal ones, the one at the earlier
@@ -138,8 +139,9 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
 
     Returns (key of the best finished path, its last move, predecessor moves, and whether each
     state's predecessor is itself at step N) or None when the goal is unreachable. Buckets hold
-    J1; within a bucket only waits cost no J1, and a wait leads to (c, WAIT) whose own wait is a
-    free self-loop, so one wait pass closes each bucket.
+    J1. Waits are left out: at steps >= N a wait after move p then a move d costs |p| + |d| in J2,
+    never less than turning at once, |d - p|; every other move costs J1 >= 1, so a bucket's
+    states are final once the buckets before it are expanded.
     """
     m, n = free_rest.shape
     M = m * n
@@ -166,21 +168,15 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
         u = u[~done[u] & ((keys[u] >> SHIFT) == bucket)]
         if u.size == 0:
             continue
-        # Wait closure: (c, p) -> (c, WAIT) costs |p|_1 in J2 only.
-        moving = u[u // M != WAIT]
-        p = moving // M
-        improved = _improve(keys, pred, from_static, done, WAIT * M + moving % M,
-                            keys[moving] + gap[p, WAIT], p)
-        settled = np.union1d(u, improved)
-        done[settled] = True
+        done[u] = True
         if done[goal_states].any():
             # Stopping after move d adds |d|_1 to J2 (the low bits of the key).
             finish = np.where(done[goal_states], keys[goal_states] + norm, INF)
             last = int(np.argmin(finish))  # smallest move on ties
             return int(finish[last]), last, pred, from_static
-        # Expand every non-wait move from the settled frontier.
-        cells = settled % M
-        prev = settled // M
+        # Expand every move but the wait from the settled frontier.
+        cells = u % M
+        prev = u // M
         cand_u, cand_k, cand_p = [], [], []
         for d in range(9):
             if d == WAIT:
@@ -188,7 +184,7 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
             to = targets[d][cells]
             ok = to >= 0
             cand_u.append(d * M + to[ok])
-            cand_k.append(keys[settled[ok]] + (norm[d] << SHIFT) + gap[prev[ok], d])
+            cand_k.append(keys[u[ok]] + (norm[d] << SHIFT) + gap[prev[ok], d])
             cand_p.append(prev[ok])
         improved = _improve(keys, pred, from_static, done, np.concatenate(cand_u),
                             np.concatenate(cand_k), np.concatenate(cand_p))

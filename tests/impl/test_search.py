@@ -1,0 +1,225 @@
+"""search_opt_path is exact: checked against two Dijkstras and against Z3's Optimize (DESIGN §5)."""
+
+from __future__ import annotations
+
+import heapq
+
+import numpy as np
+import pytest
+from hypothesis import event, given, settings
+from hypothesis import strategies as st
+
+from cfmpa.errors import InputError
+from cfmpa.impl._search import search_opt_path
+from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
+                               J1, J2, SearchResult, SearchStatus, is_path, opt_path)
+from cfmpa.spec._paths_z3 import z3_opt_path
+
+Cell = tuple[int, int]
+
+
+def plain_dijkstra(dr: np.ndarray, start: Cell, goal: Cell) -> tuple[str, object]:
+    """("found", (J1, J2)) or ("no_path", reason), by a Dijkstra written for this test alone.
+
+    States (cell, previous move, step capped at N); a path may stop at (goal, p, N), paying the
+    last J2 term |p|_1 (holding the goal from an earlier step is the same as waiting to step N).
+    """
+    N, m, n = dr.shape[0] - 1, dr.shape[1], dr.shape[2]
+    if dr[0][start]:
+        return "no_path", REASON_START_BLOCKED
+    if dr[N][goal]:
+        return "no_path", REASON_GOAL_BLOCKED
+    first = (start, (0, 0), 0)
+    dist = {first: (0, 0)}
+    heap = [((0, 0), first)]
+    answer = None
+    while heap:
+        cost, state = heapq.heappop(heap)
+        if answer is not None and cost >= answer:
+            break
+        if dist[state] < cost:
+            continue
+        (i, j), (pi, pj), s = state
+        if s == N and (i, j) == goal:
+            stop = (cost[0], cost[1] + abs(pi) + abs(pj))
+            answer = stop if answer is None else min(answer, stop)
+        nxt = min(s + 1, N)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                c = (i + di, j + dj)
+                if not (0 <= c[0] < m and 0 <= c[1] < n) or dr[nxt][c]:
+                    continue
+                new = (cost[0] + abs(di) + abs(dj), cost[1] + abs(di - pi) + abs(dj - pj))
+                key = (c, (di, dj), nxt)
+                if key not in dist or new < dist[key]:
+                    dist[key] = new
+                    heapq.heappush(heap, (new, key))
+    return ("found", answer) if answer is not None else ("no_path", REASON_UNREACHABLE)
+
+
+@st.composite
+def dr_cases(draw: st.DrawFn, max_n: int = 6, max_side: int = 8
+             ) -> tuple[np.ndarray, Cell, Cell]:
+    """A random D_R (random sizes and obstacle density), start and goal."""
+    N = draw(st.integers(1, max_n))
+    m = draw(st.integers(1, max_side))
+    n = draw(st.integers(1, max_side))
+    density = draw(st.floats(0.0, 0.6))
+    seed = draw(st.integers(0, 2**32 - 1))
+    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
+    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    if draw(st.booleans()):
+        # Mostly free ends, so that most cases reach the search proper.
+        dr[0][start] = 0
+        dr[N][goal] = 0
+    return dr, start, goal
+
+
+def check_against_oracles(dr: np.ndarray, start: Cell, goal: Cell) -> SearchResult:
+    got = search_opt_path(dr, start, goal)
+    spec = opt_path(dr, start, goal)
+    status, value = plain_dijkstra(dr, start, goal)
+    assert (got.status, got.reason, got.J1, got.J2) == (spec.status, spec.reason, spec.J1, spec.J2)
+    if status == "found":
+        assert got.status == SearchStatus.FOUND and (got.J1, got.J2) == value
+        assert is_path(got.path, dr, start, goal)
+        assert (J1(got.path), J2(got.path)) == (got.J1, got.J2)
+        assert len(got.path) == 1 or got.path[-2] != goal    # trailing waits are dropped
+    else:
+        assert (got.status, got.reason, got.path) == (SearchStatus.NO_PATH, value, ())
+    return got
+
+
+@settings(max_examples=200, deadline=None)
+@given(dr_cases())
+def test_search_matches_both_dijkstras(case: tuple[np.ndarray, Cell, Cell]) -> None:
+    got = check_against_oracles(*case)
+    event(f"{got.status}: {got.reason}")
+
+
+@pytest.mark.slow
+@settings(max_examples=2000, deadline=None)
+@given(dr_cases(max_n=10, max_side=14))
+def test_search_matches_both_dijkstras_many(case: tuple[np.ndarray, Cell, Cell]) -> None:
+    check_against_oracles(*case)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_search_matches_on_larger_grids(seed: int) -> None:
+    # Many buckets and long detours after step N, in a few cases.
+    rng = np.random.default_rng(seed)
+    dr = (rng.random((9, 40, 40)) < 0.35).astype(np.uint8)
+    dr[:, 0, 0] = 0
+    dr[8, 39, 39] = 0
+    check_against_oracles(dr, (0, 0), (39, 39))
+
+
+# --- Z3's Optimize over the spec's encoding (Definition 5 by a solver) -------------------------
+
+Z3_TIMEOUT_MS = 60_000
+
+
+def check_against_z3(dr: np.ndarray, start: Cell, goal: Cell) -> None:
+    z = z3_opt_path(dr, start, goal, timeout_ms=Z3_TIMEOUT_MS)
+    assert z.status is not None, f"Z3 answered unknown: {z.reason_unknown}"
+    got = search_opt_path(dr, start, goal)
+    assert (got.status, got.J1, got.J2) == (z.status, z.J1, z.J2)
+    if z.status == SearchStatus.FOUND:
+        assert is_path(z.path, dr, start, goal)
+        assert (J1(z.path), J2(z.path)) == (z.J1, z.J2)
+
+
+def _z3_case(seed: int, N: int, m: int, n: int, density: float) -> tuple[np.ndarray, Cell, Cell]:
+    rng = np.random.default_rng(seed)
+    dr = (rng.random((N + 1, m, n)) < density).astype(np.uint8)
+    dr[0, 0, 0] = 0
+    dr[N, m - 1, n - 1] = 0
+    return dr, (0, 0), (m - 1, n - 1)
+
+
+@pytest.mark.parametrize("seed, N, m, n, density", [
+    (0, 4, 5, 5, 0.0),     # the largest bound, B = 4 + 25
+    (1, 4, 5, 5, 0.3),
+    (2, 3, 4, 5, 0.4),
+    (3, 4, 5, 4, 0.6),     # dense: often no path
+])
+def test_search_matches_z3(seed: int, N: int, m: int, n: int, density: float) -> None:
+    check_against_z3(*_z3_case(seed, N, m, n, density))
+
+
+def test_search_matches_z3_on_the_early_arrival_case() -> None:
+    # 1 x 3, N = 4: the start is swept at step 1 and the goal (0, 2) at step 3. Arriving at
+    # step 2 (J1, J2) = (2, 2) and holding the goal is invalid; the optimum waits mid-way at
+    # (0, 1) and arrives at step 4, (2, 4).
+    dr = np.zeros((5, 1, 3), dtype=np.uint8)
+    dr[1, 0, 0] = 1
+    dr[3, 0, 2] = 1
+    check_against_z3(dr, (0, 0), (0, 2))
+    result = search_opt_path(dr, (0, 0), (0, 2))
+    assert (result.path, result.J1, result.J2) == (((0, 0), (0, 1), (0, 1), (0, 1), (0, 2)), 2, 4)
+
+
+@pytest.mark.slow
+@settings(max_examples=150, deadline=None)
+@given(dr_cases(max_n=4, max_side=5))
+def test_search_matches_z3_many(case: tuple[np.ndarray, Cell, Cell]) -> None:
+    check_against_z3(*case)
+
+
+# --- behaviour on hand-built cases ---------------------------------------------------------------
+
+def test_reasons_are_checked_in_order() -> None:
+    dr = np.zeros((3, 2, 2), dtype=np.uint8)
+    dr[0, 0, 0] = 1
+    dr[2, 1, 1] = 1
+    assert search_opt_path(dr, (0, 0), (1, 1)).reason == REASON_START_BLOCKED
+    dr[0, 0, 0] = 0
+    assert search_opt_path(dr, (0, 0), (1, 1)).reason == REASON_GOAL_BLOCKED
+    dr[2, 1, 1] = 0
+    dr[1] = 1   # every cell blocked at step 1
+    assert search_opt_path(dr, (0, 0), (1, 1)).reason == REASON_UNREACHABLE
+
+
+def test_start_equal_to_goal_is_a_one_cell_path() -> None:
+    dr = np.zeros((4, 3, 3), dtype=np.uint8)
+    result = search_opt_path(dr, (1, 1), (1, 1))
+    assert (result.status, result.path, result.J1, result.J2) == ("found", ((1, 1),), 0, 0)
+
+
+def test_dodges_the_principal_and_comes_back_after_it_stops() -> None:
+    # The start is swept at step 2 and the arm must step aside, though the goal is the start.
+    dr = np.zeros((4, 1, 3), dtype=np.uint8)
+    dr[2, 0, 0] = 1
+    result = search_opt_path(dr, (0, 0), (0, 0))
+    assert (result.J1, result.J2) == (2, 4)
+    assert len(result.path) == 4 and result.path[2] == (0, 1)
+    assert is_path(result.path, dr, (0, 0), (0, 0))
+
+
+def test_ties_follow_the_documented_rule() -> None:
+    # Three optimal paths with (J1, J2) = (2, 4) end with moves (1, 1), (0, 1) and (1, 0); the
+    # rule keeps the smallest last move in MOVES order, (0, 1), so the path comes from (1, 0).
+    result = search_opt_path(np.zeros((2, 2, 2), dtype=np.uint8), (0, 0), (1, 1))
+    assert (result.path, result.J1, result.J2) == (((0, 0), (1, 0), (1, 1)), 2, 4)
+
+
+def test_ties_are_broken_the_same_way_every_time() -> None:
+    dr = np.zeros((3, 6, 6), dtype=np.uint8)   # many optimal paths
+    first = search_opt_path(dr, (0, 0), (5, 5))
+    assert all(search_opt_path(dr.copy(), (0, 0), (5, 5)) == first for _ in range(3))
+
+
+def test_accepts_any_integer_cells_and_returns_python_ints() -> None:
+    dr = np.zeros((2, 3, 3), dtype=np.uint8)
+    result = search_opt_path(dr, np.array([0, 0]), (np.int64(2), 2))
+    assert all(type(v) is int for cell in result.path for v in cell)
+    assert type(result.J1) is int and type(result.J2) is int
+
+
+def test_rejects_bad_inputs() -> None:
+    dr = np.zeros((2, 3, 3), dtype=np.uint8)
+    with pytest.raises(InputError, match="goal"):
+        search_opt_path(dr, (0, 0), (0, 3))
+    with pytest.raises(InputError, match="dr"):
+        search_opt_path(np.zeros((3, 3), dtype=np.uint8), (0, 0), (0, 0))

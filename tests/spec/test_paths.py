@@ -1,0 +1,215 @@
+"""Paths, costs and Definition 5's oracle (DESIGN §5) on hand-built D_R arrays."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cfmpa.errors import InputError
+from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
+                               J1, J2, SearchStatus, is_path, is_path_paper, opt_path,
+                               path_violations)
+from cfmpa.spec._paths_z3 import length_bound
+
+
+def free_dr(N: int, m: int, n: int) -> np.ndarray:
+    return np.zeros((N + 1, m, n), dtype=np.uint8)
+
+
+# --- J1 and J2 -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("path, j1, j2", [
+    ([(0, 0)], 0, 0),
+    ([(0, 0), (1, 0), (2, 0)], 2, 2),            # start 1, straight 0, stop 1
+    ([(0, 0), (1, 0), (1, 1)], 2, 4),            # start 1, turn |(-1, 1)| = 2, stop 1
+    ([(0, 0), (1, 1)], 2, 4),                    # a diagonal: start 2, stop 2
+    ([(0, 0), (1, 0), (0, 0)], 2, 4),            # reversal: 1 + 2 + 1
+    ([(0, 0), (1, 0), (1, 0), (2, 0)], 2, 4),    # a wait mid-way stops and restarts: 1+1+1+1
+    ([(3, 3), (2, 4), (1, 5), (1, 6)], 5, 4),    # (-1,1),(-1,1),(0,1): 2 + 0 + 1, stop 1
+])
+def test_costs_on_hand_examples(path: list[tuple[int, int]], j1: int, j2: int) -> None:
+    assert (J1(path), J2(path)) == (j1, j2)
+
+
+def test_waiting_at_either_end_changes_neither_cost() -> None:
+    base = [(0, 0), (1, 0), (1, 1), (2, 2)]
+    for extra in range(1, 4):
+        at_goal = base + [base[-1]] * extra
+        at_start = [base[0]] * extra + base
+        assert (J1(at_goal), J2(at_goal)) == (J1(base), J2(base))
+        assert (J1(at_start), J2(at_start)) == (J1(base), J2(base))
+
+
+# --- is_path (fixed) and is_path_paper (Definition 4, literal) ---------------------------------
+
+def test_is_path_accepts_a_valid_path() -> None:
+    dr = free_dr(3, 3, 3)
+    dr[1, 1, 1] = 1
+    path = [(0, 0), (1, 0), (2, 1), (2, 2)]
+    assert is_path(path, dr, (0, 0), (2, 2))
+    assert path_violations(path, dr, (0, 0), (2, 2)) == []
+    assert is_path_paper(path, dr, (0, 0), (2, 2))
+
+
+@pytest.mark.parametrize("path, start, goal, clause, step", [
+    ([(0, 0), (2, 0), (2, 1)], (0, 0), (2, 1), "not_adjacent", 0),   # a jump of 2 rows
+    ([(0, 0), (0, -1), (0, 0), (1, 0)], (0, 0), (1, 0), "outside_grid", 1),
+    ([(0, 0), (0, 3), (0, 2)], (0, 0), (0, 2), "outside_grid", 1),
+    ([(1, 1), (1, 2)], (0, 0), (1, 2), "wrong_start", 0),
+    ([(0, 0), (1, 1)], (0, 0), (2, 2), "wrong_goal", 1),
+    ([], (0, 0), (0, 0), "empty", None),
+])
+def test_is_path_rejects(path: list[tuple[int, int]], start: tuple[int, int],
+                         goal: tuple[int, int], clause: str, step: int | None) -> None:
+    dr = free_dr(2, 3, 3)
+    found = path_violations(path, dr, start, goal)
+    assert not is_path(path, dr, start, goal)
+    assert (found[0].clause, found[0].step) == (clause, step)
+
+
+def test_is_path_rejects_a_blocked_cell_and_says_where() -> None:
+    dr = free_dr(3, 3, 3)
+    dr[2, 1, 1] = 1
+    path = [(0, 0), (0, 1), (1, 1), (2, 2)]   # at (1, 1) at step 2
+    found = path_violations(path, dr, (0, 0), (2, 2))
+    assert [(v.clause, v.step, v.cell, v.layer) for v in found] == [("blocked", 2, (1, 1), 2)]
+    assert "step 2" in str(found[0]) and "(1, 1)" in str(found[0]) and "layer 2" in str(found[0])
+    assert not is_path(path, dr, (0, 0), (2, 2))
+    assert not is_path_paper(path, dr, (0, 0), (2, 2))
+
+
+def test_steps_from_N_on_use_the_rest_layer() -> None:
+    dr = free_dr(2, 1, 4)
+    dr[2, 0, 2] = 1   # blocked only in R (index N = 2)
+    path = [(0, 0), (0, 1), (0, 2), (0, 3)]   # at (0, 2) at step 2 = N
+    found = path_violations(path, dr, (0, 0), (0, 3))
+    assert [(v.step, v.layer) for v in found] == [(2, 2)]
+    wait_first = [(0, 0), (0, 1), (0, 1), (0, 2), (0, 3)]   # step 3: still R
+    assert not is_path(wait_first, dr, (0, 0), (0, 3))
+
+
+def test_early_arrival_is_the_paper_definitions_flaw() -> None:
+    # The path reaches its goal at step 2 and waits there; the principal sweeps the goal in
+    # layer 3 < N. Definition 4 checks only k < LENGTH(L), so it accepts; the fixed one does not.
+    N = 5
+    dr = free_dr(N, 3, 3)
+    dr[3, 2, 0] = 1
+    path = [(0, 0), (1, 0), (2, 0)]
+    assert is_path_paper(path, dr, (0, 0), (2, 0))
+    assert not is_path(path, dr, (0, 0), (2, 0))
+    found = path_violations(path, dr, (0, 0), (2, 0))
+    assert [(v.clause, v.step, v.cell, v.layer) for v in found] == [("blocked", 3, (2, 0), 3)]
+    # Arriving after the sweep is valid under both.
+    late = [(0, 0), (0, 0), (0, 0), (0, 0), (1, 0), (2, 0)]
+    assert is_path(late, dr, (0, 0), (2, 0)) and is_path_paper(late, dr, (0, 0), (2, 0))
+
+
+def test_goal_blocked_only_in_the_rest_layer() -> None:
+    dr = free_dr(3, 1, 2)
+    dr[3, 0, 1] = 1
+    path = [(0, 0), (0, 1)]
+    found = path_violations(path, dr, (0, 0), (0, 1))
+    assert [(v.clause, v.step, v.cell, v.layer) for v in found] == [("blocked", None, (0, 1), 3)]
+    assert is_path_paper(path, dr, (0, 0), (0, 1))   # the paper never looks at R here
+
+
+def test_paper_definition_read_literally_skips_the_last_cell_and_outside_pairs() -> None:
+    dr = free_dr(3, 2, 2)
+    dr[1, 1, 1] = 1
+    # The last cell, at step 1, is blocked in layer 1: L_1 has no L_2, so nothing checks it.
+    assert is_path_paper([(0, 0), (1, 1)], dr, (0, 0), (1, 1))
+    assert not is_path([(0, 0), (1, 1)], dr, (0, 0), (1, 1))
+    # A pair with a cell outside the grid does not meet the antecedent i < m /\ ...
+    out = [(0, 0), (0, -5), (0, 1)]
+    assert is_path_paper(out, dr, (0, 0), (0, 1))
+    assert not is_path(out, dr, (0, 0), (0, 1))
+
+
+def test_paper_definition_uses_layer_N_minus_1_from_step_N_on() -> None:
+    dr = free_dr(1, 1, 3)
+    dr[0, 0, 1] = 1   # blocked in layer N - 1 = 0 only; free in the rest layer R = dr[1]
+    path = [(0, 0), (0, 1), (0, 2)]   # at (0, 1) at step 1 = N
+    assert not is_path_paper(path, dr, (0, 0), (0, 2))
+    assert is_path(path, dr, (0, 0), (0, 2))
+
+
+# --- opt_path: Definition 5 by Dijkstra ----------------------------------------------------------
+
+def test_opt_path_reasons_in_order() -> None:
+    dr = free_dr(2, 2, 2)
+    dr[0, 0, 0] = 1
+    dr[2, 1, 1] = 1
+    assert opt_path(dr, (0, 0), (1, 1)).reason == REASON_START_BLOCKED
+    dr[0, 0, 0] = 0
+    assert opt_path(dr, (0, 0), (1, 1)).reason == REASON_GOAL_BLOCKED
+    dr[2, 1, 1] = 0
+    dr[1] = 1   # every cell blocked at step 1
+    result = opt_path(dr, (0, 0), (1, 1))
+    assert (result.status, result.reason, result.path) == (SearchStatus.NO_PATH,
+                                                          REASON_UNREACHABLE, ())
+
+
+def test_opt_path_waits_out_an_early_sweep_of_the_goal() -> None:
+    N = 5
+    dr = free_dr(N, 1, 3)
+    dr[3, 0, 2] = 1       # the goal is swept at step 3
+    result = opt_path(dr, (0, 0), (0, 2))
+    assert (result.status, result.J1, result.J2) == ("found", 2, 2)
+    assert is_path(result.path, dr, (0, 0), (0, 2))
+    assert len(result.path) >= 5 and result.path[-2] != (0, 2)   # arrives at step >= 4
+
+
+def test_opt_path_rejects_bad_inputs() -> None:
+    dr = free_dr(2, 3, 3)
+    with pytest.raises(InputError, match="start"):
+        opt_path(dr, (3, 0), (0, 0))
+    with pytest.raises(InputError, match="goal"):
+        opt_path(dr, (0, 0), (0, 1.5))
+    with pytest.raises(InputError, match="dr"):
+        opt_path(np.zeros((1, 3, 3), dtype=np.uint8), (0, 0), (0, 0))
+
+
+def _all_paths_min(dr: np.ndarray, start: tuple[int, int], goal: tuple[int, int],
+                   max_len: int) -> tuple[int, int] | None:
+    """Least (J1, J2) over every in-grid move sequence of at most max_len cells that is_path accepts."""
+    m, n = dr.shape[1:]
+    best = None
+    frontier = [[start]]
+    for _ in range(max_len):
+        grown = []
+        for path in frontier:
+            if is_path(path, dr, start, goal):
+                cost = (J1(path), J2(path))
+                best = cost if best is None or cost < best else best
+            i, j = path[-1]
+            for di, dj in itertools.product((-1, 0, 1), repeat=2):
+                if 0 <= i + di < m and 0 <= j + dj < n:
+                    grown.append(path + [(i + di, j + dj)])
+        frontier = grown
+    return best
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.data())
+def test_opt_path_is_the_minimum_over_all_short_paths(data: st.DataObject) -> None:
+    # Definition 5 by enumeration: every path of up to length_bound + 1 cells; the extra cell
+    # also checks, on these cases, that longer paths never beat the bound.
+    N = data.draw(st.integers(1, 2))
+    m, n = data.draw(st.sampled_from([(1, 1), (1, 2), (2, 1), (1, 3), (2, 2)]))
+    dr = np.array(data.draw(st.lists(st.integers(0, 1), min_size=(N + 1) * m * n,
+                                     max_size=(N + 1) * m * n)), dtype=np.uint8)
+    dr = dr.reshape(N + 1, m, n)
+    start = (data.draw(st.integers(0, m - 1)), data.draw(st.integers(0, n - 1)))
+    goal = (data.draw(st.integers(0, m - 1)), data.draw(st.integers(0, n - 1)))
+    want = _all_paths_min(dr, start, goal, length_bound(dr) + 1)
+    got = opt_path(dr, start, goal)
+    if want is None:
+        assert got.status == SearchStatus.NO_PATH
+    else:
+        assert got.status == SearchStatus.FOUND and (got.J1, got.J2) == want
+        assert is_path(got.path, dr, start, goal)
+        assert (J1(got.path), J2(got.path)) == want
