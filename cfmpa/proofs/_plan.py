@@ -1,4 +1,4 @@
-"""`cfmpa plan`: BuiltDR, searchoptpath and the certificate, written as DESIGN §9's files.
+"""`cfmpa plan`: BuiltDR, searchoptpath (under contracts) and the certificate, as DESIGN §9's files.
 
 Output is deterministic: the same scenario bytes, variant and version give byte-identical JSON
 apart from the ``timings_s`` object.
@@ -8,26 +8,33 @@ from __future__ import annotations
 
 import platform
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
 from .._io import dumps_json, save_npy_atomic, write_bytes_atomic
+from ..errors import ContractViolation
 from ..impl import build_dr, search_opt_path
 from ..spec import Grid, Scenario, Variant, make_grid
-from ..spec._certificate import Certificate, certificate_json, certify
+from ..spec._certificate import Certificate, certificate_json, certify, require_clear
 from ..spec._paths import SearchResult, SearchStatus
+from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
+                         checked_search, contracts_json)
 
-__all__ = ["PlanResult", "plan", "plan_json", "write_plan", "versions"]
+R = TypeVar("R")
+
+__all__ = ["CERTIFICATE", "PlanResult", "plan", "plan_json", "write_plan", "versions"]
 
 
 @dataclass(frozen=True)
 class PlanResult:
-    """One planning run: the grid, D_R, the search's answer, the certificate and the timings."""
+    """One planning run: the grid, D_R, the search's answer, the certificate, the contracts' record
+    (plan.json's ``contracts``) and the timings; ``runs`` are the contract checks as values."""
 
     scenario: Scenario
     variant: Variant
@@ -37,10 +44,21 @@ class PlanResult:
     certificate: Certificate | None
     contracts: dict[str, Any] | None
     timings_s: dict[str, float] = field(default_factory=dict)
+    runs: tuple[TripleRun, ...] = ()
 
     @property
     def free_fraction(self) -> float:
         return 1.0 - float(self.dr.mean())
+
+    @property
+    def violations(self) -> list[ContractViolation]:
+        """Every violation recorded (empty unless the run was asked not to stop at one)."""
+        out = [v for r in self.runs for v in r.violations()]
+        cert = self.certificate
+        enforced = self.contracts is not None and self.contracts["certificate_enforced"]
+        if enforced and cert is not None and not cert.clear:
+            out.append(_certificate_violation(cert))
+        return out
 
 
 def versions() -> dict[str, str]:
@@ -52,25 +70,68 @@ def versions() -> dict[str, str]:
             "shapely": shapely.__version__, "z3": z3.get_version_string()}
 
 
-def plan(s: Scenario, variant: Variant | str, *, contracts: str = "off", seed: int = 0,
-         sample: int | None = None) -> PlanResult:
-    """Plan the subordinate's path for ``variant`` (no contracts: mode 'off')."""
+def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
+         sample: int | None = None, stop: bool = True, grid: Grid | None = None,
+         build: Builder = build_dr, search: Searcher = search_opt_path) -> PlanResult:
+    """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
+
+    ``contracts`` is off, sampled (``sample`` random cells, ``seed``) or full (see _contracts).
+    Unless off, a certificate that is not clear (a contact, or an interval left undecided) is a
+    violation too. A violation raises ContractViolation; with ``stop=False`` postcondition and
+    certificate violations are recorded in ``contracts`` and the run goes on (a failed
+    precondition always stops it). ``grid``, ``build`` and ``search`` replace the scenario's grid
+    and the reference implementation: for checking another implementation, or a seeded fault.
+    """
     v = Variant(variant)
-    g = make_grid(s)
+    settings = Settings.of(contracts, seed, sample)
+    g = grid or make_grid(s)
+    enforce = settings.mode is not Mode.OFF
     t: dict[str, float] = {}
     t0 = time.perf_counter()
-    dr = build_dr(s, v, g)
-    t["build_dr"] = time.perf_counter() - t0
+    dr, runs = checked_build_dr(s, v, g, settings, build=_timed(build, t, "build_dr"), stop=stop)
+    if enforce:
+        t["contracts_builtdr"] = time.perf_counter() - t0 - t["build_dr"]
     t0 = time.perf_counter()
-    result = search_opt_path(dr, s.right.start_cell, s.right.goal_cell)
-    t["search"] = time.perf_counter() - t0
+    result, search_runs = checked_search(s, v, g, dr, settings, established=runs[-1] if runs
+                                         else None, search=_timed(search, t, "search"), stop=stop)
+    if enforce:
+        t["contracts_search"] = time.perf_counter() - t0 - t["search"]
+    runs += search_runs
     cert = None
     if result.status is SearchStatus.FOUND:
         t0 = time.perf_counter()
         cert = certify(s, g, result.path)
         t["certificate"] = time.perf_counter() - t0
+        if enforce and stop:
+            require_clear(cert, name=CERTIFICATE)
+    record = contracts_json(settings, runs,
+                            _certificate_violation(cert) if enforce and cert and not cert.clear
+                            else None, certificate_checked=enforce)
     return PlanResult(scenario=s, variant=v, grid=g, dr=dr, search=result, certificate=cert,
-                      contracts=None, timings_s=t)
+                      contracts=record, timings_s=t, runs=tuple(runs))
+
+
+#: The certificate's name in violations (it is not one of the paper's triples).
+CERTIFICATE = "continuous-time certificate"
+
+
+def _certificate_violation(cert: Certificate) -> ContractViolation:
+    try:
+        require_clear(cert, name=CERTIFICATE)
+    except ContractViolation as exc:
+        return exc
+    raise AssertionError("require_clear accepted a certificate that is not clear")
+
+
+def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[..., R]:
+    """``fn``, recording its own time in t[key] (so contract time can be told apart from it)."""
+    def run(*args: Any) -> R:
+        t0 = time.perf_counter()
+        try:
+            return fn(*args)
+        finally:
+            t[key] = time.perf_counter() - t0
+    return run
 
 
 def plan_json(p: PlanResult) -> dict[str, Any]:

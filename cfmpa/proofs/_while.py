@@ -1,0 +1,267 @@
+"""A small while-language with weakest preconditions, producing verification conditions for Z3.
+
+Commands: Skip, Assign, Store (array update), Seq, If, While (with invariant and variant), For
+(a counted loop, sugar for While), Assume and Havoc (to model a callee by its contract). The
+rules are Dijkstra's; a loop contributes its invariant to the enclosing precondition, its exit
+condition with the loop's modified variables universally quantified (so facts about the other
+variables flow past the loop), and a side VC: the invariant is preserved. Partial correctness
+and termination are generated separately: for termination every loop adds that its variant is
+>= 0 while it runs and decreases in every iteration. All VCs of both valid => total correctness.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import z3
+
+from ._obligation import VC
+
+__all__ = [
+    "Assign",
+    "Assume",
+    "Cmd",
+    "For",
+    "Havoc",
+    "If",
+    "Seq",
+    "Skip",
+    "Store",
+    "While",
+    "modifies",
+    "verification_conditions",
+    "wp",
+]
+
+
+@dataclass(frozen=True)
+class Skip:
+    pass
+
+
+@dataclass(frozen=True)
+class Assign:
+    """var := value."""
+
+    var: z3.ExprRef
+    value: z3.ExprRef
+
+
+@dataclass(frozen=True)
+class Store:
+    """array[index...] := value."""
+
+    array: z3.ExprRef
+    index: tuple[z3.ExprRef, ...]
+    value: z3.ExprRef
+
+
+@dataclass(frozen=True)
+class Seq:
+    cmds: tuple[Cmd, ...]
+
+
+@dataclass(frozen=True)
+class If:
+    cond: z3.BoolRef
+    then: Cmd
+    orelse: Cmd = Skip()
+
+
+@dataclass(frozen=True)
+class While:
+    """while cond invariant inv variant var do body; ``label`` names its VCs."""
+
+    label: str
+    cond: z3.BoolRef
+    invariant: z3.BoolRef
+    variant: z3.ArithRef
+    body: Cmd
+
+
+@dataclass(frozen=True)
+class For:
+    """for var in [lo, hi) invariant inv do body (body may modify neither var nor lo, hi).
+
+    Means var := lo; while var < hi invariant (lo <= var <= max(lo, hi) ∧ inv)
+    variant hi - var do (body; var := var + 1).
+    """
+
+    label: str
+    var: z3.ArithRef
+    lo: z3.ArithRef
+    hi: z3.ArithRef
+    invariant: z3.BoolRef
+    body: Cmd
+
+    def desugar(self, counters_only: bool = False) -> Seq:
+        """The While loop this For means; ``counters_only`` keeps just lo <= var <= hi as the
+        invariant (all termination needs: the body can change neither var nor the bounds)."""
+        reads = {_key(c) for c in _consts(self.lo) + _consts(self.hi)} | {_key(self.var)}
+        clash = reads & {_key(v) for v in modifies(self.body)}
+        if clash:
+            raise ValueError(f"loop {self.label}: body modifies its counter or bounds {sorted(clash)}")
+        # range(lo, hi) in Python: runs no iteration when hi <= lo, leaving var at lo.
+        top = z3.If(self.hi >= self.lo, self.hi, self.lo)
+        bounds = z3.And(self.lo <= self.var, self.var <= top)
+        inv = bounds if counters_only else z3.And(bounds, self.invariant)
+        return Seq((Assign(self.var, self.lo),
+                    While(self.label, self.var < self.hi, inv, self.hi - self.var,
+                          Seq((self.body, Assign(self.var, self.var + 1))))))
+
+
+@dataclass(frozen=True)
+class Assume:
+    """Continue only in states where cond holds (a callee's postcondition)."""
+
+    cond: z3.BoolRef
+
+
+@dataclass(frozen=True)
+class Havoc:
+    """Give the variables arbitrary values (a callee's outputs)."""
+
+    vars: tuple[z3.ExprRef, ...]
+
+
+Cmd = Skip | Assign | Store | Seq | If | While | For | Assume | Havoc
+
+
+def modifies(c: Cmd) -> list[z3.ExprRef]:
+    """The variables a command may change, each once, in order of first appearance."""
+    out: dict[tuple[str, str], z3.ExprRef] = {}
+
+    def walk(c: Cmd) -> None:
+        if isinstance(c, Assign):
+            out.setdefault(_key(c.var), c.var)
+        elif isinstance(c, Store):
+            out.setdefault(_key(c.array), c.array)
+        elif isinstance(c, Seq):
+            for x in c.cmds:
+                walk(x)
+        elif isinstance(c, If):
+            walk(c.then)
+            walk(c.orelse)
+        elif isinstance(c, While):
+            walk(c.body)
+        elif isinstance(c, For):
+            out.setdefault(_key(c.var), c.var)
+            walk(c.body)
+        elif isinstance(c, Havoc):
+            for v in c.vars:
+                out.setdefault(_key(v), v)
+    walk(c)
+    return list(out.values())
+
+
+class _Gen:
+    """Collects side VCs and hands out deterministic names for quantified copies of variables."""
+
+    def __init__(self, termination: bool = False) -> None:
+        self.side: list[VC] = []
+        self.counter = 0
+        self.termination = termination
+
+    def fresh(self, v: z3.ExprRef, label: str) -> z3.ExprRef:
+        self.counter += 1
+        return z3.Const(f"{v}@{label}#{self.counter}", v.sort())
+
+
+def wp(c: Cmd, post: z3.BoolRef, gen: _Gen | None = None) -> z3.BoolRef:
+    """The weakest precondition of c for post; side VCs of loops go into ``gen.side``."""
+    g = gen if gen is not None else _Gen()
+    return _wp(c, post, g)
+
+
+def _wp(c: Cmd, q: z3.BoolRef, g: _Gen) -> z3.BoolRef:
+    if isinstance(c, Skip):
+        return q
+    if isinstance(c, Assign):
+        return z3.substitute(q, (c.var, c.value))
+    if isinstance(c, Store):
+        return z3.substitute(q, (c.array, z3.Store(c.array, *c.index, c.value)))
+    if isinstance(c, Seq):
+        for x in reversed(c.cmds):
+            q = _wp(x, q, g)
+        return q
+    if isinstance(c, If):
+        return z3.And(z3.Implies(c.cond, _wp(c.then, q, g)),
+                      z3.Implies(z3.Not(c.cond), _wp(c.orelse, q, g)))
+    if isinstance(c, For):
+        return _wp(c.desugar(counters_only=g.termination), q, g)
+    if isinstance(c, Assume):
+        return z3.Implies(c.cond, q)
+    if isinstance(c, Havoc):
+        return _forall_fresh(list(c.vars), q, g, "havoc")
+    if isinstance(c, While):
+        return _wp_while(c, q, g)
+    raise TypeError(f"not a command: {c!r}")
+
+
+def _forall_fresh(vs: list[z3.ExprRef], q: z3.BoolRef, g: _Gen, label: str) -> z3.BoolRef:
+    """∀ vs. q, with the bound copies named deterministically."""
+    if not vs:
+        return q
+    fresh = [g.fresh(v, label) for v in vs]
+    return z3.ForAll(fresh, z3.substitute(q, *zip(vs, fresh)))
+
+
+def _wp_while(c: While, q: z3.BoolRef, g: _Gen) -> z3.BoolRef:
+    inv, cond = c.invariant, c.cond
+    kind = "termination" if g.termination else "correctness"
+    # Preservation: one iteration from a state where the invariant and the guard hold.
+    g.side.append(VC(f"{c.label}.preserve", (("invariant", inv), ("guard", cond)),
+                     _wp(c.body, inv, g), key_premise="invariant", kind=kind))
+    if g.termination:
+        # The variant is bounded below while the loop runs, and every iteration lowers it; V0
+        # is its value at the start of the iteration. (For a For loop the bound follows from
+        # the guard and from the invariant alike: no single key premise.)
+        v0 = z3.Int(f"{c.label}.V0")
+        g.side.append(VC(f"{c.label}.variant_bounded", (("invariant", inv), ("guard", cond)),
+                         c.variant >= 0, kind=kind))
+        # Nested loops' side VCs do not depend on the postcondition and were just collected
+        # by the preservation VC's wp: compute this one with a scratch collector.
+        scratch = _Gen(termination=True)
+        scratch.counter = g.counter
+        decreases = _wp(c.body, c.variant < v0, scratch)
+        g.counter = scratch.counter
+        g.side.append(VC(f"{c.label}.variant_decreases",
+                         (("invariant", inv), ("guard", cond), ("entry", c.variant == v0)),
+                         decreases, key_premise="entry", kind=kind))
+    # Exit: whatever the loop did to the variables it modifies, invariant ∧ ¬guard gives q.
+    return z3.And(inv, _forall_fresh(modifies(c.body), z3.Implies(z3.And(inv, z3.Not(cond)), q),
+                                     g, c.label))
+
+
+def verification_conditions(name: str, pre: z3.BoolRef, c: Cmd, post: z3.BoolRef,
+                            *, termination: bool = False,
+                            witness: tuple[tuple[z3.ExprRef, z3.ExprRef], ...] = ()
+                            ) -> tuple[VC, ...]:
+    """{pre} c {post}: the main VC pre => wp(c, post), then every loop's preservation VC.
+
+    With ``termination``: the VCs that c terminates from pre instead; For loops keep only their
+    counter bounds as invariant (inductive on their own), every loop adds its variant's VCs,
+    and the main VC shows the bounds hold on entry (post is ignored)."""
+    g = _Gen(termination=termination)
+    goal = _wp(c, z3.BoolVal(True) if termination else post, g)
+    # For termination the entry condition is trivial for For loops: no key premise then.
+    main = VC(f"{name}.main", (("pre", pre),), goal, witness=witness,
+              key_premise=None if termination else "pre",
+              kind="termination" if termination else "correctness")
+    return (main, *g.side)
+
+
+def _key(v: z3.ExprRef) -> tuple[str, str]:
+    return (str(v), str(v.sort()))
+
+
+def _consts(e: z3.ExprRef) -> list[z3.ExprRef]:
+    """The uninterpreted constants occurring in e."""
+    seen: dict[tuple[str, str], z3.ExprRef] = {}
+    todo = [e]
+    while todo:
+        x = todo.pop()
+        if z3.is_const(x) and x.decl().kind() == z3.Z3_OP_UNINTERPRETED:
+            seen.setdefault(_key(x), x)
+        todo.extend(x.children())
+    return list(seen.values())
