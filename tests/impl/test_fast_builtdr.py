@@ -1,0 +1,153 @@
+"""build_dr_fast gives the reference's D_R bit for bit: bundled scenarios, random ones, and the
+pairs its kernel leaves to the reference (thresholds widened so that many do)."""
+
+from __future__ import annotations
+
+import io
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import factory
+from cfmpa.impl import _fast_builtdr, _progress, build_dr, right_regions
+from cfmpa.impl._fast_builtdr import build_dr_fast
+from cfmpa.spec import Variant, joint_points, load_scenario, make_grid, parse_scenario
+
+SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
+SMALL = [p for p in SCENARIOS if p.stem != "default"]
+DEFAULT = [p for p in SCENARIOS if p.stem == "default"]
+
+
+def assert_same(s, variant, grid=None, **kw):
+    g = grid or make_grid(s)
+    rr = right_regions(s, g)
+    ref = build_dr(s, variant, g, right=rr, **kw)
+    fast = build_dr_fast(s, variant, g, right=rr, **kw)
+    assert fast.dtype == ref.dtype == np.uint8
+    assert fast.shape == ref.shape == g.shape
+    diff = np.argwhere(fast != ref)
+    assert diff.size == 0, f"{len(diff)} cells differ, first (k, i, j) = {diff[:5].tolist()}"
+    return ref
+
+
+@pytest.mark.parametrize("variant", list(Variant), ids=str)
+@pytest.mark.parametrize("path", SMALL, ids=lambda p: p.stem)
+def test_bit_identical_on_bundled_scenarios(path, variant):
+    ref = assert_same(load_scenario(path), variant)
+    assert 0 < ref.mean() < 1   # both decisions occur, so equality has teeth
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("variant", list(Variant), ids=str)
+@pytest.mark.parametrize("path", DEFAULT, ids=lambda p: p.stem)
+def test_bit_identical_on_the_default_scenario(path, variant):
+    assert_same(load_scenario(path), variant)
+
+
+@pytest.mark.parametrize("variant", list(Variant), ids=str)
+def test_bit_identical_on_a_coarse_default(variant):
+    # The default workcell at 4x the time step: the default run's stand-in for the slow test.
+    s = parse_scenario(factory.doc(dt=0.08, right__start_cell=[10, 25], right__goal_cell=[38, 15]),
+                       check_budget=False)
+    assert_same(s, variant)
+
+
+@pytest.mark.parametrize("variant", list(Variant), ids=str)
+def test_pairs_left_to_the_reference_are_decided_as_it_does(monkeypatch, variant):
+    # A margin of 5 cm sends every pair near contact to blocked_against; eps = 1 cm makes the
+    # reference's exact-distance band (0, eps] matter. The output must still be identical.
+    monkeypatch.setattr(_fast_builtdr, "MARGIN_REL", 0.05)
+    s = factory.scenario()
+    calls = []
+    real = _fast_builtdr.blocked_against
+    monkeypatch.setattr(_fast_builtdr, "blocked_against",
+                        lambda *a: calls.append(len(a[1])) or real(*a))
+    assert_same(s, variant, eps=0.01)
+    assert sum(calls) > 50   # the fallback really ran, on many pairs
+
+
+def test_kernel_decides_default_pairs_itself(monkeypatch):
+    # With the real margin no pair of the coarse default needs the reference routine.
+    calls = []
+    monkeypatch.setattr(_fast_builtdr, "blocked_against", lambda *a: calls.append(a) or None)
+    s = factory.scenario(dt=0.08, right__start_cell=[10, 25], right__goal_cell=[38, 15])
+    build_dr_fast(s, Variant.ORIGINAL)
+    assert calls == []
+
+
+@st.composite
+def random_scenarios(draw):
+    """Random workcells with coarse grids (m, n <= ~40, N <= ~15): bases, links, widths, speeds,
+    start and goal all vary; the right base is near enough for the arms to meet."""
+    dt = draw(st.sampled_from([0.1, 0.125, 0.2, 0.25]))
+    f = st.floats
+
+    def arm(base):
+        return {"base": base,
+                "links": [draw(f(0.05, 0.5)), draw(f(0.05, 0.5))],
+                "width": draw(f(0.005, 0.15)),
+                "omega": [draw(f(1.2, 3.0)), draw(f(1.2, 3.0))]}
+
+    left = arm([draw(f(-0.2, 0.2)), draw(f(-0.2, 0.2))])
+    start = [draw(f(-3.2, 3.2)), draw(f(-3.2, 3.2))]
+    left["start"] = start
+    left["goal"] = [start[q] + draw(f(-1.5, 1.5)) for q in range(2)]
+    right = arm([draw(f(0.0, 0.9)), draw(f(-0.4, 0.4))])
+    limits = []
+    for q in range(2):
+        lo = draw(f(-math.pi, 0.0))
+        limits.append([lo, lo + draw(f(0.5, 2 * math.pi))])
+    right["limits"] = limits
+    size = [joint_points(limits[q][0], limits[q][1], right["omega"][q], dt) for q in range(2)]
+    right["start_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
+    right["goal_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
+    return parse_scenario({"name": "random", "purpose": "hypothesis", "dt": dt, "left": left,
+                           "right": right}, check_budget=False)
+
+
+@settings(max_examples=40, deadline=None)
+@given(s=random_scenarios(), variant=st.sampled_from(list(Variant)))
+def test_bit_identical_on_random_scenarios(s, variant):
+    assert_same(s, variant)
+
+
+class FakeTerminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_is_silent_when_stderr_is_not_a_terminal(monkeypatch, capsys):
+    monkeypatch.setattr(_progress, "PROGRESS_MIN_CELLS", 0)   # even a tiny grid counts as large
+    build_dr_fast(factory.scenario(), Variant.TIGHT)
+    assert capsys.readouterr().err == ""
+
+
+def test_progress_is_silent_for_small_grids_on_a_terminal(monkeypatch):
+    term = FakeTerminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    build_dr_fast(factory.scenario(), Variant.TIGHT)
+    assert term.getvalue() == ""
+
+
+def test_progress_draws_a_bar_on_a_terminal_for_large_grids(monkeypatch):
+    term = FakeTerminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    monkeypatch.setattr(_progress, "PROGRESS_MIN_CELLS", 0)
+    s = factory.scenario()
+    build_dr_fast(s, Variant.TIGHT)
+    layers = make_grid(s).N + 1
+    out = term.getvalue()
+    assert out.startswith("\rBuiltDR tight [") and out.endswith(f"] {layers}/{layers}\n")
+
+
+def test_progress_false_silences_even_a_terminal(monkeypatch):
+    term = FakeTerminal()
+    monkeypatch.setattr(sys, "stderr", term)
+    monkeypatch.setattr(_progress, "PROGRESS_MIN_CELLS", 0)
+    build_dr_fast(factory.scenario(), Variant.TIGHT, progress=False)
+    assert term.getvalue() == ""
