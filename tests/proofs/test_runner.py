@@ -1,0 +1,117 @@
+"""`make prove`'s driver: the expected-id check, replay hashes, results.json, the summary."""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from cfmpa.proofs import (ASSUMPTIONS, FIXED_IDS, Verdict, collect_obligations, expected_ids,
+                          render_report, run_obligations, run_prove, selected)
+
+REPO = Path(__file__).resolve().parents[2]
+CHEAP = ["Def1", "Lemma1", "Prop2", "Margin.naive_hull"]
+
+
+def _strip_times(doc: dict) -> dict:
+    doc = dict(doc)
+    doc.pop("seconds")
+    doc["obligations"] = [{k: v for k, v in o.items() if k not in ("seconds", "change")}
+                          for o in doc["obligations"]]
+    return doc
+
+
+def test_fixed_ids_match_the_collected_obligations_exactly():
+    ids = [o.id for o in collect_obligations(scenarios_dir="/nonexistent")]
+    assert len(ids) == len(set(ids))
+    assert tuple(ids) == FIXED_IDS
+
+
+def test_scenario_ids_come_from_the_files_found(tmp_path: Path):
+    for name in ("a", "b"):
+        shutil.copy(REPO / "scenarios" / "default.toml", tmp_path / f"{name}.toml")
+    ids = expected_ids(tmp_path)
+    assert ids[: len(FIXED_IDS)] == FIXED_IDS
+    assert ids[len(FIXED_IDS):] == tuple(f"Scenario.{s}.{c}" for s in ("a", "b")
+                                         for c in ("time_grid", "cspace_grid", "containment"))
+    assert [o.id for o in collect_obligations(tmp_path, ["Scenario"])] == list(ids[len(FIXED_IDS):])
+
+
+def test_selection_by_id_prefix_and_glob():
+    assert selected("Prop8.printed", ["Prop8"]) and selected("Prop8.printed", ["Prop8.printed"])
+    assert not selected("Prop80.x", ["Prop8"])
+    assert selected("Thm3.builtdr", ["Thm*"]) and not selected("Def1.segment", ["Thm*"])
+    assert selected("anything", None)
+
+
+def test_replay_reports_new_same_changed_and_writes_atomically(tmp_path: Path):
+    obs = collect_obligations("/nonexistent", CHEAP)
+    exp = [o.id for o in obs]
+    first = run_obligations(obs, tmp_path, exp)
+    assert first.ok and set(first.changes.values()) == {"new"}
+    files = sorted(p.name for p in tmp_path.iterdir())
+    assert not [f for f in files if f.startswith(".")]              # no temp files left over
+    assert "Def1.segment.smt2" in files and "Margin.naive_hull.txt" in files
+    doc1 = json.loads((tmp_path / "results.json").read_text())
+    entry = next(o for o in doc1["obligations"] if o["id"] == "Def1.segment")
+    text = (tmp_path / "Def1.segment.smt2").read_text()
+    import hashlib
+    assert entry["sha256"] == hashlib.sha256(text.encode()).hexdigest()
+
+    second = run_obligations(obs, tmp_path, exp)
+    assert set(second.changes.values()) == {"same"}
+    doc2 = json.loads((tmp_path / "results.json").read_text())
+    assert _strip_times(doc1) == _strip_times(doc2)
+
+    edited = [dataclasses.replace(o, statement=o.statement + " (edited)")
+              if o.id == "Prop2.endpoints" else o for o in obs]
+    third = run_obligations(edited, tmp_path, exp)
+    assert third.changes["Prop2.endpoints"] == "changed"
+    assert {v for k, v in third.changes.items() if k != "Prop2.endpoints"} == {"same"}
+
+
+def test_a_missing_or_unexpected_id_fails_the_run(tmp_path: Path):
+    obs = collect_obligations("/nonexistent", ["Def1"])
+    run = run_obligations(obs, tmp_path, [o.id for o in obs] + ["Ghost.id"])
+    assert not run.ok and run.missing_ids == ("Ghost.id",)
+    assert "MISSING obligations" in render_report(run)
+    run = run_obligations(obs, tmp_path, [obs[0].id])
+    assert not run.ok and run.unexpected_ids == tuple(o.id for o in obs[1:])
+
+
+def test_a_scenario_that_does_not_load_fails_instead_of_vanishing(tmp_path: Path):
+    (tmp_path / "broken.toml").write_text('name = "broken"\n')
+    out = io.StringIO()
+    rc = run_prove(out_dir=tmp_path / "out", scenarios_dir=tmp_path, only=["Scenario"],
+                   stream=out)
+    assert rc == 1
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    verdicts = {o["id"]: o["verdict"] for o in doc["obligations"]}
+    assert verdicts == {f"Scenario.broken.{c}": "failed"
+                        for c in ("time_grid", "cspace_grid", "containment")}
+
+
+def test_full_run_discharges_everything_as_expected(tmp_path: Path):
+    out = io.StringIO()
+    rc = run_prove(out_dir=tmp_path, scenarios_dir=REPO / "scenarios", stream=out)
+    text = out.getvalue()
+    assert rc == 0, text
+    doc = json.loads((tmp_path / "results.json").read_text())
+    assert doc["ok"] and not doc["missing_ids"] and not doc["unexpected_ids"]
+    ids = [o["id"] for o in doc["obligations"]]
+    assert ids == list(expected_ids(REPO / "scenarios"))
+    assert all(o["verdict"] == o["expected"] for o in doc["obligations"])
+    refuted = {o["id"] for o in doc["obligations"] if o["verdict"] == "refuted as expected"}
+    assert refuted == {"Def1.segment_printed", "Margin.naive_hull", "Prop5.printed",
+                       "Def4.is_path_printed", "Prop8.printed"}
+    assert all(o["counterexample"] for o in doc["obligations"] if o["id"] in refuted)
+    assert [a["id"] for a in doc["assumptions"]] == [a.id for a in ASSUMPTIONS]
+    assert "Summary of proof obligations" in text and "Assumptions (not proved)" in text
+    assert doc["totals"]["unknown"] == 0 and doc["totals"]["failed"] == 0
+    for o in doc["obligations"]:
+        assert (tmp_path / o["file"]).is_file()
+    assert Verdict(doc["obligations"][0]["verdict"]) is Verdict.PROVED
