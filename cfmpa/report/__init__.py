@@ -1,0 +1,13 @@
+"""The audit report (`cfmpa audit`) and the comparison campaign (`cfmpa compare`).
+
+The only package of cfmpa that plots (matplotlib, in ``_figures``).
+"""
+
+from ._audit import (DEFAULT_COMPARE_N, AuditResult, build_audit, render_html, run_audit,
+                     write_report)
+from ._compare import campaign_json, random_workcell, run_campaign, run_compare
+
+__all__ = [
+    "AuditResult", "DEFAULT_COMPARE_N", "build_audit", "campaign_json", "random_workcell",
+    "render_html", "run_audit", "run_campaign", "run_compare", "write_report",
+]

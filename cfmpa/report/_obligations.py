@@ -1,0 +1,223 @@
+"""The report's proof data: obligations, the assumptions ledger and the mutation self-check.
+
+Where the obligations come from (decided here, printed in the report):
+- ``proofs_json`` given (what ``make prove`` passes: ``build/proofs/results.json``, just written):
+  read from that file, so the report shows exactly the run that ``make prove`` printed;
+- otherwise a fresh run of the prove machinery (``cfmpa.proofs.collect_obligations``, each
+  obligation discharged in this process by ``discharge``; nothing is written under build/proofs).
+Either way the ids are checked against ``cfmpa.proofs.expected_ids``: none missing, none extra.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = [
+    "ObligationRow",
+    "ProofData",
+    "SUMMARY_COLUMNS",
+    "load_proofs",
+    "summary_table",
+    "load_selftest",
+]
+
+#: The summary's columns (gnatprove.out style), key -> heading.
+SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("total", "total"),
+    ("proved_z3", "proved by Z3"),
+    ("proved_sympy", "proved by sympy"),
+    ("checked_data", "checked on data"),
+    ("tested_only", "tested only"),
+    ("refuted_as_expected", "refuted as expected"),
+    ("unproved", "unproved"),
+)
+
+_VERDICTS = ("proved", "refuted as expected", "unknown", "failed")
+
+
+@dataclass(frozen=True)
+class ObligationRow:
+    """One obligation's outcome as the report prints it."""
+
+    id: str
+    group: str
+    paper_ref: str
+    statement: str
+    method: str
+    verdict: str
+    expected: str
+    seconds: float | None
+    counterexample: str | None
+    reason: str
+    sha256: str
+    change: str | None = None      # new | changed | same | not run, against the previous prove run
+
+    @property
+    def as_expected(self) -> bool:
+        return self.verdict == self.expected
+
+    def as_json(self) -> dict[str, Any]:
+        return {"id": self.id, "group": self.group, "paper_ref": self.paper_ref,
+                "statement": self.statement, "method": self.method, "verdict": self.verdict,
+                "expected": self.expected, "as_expected": self.as_expected,
+                "seconds": self.seconds, "counterexample": self.counterexample,
+                "reason": self.reason, "sha256": self.sha256, "change": self.change}
+
+
+@dataclass(frozen=True)
+class ProofData:
+    """Obligations and ledger, with where they came from; ``available`` False: none this run."""
+
+    available: bool
+    source: str
+    note: str
+    rows: tuple[ObligationRow, ...]
+    ledger: tuple[dict[str, str], ...]
+    ledger_available: bool
+    missing_ids: tuple[str, ...] = ()      # expected by the prove machinery, not in the data
+    unexpected_ids: tuple[str, ...] = ()   # in the data, not expected
+
+
+def load_proofs(proofs_json: str | None, scenarios_dir: str | Path) -> ProofData:
+    """Obligations and ledger from ``proofs_json``, else from a fresh run (module docstring)."""
+    if proofs_json is not None:
+        return _from_file(Path(proofs_json))
+    return _fresh(Path(scenarios_dir))
+
+
+def summary_table(rows: Iterable[ObligationRow]) -> dict[str, Any]:
+    """Counts per group (in first-seen order) and in total, by the columns of SUMMARY_COLUMNS.
+
+    "proved by Z3 / sympy", "checked on data" and "tested only" count proved verdicts by their
+    method (data: an exhaustive check on concrete data; test: method 'test', if any obligation
+    declares it); "unproved" counts unknown and failed verdicts.
+    """
+    groups: dict[str, dict[str, int]] = {}
+    total = {k: 0 for k, _ in SUMMARY_COLUMNS}
+    for r in rows:
+        g = groups.setdefault(r.group, {k: 0 for k, _ in SUMMARY_COLUMNS})
+        key = _column(r)
+        for bucket in (g, total):
+            bucket["total"] += 1
+            bucket[key] += 1
+    return {"columns": [{"key": k, "heading": h} for k, h in SUMMARY_COLUMNS],
+            "rows": [{"group": name, **counts} for name, counts in groups.items()],
+            "total": total}
+
+
+def _column(r: ObligationRow) -> str:
+    if r.verdict == "proved":
+        return {"z3": "proved_z3", "sympy": "proved_sympy", "data": "checked_data",
+                "test": "tested_only"}.get(r.method, "unproved")
+    if r.verdict == "refuted as expected":
+        return "refuted_as_expected"
+    return "unproved"
+
+
+# --- from results.json ------------------------------------------------------------------------
+
+def _from_file(path: Path) -> ProofData:
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError("proofs_json", str(path), f"cannot be read ({exc.strerror or exc})") from None
+    except json.JSONDecodeError as exc:
+        raise InputError("proofs_json", str(path), f"is not valid JSON ({exc.msg}, line "
+                         f"{exc.lineno})") from None
+    items = doc.get("obligations") if isinstance(doc, dict) else None
+    if not isinstance(items, list):
+        raise InputError("proofs_json", str(path), "has no 'obligations' list")
+    rows = tuple(_row_from_json(item, k, path) for k, item in enumerate(items))
+    ledger_doc = doc.get("assumptions")
+    ledger = _ledger_entries(ledger_doc) if isinstance(ledger_doc, list) else ()
+    return ProofData(available=True, source=f"read from {path}",
+                     note="the results the prove run recorded, not re-run for this report",
+                     rows=rows, ledger=ledger, ledger_available=isinstance(ledger_doc, list),
+                     missing_ids=tuple(doc.get("missing_ids") or ()),
+                     unexpected_ids=tuple(doc.get("unexpected_ids") or ()))
+
+
+def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
+    if not isinstance(item, dict) or not isinstance(item.get("id"), str):
+        raise InputError(f"obligations[{k}]", item, f"in {path} must be an object with an 'id'")
+    verdict = str(item.get("verdict", ""))
+    if verdict not in _VERDICTS:
+        raise InputError(f"obligations[{k}].verdict", verdict,
+                         f"in {path} must be one of {', '.join(_VERDICTS)}")
+    seconds = item.get("seconds")
+    return ObligationRow(
+        id=item["id"], group=str(item.get("group") or "ungrouped"),
+        paper_ref=str(item.get("paper_ref") or ""), statement=str(item.get("statement") or ""),
+        method=str(item.get("method", "")), verdict=verdict,
+        expected=str(item.get("expected", "proved")),
+        seconds=float(seconds) if isinstance(seconds, (int, float)) else None,
+        counterexample=item.get("counterexample"), reason=str(item.get("reason", "")),
+        sha256=str(item.get("sha256", "")), change=item.get("change"))
+
+
+# --- a fresh run --------------------------------------------------------------------------------
+
+def _fresh(scenarios_dir: Path) -> ProofData:
+    from ..proofs import ASSUMPTIONS, collect_obligations, discharge, expected_ids
+
+    t0 = time.perf_counter()
+    rows = []
+    for ob in collect_obligations(scenarios_dir):
+        p = discharge(ob)
+        rows.append(ObligationRow(
+            id=ob.id, group=ob.group, paper_ref=ob.paper_ref, statement=ob.statement,
+            method=p.method.value, verdict=p.verdict.value, expected=p.expected.value,
+            seconds=float(p.seconds), counterexample=p.counterexample, reason=p.reason,
+            sha256=p.sha256))
+    ids = [r.id for r in rows]
+    expected = expected_ids(scenarios_dir)
+    return ProofData(available=True, source="a fresh run of the prove machinery for this report",
+                     note=f"{len(rows)} obligations discharged in "
+                     f"{time.perf_counter() - t0:.1f} s; nothing written under build/proofs",
+                     rows=tuple(rows), ledger=_ledger_entries(ASSUMPTIONS), ledger_available=True,
+                     missing_ids=tuple(i for i in expected if i not in ids),
+                     unexpected_ids=tuple(i for i in ids if i not in expected))
+
+
+def _ledger_entries(entries: Iterable[Any]) -> tuple[dict[str, str], ...]:
+    """Ledger entries {id, what, why, used_by} from Assumption values or their JSON."""
+    out = []
+    for e in entries:
+        get = e.get if isinstance(e, dict) else (lambda k, _e=e: getattr(_e, k, None))
+        out.append({k: str(get(k) or "") for k in ("id", "what", "why", "used_by")})
+    return tuple(out)
+
+
+# --- mutation self-check ------------------------------------------------------------------------
+
+def load_selftest() -> dict[str, Any]:
+    """The mutation self-check table from ``cfmpa.proofs._selftest`` when it provides its rows."""
+    try:
+        from ..proofs import _selftest  # type: ignore[attr-defined]
+    except ImportError:
+        return {"available": False, "source": "not available in this run",
+                "note": "cfmpa.proofs._selftest is not in this checkout", "rows": []}
+    rows_fn = getattr(_selftest, "selftest_rows", None)
+    if rows_fn is None:
+        return {"available": False, "source": "not available in this run",
+                "note": "cfmpa.proofs._selftest provides no selftest_rows()", "rows": []}
+    rows = []
+    for r in rows_fn():
+        get = r.get if isinstance(r, dict) else (lambda k, _r=r: getattr(_r, k, None))
+        rows.append({k: _plain(get(k)) for k in ("fault", "caught_full", "caught_sampled",
+                                                 "caught_by", "detail")})
+    return {"available": True, "source": "cfmpa.proofs._selftest.selftest_rows(), run for this "
+            "report", "note": "", "rows": rows}
+
+
+def _plain(x: Any) -> Any:
+    if x is None or isinstance(x, (bool, int, float, str)):
+        return x
+    return str(x)

@@ -1,0 +1,323 @@
+"""The audit report: schema, content and order, no external URL, provenance, golden text, browser.
+
+One report is built per module (a coarse copy of the default workcell: 13 layers of 52 x 52
+cells, where original's start is blocked and modified/tight find a path; the four findings on the
+bundled scenarios, a real `run_prove` over a subset of the obligations, a 4-workcell campaign).
+
+Golden files live in tests/report/golden/. After an intended change of the findings' text or of
+report.json's keys, regenerate them with
+
+    CFMPA_REGEN_GOLDEN=1 .venv/bin/python -m pytest tests/report
+
+and review the diff before committing.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import io
+import json
+import os
+import re
+import shutil
+import struct
+import subprocess
+import zlib
+from pathlib import Path
+
+import jsonschema
+import pytest
+from markupsafe import escape
+
+from cfmpa._io import dumps_json
+from cfmpa.errors import InputError
+from cfmpa.proofs import run_prove
+from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
+from cfmpa.report._audit import _proof_sections, _verdict
+from cfmpa.report._obligations import load_proofs
+from cfmpa.report._provenance import git_state
+
+ROOT = Path(__file__).resolve().parents[2]
+GOLDEN = Path(__file__).parent / "golden"
+SCHEMA = ROOT / "cfmpa" / "report" / "schema.json"
+CHROMIUM = Path("/usr/bin/chromium")
+#: A subset of obligations that discharges in a few seconds, across several groups and verdicts.
+OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival"]
+
+
+@pytest.fixture(scope="module")
+def tiny_file(tmp_path_factory):
+    text = (ROOT / "scenarios" / "default.toml").read_text()
+    p = tmp_path_factory.mktemp("scen") / "tiny.toml"
+    p.write_text(text.replace('name = "default"', 'name = "tiny-default"')
+                 .replace("dt = 0.02", "dt = 0.125").replace("start_cell = [40, 100]",
+                                                              "start_cell = [6, 16]")
+                 .replace("goal_cell = [150, 60]", "goal_cell = [24, 10]"))
+    return p
+
+
+@pytest.fixture(scope="module")
+def results_json(tmp_path_factory):
+    out = tmp_path_factory.mktemp("proofs")
+    code = run_prove(out_dir=out, scenarios_dir=ROOT / "scenarios", only=OBLIGATIONS,
+                     stream=io.StringIO())
+    assert code == 0
+    return out / "results.json"
+
+
+@pytest.fixture(scope="module")
+def report(tiny_file, results_json, tmp_path_factory):
+    out = tmp_path_factory.mktemp("audit")
+    argv = ["cfmpa", "audit", str(tiny_file), "--out", str(out)]
+    result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
+                         compare_n=4, compare_seed=3)
+    write_report(result, out)
+    doc = json.loads((out / "report.json").read_text())
+    html = (out / "report.html").read_text()
+    return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv}
+
+
+def test_report_json_validates_against_the_schema(report):
+    schema = json.loads(SCHEMA.read_text())
+    jsonschema.Draft202012Validator.check_schema(schema)
+    errors = list(jsonschema.Draft202012Validator(schema).iter_errors(report["doc"]))
+    assert not errors, [f"{list(e.absolute_path)}: {e.message}" for e in errors[:5]]
+
+
+def test_schema_rejects_a_report_missing_a_part(report):
+    schema = json.loads(SCHEMA.read_text())
+    broken = {k: v for k, v in report["doc"].items() if k != "findings"}
+    with pytest.raises(jsonschema.ValidationError, match="findings"):
+        jsonschema.validate(broken, schema)
+
+
+def test_report_passes_and_both_files_are_written_atomically(report):
+    assert report["doc"]["verdict"]["ok"] is True, report["doc"]["verdict"]
+    assert sorted(p.name for p in report["out"].iterdir()) == ["report.html", "report.json"]
+    assert report["doc"] == json.loads(dumps_json(report["result"].doc))
+
+
+def test_html_names_every_obligation_and_scenario(report):
+    doc, html = report["doc"], report["html"]
+    ids = [o["id"] for o in json.loads(_results(report)["text"])["obligations"]]
+    assert ids and [o["id"] for o in doc["obligations"]["items"]] == ids
+    for i in ids:
+        assert f'<span class="id">{i}</span>' in html, i
+    for s in doc["scenarios"]:
+        assert f'id="scenario-{s["name"]}"' in html and s["name"] in html
+    for f in doc["findings"]:
+        assert f["available"] and f"finding-{f['id'].replace('_', '-')}" in html
+
+
+def test_html_has_no_external_url(report):
+    html = report["html"]
+    assert "http://" not in html and "https://" not in html
+    refs = re.findall(r'(?:src|href)\s*=\s*"([^"]*)"', html)
+    assert refs, "the page has pictures and links"
+    for ref in refs:
+        assert ref.startswith(("data:image/png;base64,", "#")), ref[:60]
+    assert "<script" not in html and "<link" not in html and "@import" not in html
+    assert "url(" not in html
+
+
+def test_sections_come_in_the_issue_order(report):
+    html = report["html"]
+    marks = ['id="provenance"', 'id="summary"', 'id="obligations"', 'id="assumptions"',
+             'id="findings"', 'id="selftest"', 'id="scenarios"', 'id="compare"']
+    where = [html.index(m) for m in marks]
+    assert where == sorted(where)
+
+
+def test_provenance_records_the_run(report, tiny_file):
+    p = report["doc"]["provenance"]
+    assert p["command_line"] == " ".join(report["argv"])
+    assert p["scenarios"] == [{"name": "tiny-default", "path": str(tiny_file),
+                               "sha256": hashlib.sha256(tiny_file.read_bytes()).hexdigest()}]
+    git = shutil.which("git")
+    if git and (ROOT / ".git").exists():
+        # The shared tree may move while tests run: check the commit exists, not that it is HEAD.
+        kind = subprocess.run([git, "-C", str(ROOT), "cat-file", "-t", p["git"]["commit"]],
+                              capture_output=True, text=True, check=False).stdout.strip()
+        assert kind == "commit"
+        assert p["git"]["clean"] is (p["git"]["modified"] + p["git"]["untracked"] == 0)
+    for lib in ("python", "numpy", "z3", "matplotlib"):
+        assert p["versions"][lib] and p["versions"][lib] in report["html"]
+
+
+@pytest.mark.skipif(shutil.which("git") is None, reason="git is not installed")
+def test_git_state_tells_clean_from_modified_and_untracked(tmp_path):
+    def git(*args):
+        subprocess.run(["git", "-C", str(tmp_path), *args], check=True, capture_output=True)
+    assert git_state(tmp_path)["available"] is False
+    git("init", "-q")
+    (tmp_path / "a.txt").write_text("a\n")
+    git("add", "a.txt")
+    git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "a")
+    state = git_state(tmp_path)
+    assert state["available"] and state["clean"] is True and len(state["commit"]) == 40
+    (tmp_path / "b.txt").write_text("b\n")
+    assert git_state(tmp_path) | {"note": ""} == state | {"clean": False, "untracked": 1, "note": ""}
+    (tmp_path / "a.txt").write_text("changed\n")
+    assert (git_state(tmp_path)["modified"], git_state(tmp_path)["clean"]) == (1, False)
+
+
+def test_summary_counts_match_the_obligations(report):
+    ob = report["doc"]["obligations"]
+    items, total = ob["items"], ob["summary"]["total"]
+    assert total["total"] == len(items) == sum(r["total"] for r in ob["summary"]["rows"])
+    assert total["refuted_as_expected"] == sum(i["verdict"] == "refuted as expected" for i in items)
+    assert total["proved_z3"] == sum(i["verdict"] == "proved" and i["method"] == "z3" for i in items)
+    assert total["checked_data"] == sum(i["verdict"] == "proved" and i["method"] == "data"
+                                        for i in items)
+    # Every refuted-as-expected obligation prints its counterexample.
+    for i in items:
+        if i["verdict"] == "refuted as expected":
+            first = i["counterexample"].splitlines()[0]
+            assert str(escape(first)) in report["html"], first
+
+
+def test_scenario_section_reports_each_variant(report):
+    (s,) = report["doc"]["scenarios"]
+    assert [v["variant"] for v in s["variants"]] == ["original", "modified", "tight"]
+    for v in s["variants"]:
+        if v["status"] == "found":
+            assert v["J1"] is not None and v["clearance"]["clear"] is True
+            assert f'{1000 * v["clearance"]["min_m"]:.2f} mm' in report["html"]
+    assert {f["id"].rsplit("-", 1)[1] for f in s["figures"]} == {"workcell", "cspace", "variants",
+                                                                "clearance"}
+
+
+def test_findings_text_matches_golden(report):
+    text = "\n\n".join(f"[{f['id']}] {f['title']}\n{f['text']}" for f in report["doc"]["findings"])
+    _golden("findings.txt", text + "\n")
+    assert all(f["reproduced"] for f in report["doc"]["findings"])
+
+
+def test_report_json_key_set_matches_golden(report):
+    _golden("report_keys.txt", "\n".join(sorted(_keys(report["doc"]))) + "\n")
+
+
+def test_a_failed_obligation_fails_the_audit(report, tmp_path):
+    # A results.json recording one failed obligation, read the way build_audit reads it.
+    doc = json.loads(_results(report)["text"])
+    doc["obligations"][0]["verdict"] = "failed"
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios")))
+    audit["verdict"] = _verdict(audit)
+    assert audit["verdict"]["ok"] is False
+    assert audit["obligations"]["summary"]["total"]["unproved"] == 1
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert f"expected: {doc['obligations'][0]['expected']}" in text and "FAILED" in text
+
+
+def test_missing_parts_are_labelled_not_available(report):
+    audit = copy.deepcopy(report["result"].doc)
+    audit["compare"] = {"available": False, "note": "not run for this report (compare_n = 0)"}
+    audit["verdict"] = _verdict(audit)
+    assert audit["verdict"]["ok"] is True
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert "not run for this report (compare_n = 0)" in text
+    if not audit["selftest"]["available"]:
+        assert "Not available in this run" in text
+
+
+def test_unreadable_proofs_json_is_an_input_error(tmp_path, tiny_file):
+    with pytest.raises(InputError, match="cannot be read"):
+        build_audit([str(tiny_file)], proofs_json=str(tmp_path / "none.json"), compare_n=0)
+    (tmp_path / "bad.json").write_text("{not json")
+    with pytest.raises(InputError, match="not valid JSON"):
+        build_audit([str(tiny_file)], proofs_json=str(tmp_path / "bad.json"), compare_n=0)
+
+
+@pytest.mark.browser
+def test_report_renders_in_headless_chromium(report, tmp_path):
+    if not CHROMIUM.exists():
+        pytest.skip("/usr/bin/chromium is absent (Debian package 'chromium'; .ci/run installs it)")
+    shot = tmp_path / "report.png"
+    url = (report["out"] / "report.html").resolve().as_uri()
+    proc = subprocess.run(
+        [str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+         "--no-first-run", "--disable-background-networking", "--disable-component-update",
+         "--disable-sync", f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr",
+         "--v=0", f"--screenshot={shot}", "--window-size=1280,4000", url],
+        capture_output=True, text=True, timeout=180, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    # A resource that failed to load, or a script error, is logged as a console message.
+    assert not re.search(r"Failed to load resource|Uncaught|net::ERR_", proc.stderr), proc.stderr
+    width, height, distinct = _png_stats(shot.read_bytes())
+    assert (width, height) == (1280, 4000)
+    assert distinct > 50, "the screenshot is (nearly) blank"
+
+
+# --- helpers --------------------------------------------------------------------------------------
+
+def _results(report):
+    path = Path(report["doc"]["obligations"]["source"].removeprefix("read from "))
+    return {"path": path, "text": path.read_text()}
+
+
+def _golden(name: str, text: str) -> None:
+    path = GOLDEN / name
+    if os.environ.get("CFMPA_REGEN_GOLDEN") == "1":
+        path.write_text(text)
+    assert path.exists(), f"no golden file {path}; run with CFMPA_REGEN_GOLDEN=1 to create it"
+    assert text == path.read_text(), f"{name} differs from the golden file (see module docstring)"
+
+
+#: Parts of report.json whose keys belong to other modules' records (contracts, certificate,
+#: a finding's own numbers, the campaign's cases) or to the environment (versions).
+_OPEN = ("findings[].data", "scenarios[].variants[].contracts", "scenarios[].variants[].clearance",
+         "scenarios[].variants[].timings_s", "selftest.rows[]", "provenance.versions",
+         "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks")
+
+
+def _keys(x, prefix: str = "") -> set[str]:
+    out: set[str] = set()
+    if prefix in _OPEN:
+        return {prefix + ".*"}
+    if isinstance(x, dict):
+        for k, v in x.items():
+            p = f"{prefix}.{k}" if prefix else k
+            out.add(p)
+            out |= _keys(v, p)
+    elif isinstance(x, list):
+        for v in x:
+            out |= _keys(v, prefix + "[]")
+    return out
+
+
+def _png_stats(data: bytes) -> tuple[int, int, int]:
+    """Width, height and the number of distinct byte values of the decoded scanlines."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat, width, height = 8, b"", 0, 0
+    while pos < len(data):
+        (length,) = struct.unpack(">I", data[pos:pos + 4])
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height = struct.unpack(">II", body[:8])
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    return width, height, len(set(zlib.decompress(idat)))
+
+
+@pytest.mark.slow
+def test_full_audit_of_the_bundled_scenarios(tmp_path, capsys):
+    """`cfmpa audit` as `make prove` ends: every scenario, fresh obligations, 100 workcells."""
+    out = tmp_path / "audit"
+    code = run_audit(None, str(out), argv=["cfmpa", "audit", "--out", str(out)])
+    printed = capsys.readouterr().out
+    doc = json.loads((out / "report.json").read_text())
+    assert code == 0, printed
+    assert "wrote" in printed and str(out / "report.html") in printed
+    jsonschema.validate(doc, json.loads(SCHEMA.read_text()))
+    names = {p.stem for p in (ROOT / "scenarios").glob("*.toml")}
+    assert {s["path"].rsplit("/", 1)[-1][:-5] for s in doc["scenarios"]} == names
+    assert doc["obligations"]["source"].startswith("a fresh run")
+    assert not doc["obligations"]["missing_ids"] and doc["compare"]["n"] == 100
+    html = (out / "report.html").read_text()
+    assert all(f'<span class="id">{o["id"]}</span>' in html for o in doc["obligations"]["items"])

@@ -1,0 +1,87 @@
+"""`cfmpa compare`: reproducible random workcells, honest counts, paths checked by the spec."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from cfmpa.errors import InputError
+from cfmpa.impl import build_dr
+from cfmpa.report import campaign_json, random_workcell, run_campaign, run_compare
+from cfmpa.spec import EPS, Variant, arm_corners, make_grid, polygon_distance
+from cfmpa.spec._paths import J1, J2, is_path
+
+SEED = 11
+
+
+@pytest.fixture(scope="module")
+def campaign():
+    return run_campaign(6, SEED)
+
+
+def test_workcells_are_reproducible_from_the_seed():
+    a, b = random_workcell(SEED, 2), random_workcell(SEED, 2)
+    assert a == b
+    assert random_workcell(SEED, 3) != a and random_workcell(SEED + 1, 2) != a
+
+
+def test_a_smaller_campaign_is_a_prefix_of_a_larger_one(campaign):
+    small = run_campaign(2, SEED)
+    strip = lambda c: [(x.index, x.shape, [(o.status, o.J1, o.J2, o.free_fraction) for o in x.outcomes])
+                       for x in c.cases]
+    assert strip(small) == strip(campaign)[:2]
+
+
+def test_start_and_goal_poses_are_apart_from_the_principal():
+    for i in range(5):
+        s = random_workcell(SEED, i)
+        g = make_grid(s)
+        for cell, pose in ((s.right.start_cell, s.left.start), (s.right.goal_cell, s.left.goal)):
+            gap = min(polygon_distance(a, b) for a in arm_corners(s.left, pose)
+                      for b in arm_corners(s.right, g.angles(cell)))
+            assert gap > EPS or "(a pose drawn in contact)" in s.purpose
+
+
+def test_found_paths_are_valid_on_the_reference_dr_with_their_costs(campaign):
+    checked = 0
+    for case in campaign.cases[:3]:
+        s = random_workcell(SEED, case.index)
+        g = make_grid(s)
+        for o in case.outcomes:
+            if o.status != "found":
+                continue
+            dr = build_dr(s, o.variant, g)
+            assert is_path(o.path, dr, s.right.start_cell, s.right.goal_cell)
+            assert (J1(o.path), J2(o.path)) == (o.J1, o.J2)
+            assert o.certified_clear is True
+            checked += 1
+    assert checked > 0
+
+
+def test_table_counts_agree_with_the_cases(campaign):
+    doc = campaign_json(campaign)
+    found = {v: [x.found(v) for x in campaign.cases] for v in Variant}
+    for row in doc["table"]:
+        v = Variant(row["variant"])
+        assert row["found"] == sum(found[v])
+        assert row["success_rate"] == sum(found[v]) / campaign.n
+    assert doc["original_fails_modified_succeeds"] == sum(
+        m and not o for o, m in zip(found[Variant.ORIGINAL], found[Variant.MODIFIED]))
+    # The corrected Property 8 predicts these counts; the campaign measures them.
+    assert doc["checks_ok"] and not any(doc["checks"].values())
+    json.dumps(doc, allow_nan=False)
+
+
+def test_run_compare_prints_the_table_and_writes_json(tmp_path, capsys):
+    assert run_compare(n=3, seed=SEED, out=str(tmp_path)) == 0
+    text = capsys.readouterr().out
+    assert "original fails, modified succeeds" in text and "checks    all hold" in text
+    doc = json.loads((tmp_path / "compare.json").read_text())
+    assert doc["n"] == 3 and doc["seed"] == SEED and len(doc["cases"]) == 3
+
+
+@pytest.mark.parametrize("n", [0, -1, True, 2.5])
+def test_campaign_size_must_be_a_positive_integer(n):
+    with pytest.raises(InputError, match="--n"):
+        run_campaign(n, 0)
