@@ -25,8 +25,7 @@ import jinja2
 from .._io import dumps_json, write_bytes_atomic
 from ..errors import CfmpaError, InputError
 from ..impl import left_regions
-from ..spec import Scenario, Variant, load_scenario
-from ..spec._paths import SearchStatus
+from ..spec import Scenario, SearchStatus, Variant, load_scenario
 from . import _figures as F
 from ._compare import campaign_json, format_campaign, run_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,

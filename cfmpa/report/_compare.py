@@ -23,10 +23,8 @@ from typing import Any
 import numpy as np
 
 from .._io import dumps_json, write_bytes_atomic
-from ..impl import search_opt_path
-from ..spec import (EPS, Scenario, Variant, arm_corners, certify, make_grid, parse_scenario,
-                    polygon_distance)
-from ..spec._paths import SearchStatus
+from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
+                    parse_scenario, polygon_distance)
 
 __all__ = ["COMPARE_DT", "MAX_DRAWS", "Campaign", "CaseResult", "VariantOutcome",
            "random_workcell", "run_campaign", "campaign_json", "format_campaign", "run_compare"]
@@ -120,7 +118,7 @@ def run_campaign(n: int = 100, seed: int = 0) -> Campaign:
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         from ..errors import InputError
         raise InputError("--n", n, "must be an integer >= 1")
-    build, kernel = _builder()
+    build, search, kernel = _kernels()
     cases = []
     for i in range(n):
         s = random_workcell(seed, i)
@@ -129,7 +127,7 @@ def run_campaign(n: int = 100, seed: int = 0) -> Campaign:
         for v in Variant:
             t0 = time.perf_counter()
             dr = build(s, v, g)
-            r = search_opt_path(dr, s.right.start_cell, s.right.goal_cell)
+            r = search(dr, s.right.start_cell, s.right.goal_cell)
             cert = certify(s, g, r.path) if r.status is SearchStatus.FOUND else None
             outcomes.append(VariantOutcome(
                 variant=v, status=r.status.value, reason=r.reason, J1=r.J1, J2=r.J2,
@@ -205,7 +203,7 @@ def campaign_json(c: Campaign) -> dict[str, Any]:
 def format_campaign(doc: dict[str, Any]) -> str:
     """The campaign's table and counts as plain text (what `cfmpa compare` prints)."""
     lines = [f"campaign  {doc['n']} random workcells, seed {doc['seed']}, dt {doc['dt']} s, "
-             f"D_R by {doc['kernel']}; mean grid {doc['mean_cells']:.0f} cells",
+             f"kernels {doc['kernel']}; mean grid {doc['mean_cells']:.0f} cells",
              f"{'variant':<10}{'found':>7}{'success':>9}{'free':>9}{'mean J1':>10}{'mean J2':>10}"
              f"   (J1, J2: mean over the {doc['all_found']} workcells all variants solve)"]
     for r in doc["table"]:
@@ -243,13 +241,25 @@ def _mark_contact(s: Scenario) -> Scenario:
     return replace(s, purpose=f"{s.purpose} {_CONTACT}")
 
 
-def _builder() -> tuple[Any, str]:
-    """The fast kernel when cfmpa.impl exports it (identical output), else the reference."""
+def _kernels() -> tuple[Any, Any, str]:
+    """(build, search, label): the compiled kernels when cfmpa.impl exports them (their output
+    is identical to the reference's, which their own tests check), else the reference."""
     from .. import impl
-    fast = getattr(impl, "build_dr_fast", None)
-    if fast is not None:
-        return (lambda s, v, g: fast(s, v, g, progress=False)), "build_dr_fast"
-    return impl.build_dr, "build_dr (reference)"
+    build, search = getattr(impl, "build_dr_fast", None), getattr(impl, "search_opt_path_fast", None)
+    names = []
+    if build is not None:
+        names.append("build_dr_fast")
+        build_fn = lambda s, v, g: build(s, v, g, progress=False)  # noqa: E731
+    else:
+        names.append("build_dr (reference)")
+        build_fn = impl.build_dr
+    if search is not None:
+        names.append("search_opt_path_fast")
+        search_fn = lambda dr, a, b: search(dr, a, b, progress=False)  # noqa: E731
+    else:
+        names.append("search_opt_path (reference)")
+        search_fn = impl.search_opt_path
+    return build_fn, search_fn, " + ".join(names)
 
 
 def _draw_cell(rng: np.random.Generator, s: Scenario, g: Any, left_pose: list[float]

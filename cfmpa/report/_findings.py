@@ -18,9 +18,8 @@ import numpy.typing as npt
 import shapely
 
 from ..impl import link_rectangles, left_regions, naive_hull, right_regions, swept_region
-from ..spec import (EPS, Grid, Scenario, Variant, certify, left_angles, left_box,
-                    polygon_distance, polygon_distances)
-from ..spec._paths import is_path_paper, path_violations
+from ..spec import (EPS, Grid, Scenario, Variant, certify, is_path_paper, left_angles, left_box,
+                    path_violations, polygon_distance, polygon_distances)
 
 __all__ = [
     "Finding",

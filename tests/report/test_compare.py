@@ -9,8 +9,7 @@ import pytest
 from cfmpa.errors import InputError
 from cfmpa.impl import build_dr
 from cfmpa.report import campaign_json, random_workcell, run_campaign, run_compare
-from cfmpa.spec import EPS, Variant, arm_corners, make_grid, polygon_distance
-from cfmpa.spec._paths import J1, J2, is_path
+from cfmpa.spec import J1, J2, EPS, Variant, arm_corners, is_path, make_grid, polygon_distance
 
 SEED = 11
 
