@@ -102,12 +102,13 @@ def read_dr(path: str | Path) -> npt.NDArray[Any]:
     try:
         arr = np.load(path, allow_pickle=False)
     except OSError as exc:
-        raise InputError("dr", source, f"cannot be read ({exc.strerror or exc})",
+        raise InputError("dr", MISSING, f"cannot be read ({exc.strerror or exc})",
                          source=source) from None
     except ValueError as exc:
-        raise InputError("dr", source, f"is not a .npy array file ({exc})", source=source) from None
+        raise InputError("dr", MISSING, f"is not a .npy array file ({exc})",
+                         source=source) from None
     if not isinstance(arr, np.ndarray):
-        raise InputError("dr", source, "is not a single .npy array", source=source)
+        raise InputError("dr", MISSING, "is not a single .npy array", source=source)
     return arr
 
 
@@ -117,10 +118,10 @@ def read_plan(path: str | Path) -> PlanDoc:
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as exc:
-        raise InputError("plan", source, f"cannot be read ({exc.strerror or exc})",
+        raise InputError("plan", MISSING, f"cannot be read ({exc.strerror or exc})",
                          source=source) from None
     except UnicodeDecodeError:
-        raise InputError("plan", source, "is not UTF-8 text", source=source) from None
+        raise InputError("plan", MISSING, "is not UTF-8 text", source=source) from None
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:

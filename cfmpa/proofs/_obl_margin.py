@@ -217,7 +217,8 @@ def margin_obligations() -> list[Obligation]:
                    "A point at distance r from a pivot, turning through an angle in [0, g], "
                    "g <= 3.14, stays within r g^2/8 of the chord between its end positions "
                    "(within r (1 - cos(g/2)) of its projection on the chord, which lies on it); "
-                   "sin, cos as real unknowns with the ledger's facts; nearest point named.",
+                   "pivot at the origin, arc symmetric about the x-axis (no loss: rigid motions); "
+                   "sin, cos as real unknowns with the ledger's facts (A3); nearest point named.",
                    Method.Z3, P, _arc_chord),
         Obligation("Lemma.sweep_margin", GROUP, "DESIGN §4 (margin lemma, two joints)",
                    "A link point at (theta1, theta2) in a lattice cell [c1, c1+g1] x [c2, c2+g2] "

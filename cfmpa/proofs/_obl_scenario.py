@@ -99,7 +99,9 @@ def scenario_obligations(scenarios_dir: str | Path) -> list[Obligation]:
                        D, P, lambda f=f: _query(f, _cspace_grid, "cspace_grid")),
             Obligation(f"Scenario.{f.stem}.containment", group, "DESIGN §4 (containment chain)",
                        f"{f.name}: region_tight ⊆ region_modified ⊆ region_original on the computed "
-                       "polygons, every layer and the rest layer, both links.",
+                       "polygons, every layer and the rest layer, both links (vertices inside "
+                       "the outer polygon's edges up to 1e-12 m of float slack; the worst slack "
+                       "is reported).",
                        D, P, lambda f=f: _query(f, _containment, "containment")),
         ]
     return out

@@ -302,7 +302,7 @@ def _default_render(model: z3.ModelRef) -> str:
 
 
 def render_query(ob: Obligation, query: Query) -> str:
-    """The replayable text of an obligation: SMT-LIB for Z3 (one push/pop scope per check),
+    """The replayable text of an obligation: SMT-LIB for Z3 (one block per check, then (reset)),
     the canonical inputs for sympy and data checks. Its sha256 identifies the obligation."""
     head = [f"; obligation {ob.id} ({ob.paper_ref})", f"; method {ob.method}, expected {ob.expected}"]
     head += [f"; {line}" for line in ob.statement.splitlines()]
@@ -318,6 +318,8 @@ def render_query(ob: Obligation, query: Query) -> str:
             else:
                 s.add([c == v for c, v in vc.witness])
             names = ", ".join(n for n, _ in vc.hypotheses) or "none"
-            out += ["", f"; VC {vc.name}: {label}; hypotheses: {names}", "(push 1)",
-                    s.sexpr().rstrip(), "(check-sat)", "(pop 1)"]
+            # (reset) rather than push/pop: incremental mode would change Z3's tactics.
+            out += ["", f"; VC {vc.name}: {label}; hypotheses: {names}",
+                    f"(set-option :timeout {ob.timeout_ms})", s.sexpr().rstrip(), "(check-sat)",
+                    "(reset)"]
     return "\n".join(out) + "\n"

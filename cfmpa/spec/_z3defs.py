@@ -8,7 +8,7 @@ definitions, read as written here (the docstrings say where we depart from the p
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import z3

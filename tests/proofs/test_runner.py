@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import io
 import json
 import shutil
 from pathlib import Path
 
-import pytest
+import z3
 
 from cfmpa.proofs import (ASSUMPTIONS, FIXED_IDS, Verdict, collect_obligations, expected_ids,
                           render_report, run_obligations, run_prove, selected)
@@ -59,8 +60,14 @@ def test_replay_reports_new_same_changed_and_writes_atomically(tmp_path: Path):
     doc1 = json.loads((tmp_path / "results.json").read_text())
     entry = next(o for o in doc1["obligations"] if o["id"] == "Def1.segment")
     text = (tmp_path / "Def1.segment.smt2").read_text()
-    import hashlib
     assert entry["sha256"] == hashlib.sha256(text.encode()).hexdigest()
+
+    # The saved SMT-LIB replays to the same answers, check by check.
+    for o in doc1["obligations"]:
+        if o["method"] == "z3":
+            ctx = z3.Context()
+            out = z3.Z3_eval_smtlib2_string(ctx.ref(), (tmp_path / o["file"]).read_text())
+            assert out.split() == [a for v in o["vcs"] for a in (v["vacuity"], v["answer"])]
 
     second = run_obligations(obs, tmp_path, exp)
     assert set(second.changes.values()) == {"same"}
