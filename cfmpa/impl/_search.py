@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..errors import InputError
 from ..spec._paths import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                            Cell, SearchResult, check_search_inputs)
 
@@ -70,7 +71,7 @@ def _check_size(N: int, m: int, n: int) -> None:
     # or one move more, so J1 <= 2 (N + 9 m n + 1) and J2 <= 2 J1. Exact keys below INF need
     # J1 < 2**30 (then J2 < 2**31 = 2**SHIFT).
     if 2 * (N + 9 * m * n + 1) >= 1 << 30:
-        raise ValueError(f"grid too large for the search's cost keys: N={N}, m={m}, n={n}")
+        raise InputError("dr", (N + 1, m, n), "is too large for the search's int64 cost keys")
 
 
 def _dag_phase(free: BoolArray, start: Cell) -> tuple[IntArray, list[npt.NDArray[np.int8]]]:
@@ -85,52 +86,6 @@ def _dag_phase(free: BoolArray, start: Cell) -> tuple[IntArray, list[npt.NDArray
         keys, pred = _step(keys, np.where(free[s], np.int64(0), INF))
         preds.append(pred)
     return keys, preds
-
-
-def _step(keys: IntArray, block_next: IntArray) -> tuple[IntArray, npt.NDArray[np.int8]]:
-    """One DAG step: new[d, c + d] = min_p keys[p, c] + (|d|_1 << SHIFT) + |d - p|_1.
-
-    |d - p|_1 splits by coordinate, so the min over the 9 previous moves is two mins over 3.
-    """
-    m, n = keys.shape[2:]
-    # Over p2 (moved to the front): t[d2, p1] = min_p2 keys[p1, p2] + |d2 - p2|.
-    t, arg2 = _min_plus_gap(keys.transpose(1, 0, 2, 3))
-    # Over p1: best[d1, d2] = min_p1 t[d2, p1] + |d1 - p1|. Both keep the smallest index on
-    # ties, so the chosen (p1, p2) is the lexicographically smallest optimal previous move.
-    best, arg1 = _min_plus_gap(t.transpose(1, 0, 2, 3))
-    # arg2[d2, arg1[d1, d2]], gathered by packing the three 2-bit p2 choices of each d2 in a byte
-    a = arg2.astype(np.uint8)
-    packed = a[:, 0] | (a[:, 1] << 2) | (a[:, 2] << 4)
-    arg2_chosen = (packed[None] >> (2 * arg1).astype(np.uint8)) & 3
-    pred_here = (arg1 * 3 + arg2_chosen).astype(np.int8)
-    best += (_STEP_J1 << SHIFT)[:, :, None, None]
-    new = np.full((3, 3, m, n), INF, dtype=np.int64)
-    pred = np.full((3, 3, m, n), -1, dtype=np.int8)  # read only where new < INF
-    for d1 in range(3):
-        for d2 in range(3):
-            dst, src = _shift_slices(d1 - 1, d2 - 1, m, n)
-            new[d1, d2][dst] = best[d1, d2][src]
-            pred[d1, d2][dst] = pred_here[d1, d2][src]
-    # Blocked cells hold no state (block_next is INF there, else 0); sums that reach INF are
-    # "unreachable" and are clamped back to INF (INF = 2**61, so two INFs still fit in int64).
-    np.add(new, block_next, out=new)
-    np.minimum(new, INF, out=new)
-    return new, pred
-
-
-def _min_plus_gap(x: IntArray) -> tuple[IntArray, npt.NDArray[np.int8]]:
-    """out[d] = min over p of x[p] + |d - p| for d, p in 0..2, and the least minimising p."""
-    out = np.empty_like(x)
-    arg = np.zeros(x.shape, dtype=np.int8)
-    for d in range(3):
-        best = out[d]
-        np.add(x[0], d, out=best)
-        for p in (1, 2):
-            v = x[p] + abs(d - p)
-            better = v < best  # strict: the smaller p stays on ties
-            np.copyto(best, v, where=better)
-            np.copyto(arg[d], p, where=better)
-    return out, arg
 
 
 def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
@@ -246,6 +201,52 @@ def _unwind(goal: Cell, last: int, start: Cell, static_pred: npt.NDArray[np.int8
     while len(cells) > 1 and cells[-2] == goal:
         cells.pop()
     return cells
+
+
+def _step(keys: IntArray, block_next: IntArray) -> tuple[IntArray, npt.NDArray[np.int8]]:
+    """One DAG step: new[d, c + d] = min_p keys[p, c] + (|d|_1 << SHIFT) + |d - p|_1.
+
+    |d - p|_1 splits by coordinate, so the min over the 9 previous moves is two mins over 3.
+    """
+    m, n = keys.shape[2:]
+    # Over p2 (moved to the front): t[d2, p1] = min_p2 keys[p1, p2] + |d2 - p2|.
+    t, arg2 = _min_plus_gap(keys.transpose(1, 0, 2, 3))
+    # Over p1: best[d1, d2] = min_p1 t[d2, p1] + |d1 - p1|. Both keep the smallest index on
+    # ties, so the chosen (p1, p2) is the lexicographically smallest optimal previous move.
+    best, arg1 = _min_plus_gap(t.transpose(1, 0, 2, 3))
+    # arg2[d2, arg1[d1, d2]], gathered by packing the three 2-bit p2 choices of each d2 in a byte
+    a = arg2.astype(np.uint8)
+    packed = a[:, 0] | (a[:, 1] << 2) | (a[:, 2] << 4)
+    arg2_chosen = (packed[None] >> (2 * arg1).astype(np.uint8)) & 3
+    pred_here = (arg1 * 3 + arg2_chosen).astype(np.int8)
+    best += (_STEP_J1 << SHIFT)[:, :, None, None]
+    new = np.full((3, 3, m, n), INF, dtype=np.int64)
+    pred = np.full((3, 3, m, n), -1, dtype=np.int8)  # read only where new < INF
+    for d1 in range(3):
+        for d2 in range(3):
+            dst, src = _shift_slices(d1 - 1, d2 - 1, m, n)
+            new[d1, d2][dst] = best[d1, d2][src]
+            pred[d1, d2][dst] = pred_here[d1, d2][src]
+    # Blocked cells hold no state (block_next is INF there, else 0); sums that reach INF are
+    # "unreachable" and are clamped back to INF (INF = 2**61, so two INFs still fit in int64).
+    np.add(new, block_next, out=new)
+    np.minimum(new, INF, out=new)
+    return new, pred
+
+
+def _min_plus_gap(x: IntArray) -> tuple[IntArray, npt.NDArray[np.int8]]:
+    """out[d] = min over p of x[p] + |d - p| for d, p in 0..2, and the least minimising p."""
+    out = np.empty_like(x)
+    arg = np.zeros(x.shape, dtype=np.int8)
+    for d in range(3):
+        best = out[d]
+        np.add(x[0], d, out=best)
+        for p in (1, 2):
+            v = x[p] + abs(d - p)
+            better = v < best  # strict: the smaller p stays on ties
+            np.copyto(best, v, where=better)
+            np.copyto(arg[d], p, where=better)
+    return out, arg
 
 
 def _targets(free_rest: BoolArray) -> list[IntArray]:

@@ -10,7 +10,7 @@ from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
-from cfmpa.impl._search import search_opt_path
+from cfmpa.impl._search import _check_size, search_opt_path
 from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                                J1, J2, SearchResult, SearchStatus, is_path, opt_path)
 from cfmpa.spec._paths_z3 import z3_opt_path
@@ -223,3 +223,9 @@ def test_rejects_bad_inputs() -> None:
         search_opt_path(dr, (0, 0), (0, 3))
     with pytest.raises(InputError, match="dr"):
         search_opt_path(np.zeros((3, 3), dtype=np.uint8), (0, 0), (0, 0))
+
+
+def test_refuses_grids_too_large_for_exact_cost_keys() -> None:
+    _check_size(71, 316, 316)   # the default scenario is far inside the limit
+    with pytest.raises(InputError, match="too large"):
+        _check_size(1 << 29, 1, 1)

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
 from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                               J1, J2, SearchStatus, is_path, is_path_paper, opt_path,
+                               J1, J2, SearchResult, SearchStatus, is_path, is_path_paper, opt_path,
                                path_violations)
 from cfmpa.spec._paths_z3 import length_bound
 
@@ -161,6 +161,16 @@ def test_opt_path_waits_out_an_early_sweep_of_the_goal() -> None:
     assert (result.status, result.J1, result.J2) == ("found", 2, 2)
     assert is_path(result.path, dr, (0, 0), (0, 2))
     assert len(result.path) >= 5 and result.path[-2] != (0, 2)   # arrives at step >= 4
+
+
+def test_search_result_as_json_and_status_from_text() -> None:
+    found = SearchResult("found", None, ((0, 0), (0, 1)), 1, 2)
+    assert found.status is SearchStatus.FOUND
+    assert found.as_json() == {"status": "found", "reason": None, "path": [[0, 0], [0, 1]],
+                               "J1": 1, "J2": 2}
+    assert SearchResult.no_path(REASON_UNREACHABLE).as_json()["status"] == "no_path"
+    with pytest.raises(ValueError):
+        SearchResult("lost", None, (), None, None)
 
 
 def test_opt_path_rejects_bad_inputs() -> None:
