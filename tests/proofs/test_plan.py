@@ -1,0 +1,133 @@
+"""`plan` under contracts: what plan.json's ``contracts`` records per mode, that it is
+deterministic, and that violations stop the run or are recorded, as asked."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import factory
+from cfmpa._io import dumps_json
+from cfmpa.errors import CertificateViolation, ContractViolation
+from cfmpa.impl import build_dr, search_opt_path
+from cfmpa.proofs._plan import CERTIFICATE, plan, plan_json, write_plan
+from cfmpa.proofs._selftest import FAULTS, workcell
+from cfmpa.spec import make_grid
+
+START, GOAL = [2, 8], [13, 5]
+
+
+@pytest.fixture(scope="module")
+def s():
+    return factory.scenario(right__start_cell=START, right__goal_cell=GOAL)
+
+
+def _checks(record):
+    return {(t["name"], c["condition"], c["scope"]): c for t in record["triples"]
+            for c in t["checks"]}
+
+
+def test_off_records_the_mode_and_checks_nothing(s):
+    p = plan(s, "modified", contracts="off")
+    rec = plan_json(p)["contracts"]
+    assert rec == {"mode": "off", "seed": None, "sample": None, "checked": 0, "violations": [],
+                   "triples": [], "certificate_enforced": False}
+    assert not any(k.startswith("contracts_") for k in p.timings_s)
+
+
+def test_sampled_records_seed_sample_and_what_was_checked(s):
+    p = plan(s, "modified", contracts="sampled", seed=5, sample=300)
+    rec = plan_json(p)["contracts"]
+    assert (rec["mode"], rec["seed"], rec["sample"], rec["violations"]) == ("sampled", 5, 300, [])
+    assert [t["name"] for t in rec["triples"]] == ["Theorem 3", "Theorem 4"]
+    checks = _checks(rec)
+    sampled = [c for (name, cond, scope), c in checks.items()
+               if cond == "post.cells" and "random" in scope]
+    assert len(sampled) == 1 and sampled[0]["count"] == 300 and "seed 5" in sampled[0]["scope"]
+    on_path = [c for (name, cond, scope), c in checks.items()
+               if cond == "post.cells" and "path occupies" in scope]
+    path, N = p.search.path, p.grid.N
+    assert len(path) > N          # so every step has its own entry; R's is the last step's
+    occupied = {(min(k, N), c) for k, c in enumerate(path)} | {(N, path[-1])}
+    assert on_path[0]["count"] == len(occupied) == len(path)
+    optimal = [c for (_, cond, _), c in checks.items() if cond == "post.optimal"]
+    assert optimal[0]["ok"] is None
+    assert rec["checked"] == sum(c["count"] for c in checks.values())
+    assert rec["certificate_enforced"] is True and {"contracts_builtdr",
+                                                     "contracts_search"} <= set(p.timings_s)
+
+
+def test_full_checks_every_cell_and_optimality(s):
+    p = plan(s, "modified", contracts="full")
+    checks = _checks(plan_json(p)["contracts"])
+    cells = [c for (_, cond, _), c in checks.items() if cond == "post.cells"]
+    assert [c["count"] for c in cells] == [p.dr.size]
+    assert all(c["ok"] is True for c in checks.values())
+    assert any(cond == "post.optimal" and c["count"] == 1 for (_, cond, _), c in checks.items())
+
+
+@pytest.mark.parametrize("variant, names", [
+    ("original", ["Theorem 1", "Theorem 2"]),
+    ("tight", ["Theorem 3 (tight)", "Theorem 4 (tight)"]),
+])
+def test_each_variant_records_its_own_triples(s, variant, names):
+    rec = plan_json(plan(s, variant, contracts="sampled", sample=50))["contracts"]
+    assert [t["name"] for t in rec["triples"]] == names
+    assert all(t["statement"].startswith(t["name"]) for t in rec["triples"])
+
+
+def test_the_record_is_byte_identical_across_runs(s, tmp_path):
+    docs = []
+    for out in ("a", "b"):
+        write_plan(plan(s, "modified", contracts="sampled", sample=200, seed=1), tmp_path / out)
+        doc = json.loads((tmp_path / out / "plan.json").read_text())
+        doc.pop("timings_s")
+        docs.append(dumps_json(doc))
+    assert docs[0] == docs[1]
+
+
+def test_a_postcondition_violation_stops_the_run_unless_recording(s):
+    def lying(dr, start, goal):
+        r = search_opt_path(dr, start, goal)
+        return replace(r, J1=r.J1 - 1)
+
+    with pytest.raises(ContractViolation, match="post.costs"):
+        plan(s, "modified", contracts="sampled", search=lying)
+    p = plan(s, "modified", contracts="sampled", search=lying, stop=False)
+    rec = plan_json(p)["contracts"]
+    assert [v["condition"].split(":")[0] for v in rec["violations"]] == ["post.costs"]
+    assert rec["violations"][0]["triple"] == "Theorem 4 [searchoptpath over D'_R]"
+    assert rec["violations"][0]["values"]["reported J1, J2"] == [p.search.J1, p.search.J2]
+    dumps_json(plan_json(p))                        # the record is valid, deterministic JSON
+    # mode off checks nothing, so the same lie passes silently: that is what off means
+    assert plan_json(plan(s, "modified", contracts="off", search=lying))["contracts"][
+        "violations"] == []
+
+
+def test_a_contact_is_a_violation_unless_contracts_are_off():
+    fault = next(f for f in FAULTS if "early" in f.name)
+    s = workcell(fault.workcell)
+    m = fault.make(s, fault.variant, make_grid(s))
+    p = plan(s, fault.variant, contracts="sampled", search=m.search, stop=False)
+    assert not p.certificate.clear and p.certificate.contact is not None
+    kinds = [type(v) for v in p.violations]
+    assert CertificateViolation in kinds
+    rec = plan_json(p)["contracts"]
+    assert rec["violations"][-1]["triple"] == CERTIFICATE
+    assert rec["violations"][-1]["values"]["distance_m"] == 0.0
+    off = plan(s, fault.variant, contracts="off", search=m.search)
+    assert not off.certificate.clear and off.violations == []
+
+
+def test_another_builder_can_be_run_under_the_contracts(s):
+    seen = []
+
+    def mine(s2, v, g):
+        seen.append(v)
+        return np.ascontiguousarray(build_dr(s2, v, g))
+
+    p = plan(s, "tight", contracts="full", build=mine)
+    assert seen == ["tight"] and p.violations == []
