@@ -35,3 +35,10 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
     run = run_obligations(obligations, out_dir, expected)
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
+
+
+# Contract-checked runs, `cfmpa check` and `cfmpa selftest` (imported last: they use impl/).
+from ._check import run_check  # noqa: E402
+from ._selftest import run_selftest  # noqa: E402
+
+__all__ += ["run_check", "run_selftest"]

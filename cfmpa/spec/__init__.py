@@ -9,11 +9,12 @@ from ._paths import (J1, J2, PathViolation, SearchResult, SearchStatus, is_path,
 from ._polygon import polygon_distance, polygon_distances
 from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
                         load_scenario, max_cells, parse_scenario)
+from ._triples import TRIPLES, Triple, builtdr_triple, search_triple
 
 __all__ = [
     "ANGLE_TOLERANCE", "Certificate", "certificate_json", "certify", "require_clear", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
     "Variant", "arm_corners", "exact_n", "joints", "link_corners", "exact_tf", "joint_points", "left_angles", "left_box", "load_scenario",
     "make_grid", "max_cells", "parse_scenario", "polygon_distance", "polygon_distances", "rest_is_goal", "right_box",
     "J1", "J2", "PathViolation", "SearchResult", "SearchStatus", "is_path", "is_path_paper", "opt_path",
-    "path_violations",
+    "path_violations", "TRIPLES", "Triple", "builtdr_triple", "search_triple",
 ]
