@@ -12,16 +12,18 @@ certain despite rounding, and hands every other pair to the reference's own ``bl
   offsets; only the order of the two products may differ), which MARGIN exceeds by orders of
   magnitude, so the reference's g > eps too and it says free;
 - "blocked" when every axis's gap is below -MARGIN (so the reference's g < 0), or when a point
-  known to lie in the right polygon lies inside the left one by more than MARGIN: a point of B at
-  depth d inside A makes every gap <= -d (along A's normals B reaches the point; along B's
-  normals A covers the disc of radius d around it);
+  of one polygon lies inside the other by more than MARGIN: a point of B at depth d inside A
+  makes every gap <= -d (along A's normals B reaches the point; along B's normals A covers the
+  disc of radius d around it), and symmetrically. The points tried: one that proved the
+  previous cell of the row (it lies in A: a vertex of A, or deeper than MARGIN in A), points
+  of the links' centre lines checked deeper than MARGIN in both, and the vertices of each;
 - everything else (gaps within MARGIN of 0 or eps) is "unsure" and goes to ``blocked_against`` on
   the same polygon arrays, whose per-pair arithmetic does not depend on which other pairs share
   the batch (the reference itself runs it on the box-filtered subset).
 
 Layout: each polygon set is packed as geo (C, V, 6) = x, y, outward normal x, y, offset, edge
 has a length (1.0/0.0); box (C, 4) = lo x, lo y, hi x, hi y; spine (C, 4), the link's centre
-line, where a common point is looked for first. Few arrays per call keep the compiled calls cheap.
+line, where a common point is looked for. Few arrays per call keep the compiled calls cheap.
 
 Structure used: the rest layer of original/modified is layer N-1 (copied); a row i whose right
 link 1 is blocked is blocked whole; a row whose union box is apart is free whole; a cell already
@@ -169,7 +171,7 @@ def _pack(verts):  # pragma: no cover - compiled; PolygonSet.of's formulas, per 
             x, y = verts[c, v, 0], verts[c, v, 1]
             w = v + 1 if v + 1 < V else 0
             ex, ey = verts[c, w, 0] - x, verts[c, w, 1] - y
-            length = math.hypot(ex, ey)
+            length = math.sqrt(ex * ex + ey * ey)  # hypot's care for overflow costs 3x here
             geo[c, v, 0], geo[c, v, 1] = x, y
             if length > 0:
                 nx, ny = ey / length, -ex / length
@@ -265,6 +267,15 @@ def _deep(x, y, gq, q, d):  # pragma: no cover - compiled
 
 
 @njit(cache=True, forceinline=True)
+def _vertex_inside(gp, p, gq, q, d):  # pragma: no cover - compiled
+    """The first vertex of polygon p lying inside polygon q by more than d, or -1."""
+    for v in range(gp.shape[1]):
+        if _deep(gp[p, v, 0], gp[p, v, 1], gq, q, d):
+            return v
+    return -1
+
+
+@njit(cache=True, forceinline=True)
 def _clip(x0, y0, dx, dy, gq, q, d, lo, hi):  # pragma: no cover - compiled
     """Narrow [lo, hi] to the t with p0 + t d inside every edge line of polygon q by >= d."""
     for e in range(gq.shape[1]):
@@ -307,8 +318,8 @@ def _pair(ga, boxa, spa, a, gb, boxb, spb, b, eps, margin, hint, have, px, py
     """(code, x, y) for polygon a of A and polygon b of B: FREE or _SEPARATED + the axis found;
     _BLOCKED_AT with the common point (x, y) that proves it, or BLOCKED; or UNSURE.
 
-    ``hint`` is an axis to try first; (px, py), if ``have``, a point already known to lie deeper
-    than margin in polygon a, tried first for b. Axis e is an edge normal of A (e < V_A) or of
+    ``hint`` is an axis to try first; (px, py), if ``have``, a point known to lie in polygon a (a
+    vertex of it, or deeper than margin), tried first for b. Axis e is an edge normal of A (e < V_A) or of
     B (e - V_A). Its gap is the min over the other polygon's vertices of (n.v - offset);
     rounding is monotone, so "every vertex's term > t" is exactly "gap > t", and the scans may
     stop early.
@@ -335,6 +346,14 @@ def _pair(ga, boxa, spa, a, gb, boxb, spb, b, eps, margin, hint, have, px, py
                 found, x, y = _common_point(spa, a, ga, a, gb, b, margin)
             if found:
                 return _BLOCKED_AT, x, y
+            # A vertex of one inside the other: a vertex of A lies in A, one of B inside A is
+            # deep in A, so either may serve the next cell as the common point.
+            v = _vertex_inside(ga, a, gb, b, margin)
+            if v >= 0:
+                return _BLOCKED_AT, ga[a, v, 0], ga[a, v, 1]
+            v = _vertex_inside(gb, b, ga, a, margin)
+            if v >= 0:
+                return _BLOCKED_AT, gb[b, v, 0], gb[b, v, 1]
     for e in range(va):                        # no axis separates: overlapping on every one?
         if ga[a, e, 5] != 0.0 and not _overlaps(gb, b, ga, a, e, margin):
             return UNSURE, 0.0, 0.0
