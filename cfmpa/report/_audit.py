@@ -5,10 +5,11 @@ the assumptions ledger; the findings about the paper, drawn; the mutation self-c
 scenario the plans of the three variants with contracts, certificate and pictures; the seeded
 comparison campaign. Where a part's data is not available in this run, the part says so.
 
-report.json holds every number of the HTML (not the pictures). It is deterministic for the same
-inputs and version apart from the date and the keys named ``seconds``, ``timings_s`` and
-``mean_seconds``. Obligation data: see ``_obligations`` (results.json when given, else a fresh
-run).
+report.json holds every number of the HTML (not the pictures). For the same inputs and version
+it is the same apart from the provenance (date, git state, command line), the times (keys
+``seconds``, ``timings_s``, ``mean_seconds``) and, after a fresh run of the obligations, the
+total time in ``obligations.note``. Obligation data: see ``_obligations`` (results.json when
+given, else a fresh run).
 """
 
 from __future__ import annotations
@@ -113,6 +114,7 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
         "compare": _compare(compare_n, compare_seed, figures),
     }
     _relate(doc["findings"], proofs)
+    doc["triples"] = _triples(plans)
     doc["verdict"] = _verdict(doc)
     return AuditResult(doc=doc, figures=figures)
 
@@ -167,10 +169,15 @@ class _Plans:
         key = (s.source, s.sha256, v)
         if key not in self._done:
             try:
-                self._done[key] = plan(s, v, contracts=self.contracts, seed=0)
+                # stop=False: every failed postcondition is recorded, not only the first.
+                self._done[key] = plan(s, v, contracts=self.contracts, seed=0, stop=False)
             except CfmpaError as exc:
                 self._done[key] = exc
         return self._done[key]
+
+    def all(self) -> list[Any]:
+        """Every completed plan so far, in the order computed."""
+        return [p for p in self._done.values() if not isinstance(p, Exception)]
 
     def require(self, s: Scenario, v: Variant) -> Any:
         p = self.get(s, v)
@@ -231,18 +238,38 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
         variants.append({k: j[k] for k in ("variant", "status", "reason", "J1", "J2",
                                             "path_length", "path", "free_fraction", "clearance",
                                             "contracts", "timings_s")})
+    checks: dict[tuple[str, str, str], dict[str, Any]] = {}
+    for v, p in ok.items():                # condition x variant: how many items, whether all held
+        for tr in (p.contracts or {}).get("triples", []):
+            command = tr["title"].split(",")[0].split(" over")[0]   # BuiltDR | searchoptpath
+            for c in tr["checks"]:
+                row = checks.setdefault((command, c["part"], c["condition"]), {
+                    "command": command, "part": c["part"], "condition": c["condition"],
+                    "scope": c["scope"], "variants": {}})
+                row["variants"][v.value] = {"triple": tr["name"], "count": c["count"],
+                                            "ok": c["ok"], "scope": c["scope"]}
     any_plan = next(iter(ok.values()), None)
     grid = any_plan.grid.as_json() if any_plan is not None else None
     entry: dict[str, Any] = {
         "name": s.name, "path": s.source, "sha256": s.sha256, "purpose": s.purpose,
         "parameters": {"dt": s.dt, "left": _arm_json(s.left), "right": _arm_json(s.right)},
         "grid": None if grid is None else {**grid, "cells": (grid["N"] + 1) * grid["m"] * grid["n"]},
-        "variants": variants, "figures": [],
+        "variants": variants, "contract_checks": list(checks.values()), "figures": [],
     }
     if any_plan is None:
         return entry
     entry["figures"] = _scenario_figures(s, ok, figures)
     return entry
+
+
+def _triples(plans: _Plans) -> list[dict[str, str]]:
+    """The distinct Hoare triples the plans' contracts checked, with their printed statements."""
+    seen: dict[str, dict[str, str]] = {}
+    for p in plans.all():
+        for tr in (p.contracts or {}).get("triples", []):
+            seen.setdefault(tr["name"], {k: str(tr.get(k, "")) for k in
+                                         ("name", "title", "reference", "statement")})
+    return [seen[k] for k in sorted(seen)]
 
 
 def _primary(ok: dict[Variant, Any]) -> Variant:
@@ -371,7 +398,9 @@ def _scenario_paths(scenarios: Sequence[str] | None, sdir: Path) -> list[Path]:
     found = sorted(sdir.glob("*.toml"))
     if not found:
         raise InputError("scenarios", str(sdir), "holds no *.toml scenario files")
-    return found
+    cwd = Path.cwd().resolve()
+    # Relative to the working folder when inside it: the report reads the same on any checkout.
+    return [p.resolve().relative_to(cwd) if p.resolve().is_relative_to(cwd) else p for p in found]
 
 
 def _jsonable(x: Any) -> Any:

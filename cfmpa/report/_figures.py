@@ -514,7 +514,7 @@ def early_arrival_figure(fid: str, d: EarlyArrivalData) -> Figure:
     _draw_arm(a, s.right, right_angles_at(g, cells, np.array([t_c]))[0], RIGHT_COLOR,
               label="subordinate waiting at its goal")
     a.plot([], [], color=LEFT_COLOR, ls=":", label="principal earlier")
-    _workspace_axes(a, s)
+    _motion_bounds(a, s, g, cells, t_c)
     a.set_title("the arms in contact while the subordinate waits" if d.contact_t_s is not None
                 else "no contact found")
     a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=7, ncol=2)
