@@ -253,7 +253,8 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
     entry: dict[str, Any] = {
         "name": s.name, "path": s.source, "sha256": s.sha256, "purpose": s.purpose,
         "parameters": {"dt": s.dt, "left": _arm_json(s.left), "right": _arm_json(s.right)},
-        "grid": None if grid is None else {**grid, "cells": (grid["N"] + 1) * grid["m"] * grid["n"]},
+        "grid": None if grid is None else {
+            **grid, "cells": (grid["N"] + 1) * grid["m"] * grid["n"]},
         "variants": variants, "contract_checks": list(checks.values()), "figures": [],
     }
     if any_plan is None:
@@ -309,7 +310,8 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
             minima[v] = (p.certificate.t_min_s, p.certificate.min_clearance_m)
     if series:
         missing = [v for v in ok if v not in series]
-        made.append(F.clearance_figure(f"fig-{slug}-clearance", s, g, series, minima, missing, same))
+        made.append(F.clearance_figure(f"fig-{slug}-clearance", s, g, series, minima, missing,
+                                       same))
     for f in made:
         figures[f.id] = f
     return [{"id": f.id, "caption": f.caption} for f in made]
@@ -390,7 +392,7 @@ def _item(check: str, ok: bool | None, detail: str) -> dict[str, Any]:
     return {"check": check, "ok": ok, "detail": detail}
 
 
-# --- helpers ---------------------------------------------------------------------------------------
+# --- helpers ------------------------------------------------------------------------------
 
 def _scenario_paths(scenarios: Sequence[str] | None, sdir: Path) -> list[Path]:
     if scenarios:

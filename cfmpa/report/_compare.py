@@ -23,16 +23,19 @@ from typing import Any
 import numpy as np
 
 from .._io import dumps_json, write_bytes_atomic
+from ..errors import InputError
 from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
                     parse_scenario, polygon_distance)
 
-__all__ = ["COMPARE_DT", "MAX_DRAWS", "Campaign", "CaseResult", "VariantOutcome",
+__all__ = ["COMPARE_DT", "CONTACT_NOTE", "MAX_DRAWS", "Campaign", "CaseResult", "VariantOutcome",
            "random_workcell", "run_campaign", "campaign_json", "format_campaign", "run_compare"]
 
 #: Time step of campaign workcells (s): grids of about 10-30 layers of 60-80 x 50-65 cells.
 COMPARE_DT = 0.1
 #: Draws of a start or goal cell before the campaign keeps a pose in contact (then counted).
 MAX_DRAWS = 200
+#: Appended to a workcell's purpose when a pose was kept in contact after MAX_DRAWS draws.
+CONTACT_NOTE = "(a pose drawn in contact)"
 _TWO_PI = 6.283185307179586
 
 
@@ -80,7 +83,13 @@ class Campaign:
 
 
 def random_workcell(seed: int, index: int) -> Scenario:
-    """Workcell ``index`` of the campaign with ``seed`` (see the module docstring)."""
+    """Workcell ``index`` of the campaign with ``seed`` (see the module docstring); its purpose
+    ends with CONTACT_NOTE when a start or goal pose had to be kept in contact."""
+    return _workcell(seed, index)[0]
+
+
+def _workcell(seed: int, index: int) -> tuple[Scenario, bool]:
+    """The workcell, and whether its start and goal poses were drawn apart from the principal."""
     rng = np.random.default_rng([seed, index])
 
     def arm() -> dict[str, Any]:
@@ -109,19 +118,19 @@ def random_workcell(seed: int, index: int) -> Scenario:
         cell, ok = _draw_cell(rng, s, g, pose)
         apart &= ok
         doc["right"][key] = list(cell)
-    s = parse_scenario(doc, check_budget=False)
-    return s if apart else _mark_contact(s)
+    if not apart:
+        doc["purpose"] += f" {CONTACT_NOTE}"
+    return parse_scenario(doc, check_budget=False), apart
 
 
 def run_campaign(n: int = 100, seed: int = 0) -> Campaign:
     """Plan ``n`` random workcells under original, modified and tight."""
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        from ..errors import InputError
         raise InputError("--n", n, "must be an integer >= 1")
     build, search, kernel = _kernels()
     cases = []
     for i in range(n):
-        s = random_workcell(seed, i)
+        s, apart = _workcell(seed, i)
         g = make_grid(s)
         outcomes = []
         for v in Variant:
@@ -135,7 +144,7 @@ def run_campaign(n: int = 100, seed: int = 0) -> Campaign:
                 certified_clear=None if cert is None else cert.clear,
                 min_clearance_m=None if cert is None else cert.min_clearance_m,
                 seconds=time.perf_counter() - t0, path=r.path))
-        cases.append(CaseResult(index=i, shape=g.shape, poses_apart=not s.purpose.endswith(_CONTACT),
+        cases.append(CaseResult(index=i, shape=g.shape, poses_apart=apart,
                                 outcomes=tuple(outcomes)))
     return Campaign(n=n, seed=seed, dt=COMPARE_DT, kernel=kernel, cases=tuple(cases))
 
@@ -169,7 +178,8 @@ def campaign_json(c: Campaign) -> dict[str, Any]:
                    if (x.outcome(a).J1, x.outcome(a).J2) > (x.outcome(b).J1, x.outcome(b).J2))
 
     checks = {
-        "modified_fails_original_succeeds": sum(1 for x in c.cases if x.found(O) and not x.found(M)),
+        "modified_fails_original_succeeds": sum(1 for x in c.cases
+                                                if x.found(O) and not x.found(M)),
         "tight_fails_modified_succeeds": sum(1 for x in c.cases if x.found(M) and not x.found(T)),
         "modified_optimum_worse_than_original": worse(M, O),
         "tight_optimum_worse_than_modified": worse(T, M),
@@ -233,19 +243,12 @@ def run_compare(n: int = 100, seed: int = 0, out: str | None = None) -> int:
     return 0 if doc["checks_ok"] else 1
 
 
-_CONTACT = "(a pose drawn in contact)"
-
-
-def _mark_contact(s: Scenario) -> Scenario:
-    from dataclasses import replace
-    return replace(s, purpose=f"{s.purpose} {_CONTACT}")
-
-
 def _kernels() -> tuple[Any, Any, str]:
     """(build, search, label): the compiled kernels when cfmpa.impl exports them (their output
     is identical to the reference's, which their own tests check), else the reference."""
     from .. import impl
-    build, search = getattr(impl, "build_dr_fast", None), getattr(impl, "search_opt_path_fast", None)
+    build = getattr(impl, "build_dr_fast", None)
+    search = getattr(impl, "search_opt_path_fast", None)
     names = []
     if build is not None:
         names.append("build_dr_fast")

@@ -47,12 +47,14 @@ __all__ = [
 
 #: Pixels per inch: sharp on screen and legible printed at A4 width.
 DPI = 120
-VARIANT_COLORS = {Variant.ORIGINAL: "#c0392b", Variant.MODIFIED: "#7d3c98", Variant.TIGHT: "#1e8449"}
+VARIANT_COLORS = {Variant.ORIGINAL: "#c0392b", Variant.MODIFIED: "#7d3c98",
+                  Variant.TIGHT: "#1e8449"}
 VARIANT_STYLES = {Variant.ORIGINAL: "-", Variant.MODIFIED: "--", Variant.TIGHT: ":"}
 LEFT_COLOR = "#2e5c9a"     # the principal
 RIGHT_COLOR = "#e07b00"    # the subordinate
 ZONE_COLOR = "#f4e19c"     # the shared zone
 FREE_COLOR = "#eef3fb"
+FloatArray = npt.NDArray[np.float64]
 BLOCKED_COLOR = "#4d4d4d"
 
 plt.rcParams.update({
@@ -190,7 +192,8 @@ def _tip_traces(ax: Any, s: Scenario, g: Grid, path: Sequence[Sequence[int]]) ->
     ra = right_angles_at(g, np.asarray(path, dtype=np.int64).reshape(-1, 2), t)
     for arm, ang, color, name in ((s.left, la, LEFT_COLOR, "principal"),
                                   (s.right, ra, RIGHT_COLOR, "subordinate")):
-        e = np.asarray(arm.base) + arm.links[0] * np.stack([np.cos(ang[:, 0]), np.sin(ang[:, 0])], 1)
+        u1 = np.stack([np.cos(ang[:, 0]), np.sin(ang[:, 0])], 1)
+        e = np.asarray(arm.base) + arm.links[0] * u1
         p = e + arm.links[1] * np.stack([np.cos(ang.sum(1)), np.sin(ang.sum(1))], 1)
         ax.plot(p[:, 0], p[:, 1], color=color, lw=0.8, ls="--", alpha=0.8,
                 label=f"{name} tip path")
@@ -339,7 +342,7 @@ def variants_figure(fid: str, s: Scenario, g: Grid, drs: Mapping[Variant, npt.ND
 
 
 def clearance_figure(fid: str, s: Scenario, g: Grid,
-                     series: Mapping[Variant, tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]],
+                     series: Mapping[Variant, tuple[FloatArray, FloatArray]],
                      minima: Mapping[Variant, tuple[float, float]], missing: Sequence[Variant],
                      same_as: Mapping[Variant, Variant] | None = None) -> Figure:
     """Distance between the arms along each variant's planned motion, least value marked."""
@@ -528,8 +531,8 @@ def early_arrival_figure(fid: str, d: EarlyArrivalData) -> Figure:
         b.plot([d.contact_t_s], [0.0], marker="X", ms=9, color="black", ls="",
                label=f"contact (certificate) at t = {d.contact_t_s:.3f} s")
     b.axvline((len(d.path) - 1) * s.dt, color="#777", ls="--", lw=0.8)
-    b.text((len(d.path) - 1) * s.dt, 0.98, " list ends: the arm waits", transform=b.get_xaxis_transform(),
-           va="top", fontsize=8, color="#555")
+    b.text((len(d.path) - 1) * s.dt, 0.98, " list ends: the arm waits", va="top", fontsize=8,
+           color="#555", transform=b.get_xaxis_transform())
     b.axhline(0.0, color="black", lw=0.8)
     b.set_xlabel("time t (s)")
     b.set_ylabel("distance between the arms (mm)")

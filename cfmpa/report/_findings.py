@@ -61,7 +61,7 @@ class Finding:
 
 
 class PlanLike(Protocol):
-    """What a finding needs of a plan (``cfmpa.proofs._plan.PlanResult`` has it): grid, dr, search."""
+    """What a finding needs of a plan (``PlanResult`` of cfmpa.proofs has it)."""
 
     grid: Grid
     dr: npt.NDArray[np.uint8]
@@ -105,7 +105,8 @@ def naive_hull_finding(s: Scenario) -> Finding:
             f"a link turning about a joint bulges past that hull in between. For the principal of "
             f"{s.name}, link 2 over a {NAIVE_BOX_RAD} rad x {NAIVE_BOX_RAD} rad box leaves the "
             f"naive hull by {big['protrusion'] * 1000:.1f} mm, and even over the scenario's own "
-            f"layer-0 box (±{s.left.omega[0] * s.dt:g} rad) by {own['protrusion'] * 1e6:.2f} µm, so "
+            f"layer-0 box (±{s.left.omega[0] * s.dt:g} rad) by "
+            f"{own['protrusion'] * 1e6:.2f} µm, so "
             f"a cell it calls free can collide. The project's sound region (lattice hull plus the "
             f"margin δ) contains every sampled pose"
             + ("." if outside_sound <= 0.0 else f" except one {outside_sound:.2e} m outside."))
@@ -147,7 +148,7 @@ def _outside(region: Polygon, rects: npt.NDArray[np.float64]) -> float:
 
 @dataclass(frozen=True)
 class InconsistencyData:
-    """The principal's boxes and regions at the last motion layer, and the subordinate at its goal."""
+    """The principal's boxes and regions at the last motion layer; the subordinate at its goal."""
 
     scenario: Scenario
     grid: Grid
@@ -180,7 +181,8 @@ def inconsistency_finding(s: Scenario, plan: PlanFn) -> Finding:
     w = s.left.omega
     text = (f"Algorithm 1 lets each principal joint turn either way by ω Δt in the next step "
             f"(box [θ − ωΔt, θ + ωΔt]), although the principal's motion is planned and its "
-            f"direction known; the paper's modified box [θ, θ + sωΔt] is one quadrant of it, and "
+            f"direction known; the paper's modified box [θ, θ + sωΔt] is one quadrant of it, "
+            f"and "
             f"the tight box is the planned interval itself. In {s.name}, at the last layer "
             f"(k = {k}, boxes {2 * w[0] * s.dt:g} x {2 * w[1] * s.dt:g} rad against "
             f"{w[0] * s.dt:g} x {w[1] * s.dt:g} rad) the two-sided region "
@@ -194,7 +196,8 @@ def inconsistency_finding(s: Scenario, plan: PlanFn) -> Finding:
         theta_now=_pair(left_angles(s, k * s.dt)), theta_next=_pair(left_angles(s, (k + 1) * s.dt)),
         right_goal=g.angles(goal), right_region=right, distances_m=dist, goal_blocked=blocked)
     return Finding(
-        id="inconsistency", title="The semantic inconsistency: a two-sided box for a known direction",
+        id="inconsistency",
+        title="The semantic inconsistency: a two-sided box for a known direction",
         text=text, reproduced=reproduced,
         related=("Thm1.builtdr", "Thm3.builtdr", "Prop8.subset_monotone", "Prop8.path_exists"),
         data={"scenario": s.name, "layer": k, "goal_cell": list(goal),
@@ -209,7 +212,7 @@ def inconsistency_finding(s: Scenario, plan: PlanFn) -> Finding:
 
 @dataclass(frozen=True)
 class Prop8Data:
-    """A cell blocked under S (original) but free under S' (modified): both regions and the cell's."""
+    """A cell blocked under S (original), free under S' (modified): both regions, the cell's."""
 
     scenario: Scenario
     grid: Grid
@@ -230,7 +233,7 @@ def prop8_finding(s: Scenario, plan: PlanFn) -> Finding:
     g = po.grid
     diff = (po.dr[: g.N] == 1) & (pm.dr[: g.N] == 0)        # Property 8 quantifies k < N
     total = int(diff.sum())
-    worse = int(((pm.dr == 1) & (po.dr == 0)).sum())         # P' > P somewhere: would refute P' <= P
+    worse = int(((pm.dr == 1) & (po.dr == 0)).sum())    # P' > P anywhere would refute P' <= P
     if total == 0:
         return Finding(id="prop8_literal", title="Property 8 as printed does not hold",
                        text=(f"On {s.name} no cell is blocked under S and free under S'; the "
@@ -252,8 +255,9 @@ def prop8_finding(s: Scenario, plan: PlanFn) -> Finding:
     right = (rr.link1[i], rr.link2[i, j])
     gap_s, gap_sp = _gap(lo, right), _gap(lm, right)
     reproduced = gap_s <= EPS < gap_sp and worse == 0
-    text = (f"Property 8 as printed says that if P is the table of S (P = 0 iff S ∩ S_R = ∅) then "
-            f"P is also the table of the smaller S'. In {s.name} at layer k = {k}, cell ({i}, {j}), "
+    text = (f"Property 8 as printed says that if P is the table of S (P = 0 iff S ∩ S_R = ∅) "
+            f"then P is also the table of the smaller S'. In {s.name} at layer k = {k}, "
+            f"cell ({i}, {j}), "
             f"S meets the subordinate's region (P = 1) but S' stays {gap_sp * 1000:.1f} mm away, "
             f"so the table of S' has 0 there and P is not it; {total} cells of layers 0..{g.N - 1} "
             f"are like this one. What S' ⊆ S does give is P' ≤ P cell by cell, which the "
@@ -372,7 +376,7 @@ def _pair(a: Any) -> tuple[float, float]:
 
 def right_angles_at(g: Grid, cells: npt.NDArray[np.int64], t: npt.NDArray[np.float64]
                   ) -> npt.NDArray[np.float64]:
-    """The subordinate's joint angles at times t: linear between cells, one cell per dt, then held."""
+    """The subordinate's joint angles at times t: linear between cells, one per dt, then held."""
     ang = np.stack([g.lo[0] + cells[:, 0] * g.h[0], g.lo[1] + cells[:, 1] * g.h[1]], axis=1)
     u = t / g.dt
     k = np.minimum(np.floor(u).astype(np.int64), len(ang) - 1)

@@ -127,7 +127,8 @@ def _from_file(path: Path) -> ProofData:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise InputError("proofs_json", str(path), f"cannot be read ({exc.strerror or exc})") from None
+        raise InputError("proofs_json", str(path),
+                         f"cannot be read ({exc.strerror or exc})") from None
     except json.JSONDecodeError as exc:
         raise InputError("proofs_json", str(path), f"is not valid JSON ({exc.msg}, line "
                          f"{exc.lineno})") from None

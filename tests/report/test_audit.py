@@ -157,7 +157,8 @@ def test_git_state_tells_clean_from_modified_and_untracked(tmp_path):
     state = git_state(tmp_path)
     assert state["available"] and state["clean"] is True and len(state["commit"]) == 40
     (tmp_path / "b.txt").write_text("b\n")
-    assert git_state(tmp_path) | {"note": ""} == state | {"clean": False, "untracked": 1, "note": ""}
+    after = git_state(tmp_path)
+    assert after | {"note": ""} == state | {"clean": False, "untracked": 1, "note": ""}
     (tmp_path / "a.txt").write_text("changed\n")
     assert (git_state(tmp_path)["modified"], git_state(tmp_path)["clean"]) == (1, False)
 
@@ -167,7 +168,8 @@ def test_summary_counts_match_the_obligations(report):
     items, total = ob["items"], ob["summary"]["total"]
     assert total["total"] == len(items) == sum(r["total"] for r in ob["summary"]["rows"])
     assert total["refuted_as_expected"] == sum(i["verdict"] == "refuted as expected" for i in items)
-    assert total["proved_z3"] == sum(i["verdict"] == "proved" and i["method"] == "z3" for i in items)
+    assert total["proved_z3"] == sum(i["verdict"] == "proved" and i["method"] == "z3"
+                                     for i in items)
     assert total["checked_data"] == sum(i["verdict"] == "proved" and i["method"] == "data"
                                         for i in items)
     # Every refuted-as-expected obligation prints its counterexample.
