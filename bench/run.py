@@ -1,0 +1,417 @@
+"""`make bench`: BuiltDR, the search, `cfmpa plan` and `make prove` timed; shapely side by side.
+
+Writes OUT/results.json (default bench/results.json) and prints a table: the median of the runs
+after a warm-up, with min and max, and each item's peak resident memory (its own process).
+Items slower than their time budget get fewer runs; the table says how many. --quick is a smoke
+run on a coarse grid (one run each, one process for all in-process items, so its memory column
+is that process's high-water mark so far; no warm-up). Never imported by the package.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+WORKER = Path(__file__).resolve().parent / "_worker.py"
+DEFAULT_CELLS = {"start_cell": (40, 100), "goal_cell": (150, 60)}   # default.toml, dt = 0.02
+VARIANTS = ("original", "modified", "tight")
+GIB = 1024.0
+
+
+@dataclass
+class Config:
+    quick: bool
+    runs: int
+    warmup: int = 1
+    budget_s: float = 120.0                # per item: fewer runs when one run is slower
+    dt: float = 0.02                       # the default scenario's own
+    sample: int = 2000                     # per-cell shapely loop
+    dwithin_stride: int = 8                # vectorised dwithin: every 8th layer, extrapolated
+    scaling_dts: tuple[float, ...] = (0.04, 0.02, 0.01)
+    contracts_dt: float = 0.04             # full contracts on the default grid take minutes
+    one_degree: dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, quick: bool, runs: int | None) -> Config:
+        if quick:
+            return cls(quick=True, runs=runs or 1, warmup=0, budget_s=20.0, dt=0.16, sample=100,
+                       dwithin_stride=1, scaling_dts=(0.32, 0.16, 0.08), contracts_dt=0.32,
+                       one_degree=one_degree(10))
+        return cls(quick=False, runs=runs or 5, one_degree=one_degree(1))
+
+
+def default_at(dt: float) -> dict[str, Any]:
+    """The default scenario at time step dt, its start and goal cells scaled to the new grid."""
+    scale = 0.02 / dt
+    return {"path": "scenarios/default.toml",
+            "overrides": {"dt": dt} | {f"right__{k}": [round(c * scale) for c in v]
+                                       for k, v in DEFAULT_CELLS.items()}}
+
+
+def one_degree(degrees: int) -> dict[str, Any]:
+    """The default workcell on a grid of `degrees` degrees (361 x 361 at 1) with about 150 / degrees
+    layers: dt = h / omega, the principal's move lengthened so that N = ceil(Tf / dt) hits it."""
+    dt = math.radians(degrees)
+    layers = 150 // degrees
+    start = [0.3, 0.8]
+    goal = [start[0] + (layers - 0.5) * dt, 2.2]   # omega = 1: Tf = (layers - 0.5) dt
+    scale = 0.02 / dt
+    return {"path": "scenarios/default.toml",
+            "overrides": {"dt": dt, "left__start": start, "left__goal": goal}
+            | {f"right__{k}": [round(c * scale) for c in v] for k, v in DEFAULT_CELLS.items()}}
+
+
+# ------------------------------------------------------------------------------ running ----
+
+def stats(times: list[float], **extra: Any) -> dict[str, Any]:
+    return {"median_s": statistics.median(times), "min_s": min(times), "max_s": max(times),
+            "runs": len(times), **extra}
+
+
+def in_workers(cfg: Config, items: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Run worker items: one process each (per-item memory), or all in one process if --quick."""
+    for it in items:
+        it.setdefault("runs", cfg.runs)
+        it.setdefault("warmup", cfg.warmup)
+        it.setdefault("budget_s", cfg.budget_s)
+    groups = [items] if cfg.quick else [[it] for it in items]
+    out: list[dict[str, Any]] = []
+    for group in groups:
+        proc = subprocess.run([sys.executable, str(WORKER), json.dumps(group)], cwd=ROOT,
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise SystemExit(f"bench worker failed on {group}:\n{proc.stderr}")
+        for r in json.loads(proc.stdout.strip().splitlines()[-1]):
+            out.append(stats(r["times_s"], peak_rss_mb=r["peak_rss_mb"],
+                             rss_before_mb=r["rss_before_mb"], info=r["info"]))
+    return out
+
+
+def cfmpa_exe() -> Path | None:
+    exe = ROOT / ".venv" / "bin" / "cfmpa"
+    return exe if exe.exists() else (Path(p) if (p := shutil.which("cfmpa")) else None)
+
+
+def cli_has(command: str) -> bool:
+    exe = cfmpa_exe()
+    if exe is None:
+        return False
+    help_text = subprocess.run([str(exe), "--help"], capture_output=True, text=True).stdout
+    return f"{command}" in help_text.split("COMMAND", 1)[-1]
+
+
+def cli_run(cfg: Config, argv: list[str]) -> dict[str, Any]:
+    """Time a `cfmpa` command in its own process; peak memory from that process's rusage."""
+    exe = cfmpa_exe()
+    times: list[float] = []
+    peak = 0.0
+    runs = cfg.runs
+    for n in range(cfg.warmup + runs):
+        with tempfile.TemporaryFile() as err:   # a file, not a pipe: a full pipe would block
+            t0 = time.perf_counter()
+            proc = subprocess.Popen([str(exe), *argv], cwd=ROOT, stdout=subprocess.DEVNULL,
+                                    stderr=err)
+            _, status, usage = os.wait4(proc.pid, 0)
+            seconds = time.perf_counter() - t0
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            err.seek(0)
+            message = err.read().decode(errors="replace").strip()[-500:]
+        if proc.returncode != 0:
+            return {"error": f"exit {proc.returncode}: {message}", "argv": argv}
+        peak = max(peak, usage.ru_maxrss / 1024)
+        if n < cfg.warmup:
+            if seconds * runs > cfg.budget_s:
+                runs = max(1, math.floor(cfg.budget_s / seconds))
+            continue
+        times.append(seconds)
+        if len(times) >= runs:
+            break
+    return stats(times, peak_rss_mb=round(peak, 1), argv=argv)
+
+
+def scenario_file(spec: dict[str, Any], folder: Path) -> Path:
+    """A TOML file for the CLI: the bundled scenario with the spec's overrides."""
+    import tomllib
+
+    doc = tomllib.loads((ROOT / spec["path"]).read_text())
+    for key, value in spec.get("overrides", {}).items():
+        parts = key.split("__")
+        target = doc
+        for p in parts[:-1]:
+            target = target[p]
+        target[parts[-1]] = value
+    path = folder / f"bench-{abs(hash(json.dumps(spec, sort_keys=True))):x}.toml"
+    path.write_text(to_toml(doc))
+    return path
+
+
+def to_toml(doc: dict[str, Any]) -> str:
+    def value(v: Any) -> str:
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        return repr(v)
+    top = [f"{k} = {value(v)}" for k, v in doc.items() if not isinstance(v, dict)]
+    tables = [f"\n[{k}]\n" + "\n".join(f"{kk} = {value(vv)}" for kk, vv in v.items())
+              for k, v in doc.items() if isinstance(v, dict)]
+    return "\n".join(top) + "\n" + "\n".join(tables) + "\n"
+
+
+def skipped(why: str) -> dict[str, Any]:
+    return {"skipped": why}
+
+
+# ------------------------------------------------------------------------------ the bench ----
+
+def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
+    base = default_at(cfg.dt)
+    res: dict[str, Any] = {"meta": meta(cfg, base)}
+
+    items = [{"kind": "builtdr", "scenario": base, "variant": v, "impl": impl}
+             for v in VARIANTS for impl in ("reference", "fast", "fast_regions_given")]
+    items += [{"kind": "search", "scenario": base, "variant": v, "impl": impl}
+              for v in VARIANTS for impl in ("reference", "fast")]
+    shp = "modified"
+    items += [{"kind": "shapely_loop", "scenario": base, "variant": shp, "sample": cfg.sample,
+               "seed": 7},
+              {"kind": "shapely_vector", "scenario": base, "variant": shp, "op": "intersects"},
+              {"kind": "shapely_vector", "scenario": base, "variant": shp, "op": "dwithin",
+               "layer_stride": cfg.dwithin_stride}]
+    for dt in cfg.scaling_dts:
+        items += [{"kind": "builtdr", "scenario": default_at(dt), "variant": "modified",
+                   "impl": "fast"},
+                  {"kind": "search", "scenario": default_at(dt), "variant": "modified",
+                   "impl": "fast"}]
+    items += [{"kind": "plan_fast", "scenario": base, "variant": "modified",
+               "contracts": "sampled"},
+              {"kind": "plan_fast", "scenario": cfg.one_degree, "variant": "modified",
+               "contracts": "sampled"}]
+    out = iter(in_workers(cfg, items))
+
+    res["builtdr"] = {v: {impl: next(out) for impl in ("reference", "fast", "fast_regions_given")}
+                      for v in VARIANTS}
+    res["search"] = {v: {impl: next(out) for impl in ("reference", "fast")} for v in VARIANTS}
+    loop, inter, dwithin = next(out), next(out), next(out)
+    res["shapely"] = shapely_section(res, shp, loop, inter, dwithin)
+    res["scaling"] = [{"dt": dt, "cells": (b := next(out))["info"]["cells"], "builtdr_fast": b,
+                       "search_fast": next(out)} for dt in cfg.scaling_dts]
+    plan_fast, one_fast = next(out), next(out)
+
+    have_cli = cli_has("plan")
+    no_cli = skipped("no `cfmpa plan` in this checkout (.venv/bin/cfmpa missing or no plan)")
+    default_toml = scenario_file(base, tmp)
+    one_toml = scenario_file(cfg.one_degree, tmp)
+    res["plan"] = {
+        "cli_sampled": cli_run(cfg, ["plan", str(default_toml), "--variant", "modified", "--out",
+                                     str(tmp / "plan"), "--contracts", "sampled"])
+        if have_cli else no_cli,
+        "fast_in_process_sampled": plan_fast,
+        "note": "cli: `cfmpa plan` as this checkout wires it; fast_in_process: plan() with "
+                "build_dr_fast and search_opt_path_fast, files written, imports excluded",
+    }
+    res["prove"] = (cli_run(cfg, ["prove"]) if cli_has("prove")
+                    else skipped("no `cfmpa prove` in this checkout yet"))
+    res["contracts"] = contracts_section(cfg, tmp, have_cli)
+    res["one_degree"] = {
+        "grid": one_fast["info"]["grid"], "cells": one_fast["info"]["cells"],
+        "plan_fast_in_process_sampled": one_fast,
+        "plan_cli_sampled": cli_run(cfg, ["plan", str(one_toml), "--variant", "modified",
+                                          "--out", str(tmp / "one"), "--contracts", "sampled"])
+        if have_cli else no_cli,
+    }
+    res["targets"] = targets(res, cfg)
+    return res
+
+
+def shapely_section(res: dict[str, Any], variant: str, loop: dict[str, Any],
+                    inter: dict[str, Any], dwithin: dict[str, Any]) -> dict[str, Any]:
+    cells = loop["info"]["cells"]
+    rate = loop["info"]["sample"] / loop["median_s"]
+    loop_full = cells / rate
+    dw_full = dwithin["median_s"] * dwithin["info"]["layers"] / dwithin["info"]["layers_timed"]
+    ours = res["builtdr"][variant]["fast"]["median_s"]
+    return {
+        "variant": variant,
+        "per_cell_loop": {**loop, "rate_cells_per_s": rate, "extrapolated_full_grid_s": loop_full,
+                          "note": f"measured on {loop['info']['sample']} seeded random cells; "
+                                  "the full-grid time is extrapolated from that rate"},
+        "vectorised_intersects": {**inter, "note": "shapely.intersects on prepared polygons, "
+                                  "full grid, polygon creation included (intersects is distance "
+                                  "<= 0, not <= eps)"},
+        "vectorised_dwithin": {**dwithin, "extrapolated_full_grid_s": dw_full,
+                               "note": "shapely.dwithin(a, b, eps), the project's own rule; "
+                                       f"{dwithin['info']['layers_timed']} of "
+                                       f"{dwithin['info']['layers']} layers timed, extrapolated"},
+        "ratios": {"loop_over_ours": loop_full / ours,
+                   "intersects_over_ours": inter["median_s"] / ours,
+                   "dwithin_over_ours": dw_full / ours,
+                   "note": "their time / our fast BuiltDR time (regions included), same grid"},
+    }
+
+
+def contracts_section(cfg: Config, tmp: Path, have_cli: bool) -> dict[str, Any]:
+    if not have_cli:
+        return skipped("no `cfmpa plan` in this checkout")
+    spec = default_at(cfg.contracts_dt)
+    toml = scenario_file(spec, tmp)
+    out: dict[str, Any] = {"scenario": spec, "note": "`cfmpa plan --contracts MODE`, variant "
+                           "modified, on the default workcell at this dt (full on the default "
+                           "grid takes minutes per run)"}
+    for mode in ("off", "sampled", "full"):
+        out[mode] = cli_run(cfg, ["plan", str(toml), "--variant", "modified", "--out",
+                                  str(tmp / f"contracts-{mode}"), "--contracts", mode])
+    if all("median_s" in out[m] for m in ("off", "sampled", "full")):
+        out["ratios"] = {"sampled_over_off": out["sampled"]["median_s"] / out["off"]["median_s"],
+                         "full_over_off": out["full"]["median_s"] / out["off"]["median_s"]}
+    return out
+
+
+def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
+    """The issue's targets against the medians (meaningful on the full run only)."""
+    def row(name: str, measured: float | None, limit: float, at_most: bool = True,
+            note: str = "") -> dict[str, Any]:
+        met = None if measured is None else (measured <= limit if at_most else measured >= limit)
+        return {"target": name, "limit": limit, "measured": measured, "met": met, "note": note}
+
+    def med(d: dict[str, Any]) -> float | None:
+        return d.get("median_s")
+
+    sh = res["shapely"]["ratios"]
+    cli = res["plan"]["cli_sampled"]
+    one = res["one_degree"]
+    rows = [
+        row("BuiltDR fast, slowest variant (s)",
+            max(res["builtdr"][v]["fast"]["median_s"] for v in VARIANTS), 0.5),
+        row("BuiltDR fast vs per-cell shapely loop (x)", sh["loop_over_ours"], 1000, False),
+        row("BuiltDR fast vs vectorised shapely intersects (x)", sh["intersects_over_ours"], 10,
+            False),
+        row("search fast, slowest variant (s)",
+            max(res["search"][v]["fast"]["median_s"] for v in VARIANTS), 1.0),
+        row("cfmpa plan end to end, sampled (s)", med(cli), 3.0, note="the CLI as wired"),
+        row("plan with the fast kernels, sampled (s)",
+            med(res["plan"]["fast_in_process_sampled"]), 3.0, note="in process, imports excluded"),
+        row("1-degree plan, fast kernels (s)", med(one["plan_fast_in_process_sampled"]), 5.0),
+        row("1-degree plan, fast kernels (peak MiB)",
+            one["plan_fast_in_process_sampled"]["peak_rss_mb"], GIB),
+        row("1-degree cfmpa plan (s)", med(one["plan_cli_sampled"]), 5.0, note="the CLI as wired"),
+        row("1-degree cfmpa plan (peak MiB)", one["plan_cli_sampled"].get("peak_rss_mb"), GIB,
+            note="the CLI as wired"),
+    ]
+    if cfg.quick:
+        for r in rows:
+            r["note"] = ("quick run on a coarse grid: not the target's measurement; " + r["note"])
+    return rows
+
+
+def meta(cfg: Config, base: dict[str, Any]) -> dict[str, Any]:
+    import numba
+    import numpy
+    import shapely
+
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()
+    return {"date": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "quick": cfg.quick, "runs": cfg.runs,
+            "warmup": cfg.warmup, "budget_s_per_item": cfg.budget_s, "scenario": base,
+            "python": platform.python_version(), "numpy": numpy.__version__,
+            "numba": numba.__version__, "shapely": shapely.__version__, "commit": commit,
+            "cpus": os.cpu_count(), "load_average": os.getloadavg(),
+            "note": "medians over the runs after the warm-up; other processes may share the CPUs"}
+
+
+# ------------------------------------------------------------------------------ the table ----
+
+def table(res: dict[str, Any]) -> str:
+    lines = [f"{'item':58s} {'median s':>10s} {'min s':>9s} {'max s':>9s} {'runs':>4s} "
+             f"{'peak MiB':>9s}"]
+
+    def add(name: str, d: dict[str, Any]) -> None:
+        if "median_s" in d:
+            lines.append(f"{name:58s} {d['median_s']:10.4f} {d['min_s']:9.4f} {d['max_s']:9.4f} "
+                         f"{d['runs']:4d} {d.get('peak_rss_mb', float('nan')):9.1f}")
+        else:
+            lines.append(f"{name:58s} {d.get('skipped') or d.get('error')}")
+
+    for v in VARIANTS:
+        for impl, d in res["builtdr"][v].items():
+            add(f"BuiltDR {v} {impl} ({d['info']['cells']} cells)", d)
+    for v in VARIANTS:
+        for impl, d in res["search"][v].items():
+            add(f"search {v} {impl}", d)
+    sh = res["shapely"]
+    add(f"shapely per-cell loop, {sh['per_cell_loop']['info']['sample']} sampled cells",
+        sh["per_cell_loop"])
+    add("shapely vectorised intersects, full grid", sh["vectorised_intersects"])
+    add(f"shapely vectorised dwithin, {sh['vectorised_dwithin']['info']['layers_timed']} layers",
+        sh["vectorised_dwithin"])
+    for s in res["scaling"]:
+        add(f"scaling dt={s['dt']} BuiltDR fast ({s['cells']} cells)", s["builtdr_fast"])
+        add(f"scaling dt={s['dt']} search fast", s["search_fast"])
+    add("cfmpa plan, sampled (CLI)", res["plan"]["cli_sampled"])
+    add("plan, fast kernels, sampled (in process)", res["plan"]["fast_in_process_sampled"])
+    add("make prove (cfmpa prove)", res["prove"])
+    c = res["contracts"]
+    for mode in ("off", "sampled", "full"):
+        if mode in c:
+            add(f"cfmpa plan --contracts {mode} (dt={c['scenario']['overrides']['dt']})", c[mode])
+        elif mode == "off":
+            add("cfmpa plan --contracts", c)
+    one = res["one_degree"]
+    grid = "x".join(str(x) for x in one["grid"])
+    add(f"plan {grid}, fast kernels, sampled (in process)", one["plan_fast_in_process_sampled"])
+    add(f"cfmpa plan {grid}, sampled (CLI)", one["plan_cli_sampled"])
+    lines.append("")
+    r = sh["ratios"]
+    lines.append(f"per-cell shapely loop: {sh['per_cell_loop']['rate_cells_per_s']:.0f} cells/s, "
+                 f"full grid {sh['per_cell_loop']['extrapolated_full_grid_s']:.1f} s "
+                 "(extrapolated from the sample)")
+    lines.append(f"ratios (theirs / ours): per-cell loop {r['loop_over_ours']:.0f}x, "
+                 f"vectorised intersects {r['intersects_over_ours']:.1f}x, "
+                 f"vectorised dwithin {r['dwithin_over_ours']:.1f}x (extrapolated)")
+    if "ratios" in c:
+        lines.append(f"contracts: sampled/off {c['ratios']['sampled_over_off']:.2f}x, "
+                     f"full/off {c['ratios']['full_over_off']:.2f}x")
+    lines.append("")
+    lines.append("targets:")
+    for t in res["targets"]:
+        verdict = {True: "met", False: "MISSED", None: "n/a"}[t["met"]]
+        measured = "-" if t["measured"] is None else f"{t['measured']:.4g}"
+        cmp = "<=" if "vs" not in t["target"] else ">="
+        lines.append(f"  {t['target']:52s} {measured:>10s} {cmp} {t['limit']:<6g} {verdict}"
+                     + (f"  ({t['note']})" if t["note"] else ""))
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smoke run on a coarse grid")
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent),
+                    help="folder for results.json (default: bench/)")
+    ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
+    args = ap.parse_args(argv)
+    cfg = Config.of(args.quick, args.runs)
+    with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:
+        res = bench(cfg, Path(tmp))
+    out = Path(args.out) / "results.json"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(res, indent=1, default=str) + "\n")
+    print(table(res))
+    print(f"\nwrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
