@@ -26,6 +26,7 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 WORKER = Path(__file__).resolve().parent / "_worker.py"
+PLAN_FAST = [sys.executable, str(Path(__file__).resolve().parent / "_plan_fast.py")]
 DEFAULT_CELLS = {"start_cell": (40, 100), "goal_cell": (150, 60)}   # default.toml, dt = 0.02
 VARIANTS = ("original", "modified", "tight")
 GIB = 1024.0
@@ -113,16 +114,17 @@ def cli_has(command: str) -> bool:
     return f"{command}" in help_text.split("COMMAND", 1)[-1]
 
 
-def cli_run(cfg: Config, argv: list[str]) -> dict[str, Any]:
-    """Time a `cfmpa` command in its own process; peak memory from that process's rusage."""
-    exe = cfmpa_exe()
+def cli_run(cfg: Config, argv: list[str], program: list[str] | None = None) -> dict[str, Any]:
+    """Time a `cfmpa` command (or ``program``) in its own process; peak memory from that
+    process's rusage."""
+    exe = program or [str(cfmpa_exe())]
     times: list[float] = []
     peak = 0.0
     runs = cfg.runs
     for n in range(cfg.warmup + runs):
         with tempfile.TemporaryFile() as err:   # a file, not a pipe: a full pipe would block
             t0 = time.perf_counter()
-            proc = subprocess.Popen([str(exe), *argv], cwd=ROOT, stdout=subprocess.DEVNULL,
+            proc = subprocess.Popen([*exe, *argv], cwd=ROOT, stdout=subprocess.DEVNULL,
                                     stderr=err)
             _, status, usage = os.wait4(proc.pid, 0)
             seconds = time.perf_counter() - t0
@@ -219,9 +221,13 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
         "cli_sampled": cli_run(cfg, ["plan", str(default_toml), "--variant", "modified", "--out",
                                      str(tmp / "plan"), "--contracts", "sampled"])
         if have_cli else no_cli,
+        "fast_process_sampled": cli_run(cfg, [str(default_toml), "modified", str(tmp / "pf"),
+                                              "sampled"], PLAN_FAST),
         "fast_in_process_sampled": plan_fast,
-        "note": "cli: `cfmpa plan` as this checkout wires it; fast_in_process: plan() with "
-                "build_dr_fast and search_opt_path_fast, files written, imports excluded",
+        "note": "cli: `cfmpa plan` as this checkout wires it; fast_process: the same steps with "
+                "build_dr_fast and search_opt_path_fast in a fresh process (bench/_plan_fast.py, "
+                "imports included); fast_in_process: plan() with them, files written, imports "
+                "excluded",
     }
     res["prove"] = (cli_run(cfg, ["prove"]) if cli_has("prove")
                     else skipped("no `cfmpa prove` in this checkout yet"))
@@ -229,6 +235,8 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
     res["one_degree"] = {
         "grid": one_fast["info"]["grid"], "cells": one_fast["info"]["cells"],
         "plan_fast_in_process_sampled": one_fast,
+        "plan_fast_process_sampled": cli_run(cfg, [str(one_toml), "modified", str(tmp / "pf1"),
+                                                   "sampled"], PLAN_FAST),
         "plan_cli_sampled": cli_run(cfg, ["plan", str(one_toml), "--variant", "modified",
                                           "--out", str(tmp / "one"), "--contracts", "sampled"])
         if have_cli else no_cli,
@@ -243,7 +251,8 @@ def shapely_section(res: dict[str, Any], variant: str, loop: dict[str, Any],
     rate = loop["info"]["sample"] / loop["median_s"]
     loop_full = cells / rate
     dw_full = dwithin["median_s"] * dwithin["info"]["layers"] / dwithin["info"]["layers_timed"]
-    ours = res["builtdr"][variant]["fast"]["median_s"]
+    ours = res["builtdr"][variant]["fast_regions_given"]["median_s"]
+    ours_all = res["builtdr"][variant]["fast"]["median_s"]
     return {
         "variant": variant,
         "per_cell_loop": {**loop, "rate_cells_per_s": rate, "extrapolated_full_grid_s": loop_full,
@@ -259,7 +268,11 @@ def shapely_section(res: dict[str, Any], variant: str, loop: dict[str, Any],
         "ratios": {"loop_over_ours": loop_full / ours,
                    "intersects_over_ours": inter["median_s"] / ours,
                    "dwithin_over_ours": dw_full / ours,
-                   "note": "their time / our fast BuiltDR time (regions included), same grid"},
+                   "loop_over_ours_with_right_regions": loop_full / ours_all,
+                   "intersects_over_ours_with_right_regions": inter["median_s"] / ours_all,
+                   "note": "their time / our fast BuiltDR time, same grid and variant. Like for "
+                           "like: both are given the right arm's regions (ours still computes "
+                           "the left arm's); *_with_right_regions: ours also computes them"},
     }
 
 
@@ -293,20 +306,24 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
     sh = res["shapely"]["ratios"]
     cli = res["plan"]["cli_sampled"]
     one = res["one_degree"]
+    fast_plan = res["plan"]["fast_process_sampled"]
+    one_fast = one["plan_fast_process_sampled"]
     rows = [
         row("BuiltDR fast, slowest variant (s)",
-            max(res["builtdr"][v]["fast"]["median_s"] for v in VARIANTS), 0.5),
-        row("BuiltDR fast vs per-cell shapely loop (x)", sh["loop_over_ours"], 1000, False),
+            max(res["builtdr"][v]["fast"]["median_s"] for v in VARIANTS), 0.5,
+            note="right regions included"),
+        row("BuiltDR fast vs per-cell shapely loop (x)", sh["loop_over_ours"], 1000, False,
+            note="both given the same regions; extrapolated from the sample"),
         row("BuiltDR fast vs vectorised shapely intersects (x)", sh["intersects_over_ours"], 10,
-            False),
+            False, note="both given the same regions"),
         row("search fast, slowest variant (s)",
             max(res["search"][v]["fast"]["median_s"] for v in VARIANTS), 1.0),
         row("cfmpa plan end to end, sampled (s)", med(cli), 3.0, note="the CLI as wired"),
-        row("plan with the fast kernels, sampled (s)",
-            med(res["plan"]["fast_in_process_sampled"]), 3.0, note="in process, imports excluded"),
-        row("1-degree plan, fast kernels (s)", med(one["plan_fast_in_process_sampled"]), 5.0),
-        row("1-degree plan, fast kernels (peak MiB)",
-            one["plan_fast_in_process_sampled"]["peak_rss_mb"], GIB),
+        row("plan, fast kernels, fresh process, sampled (s)", med(fast_plan), 3.0,
+            note="what `cfmpa plan` does once wired to them"),
+        row("1-degree plan, fast kernels, fresh process (s)", med(one_fast), 5.0),
+        row("1-degree plan, fast kernels, fresh process (peak MiB)", one_fast.get("peak_rss_mb"),
+            GIB),
         row("1-degree cfmpa plan (s)", med(one["plan_cli_sampled"]), 5.0, note="the CLI as wired"),
         row("1-degree cfmpa plan (peak MiB)", one["plan_cli_sampled"].get("peak_rss_mb"), GIB,
             note="the CLI as wired"),
@@ -360,7 +377,8 @@ def table(res: dict[str, Any]) -> str:
     for s in res["scaling"]:
         add(f"scaling dt={s['dt']} BuiltDR fast ({s['cells']} cells)", s["builtdr_fast"])
         add(f"scaling dt={s['dt']} search fast", s["search_fast"])
-    add("cfmpa plan, sampled (CLI)", res["plan"]["cli_sampled"])
+    add("cfmpa plan, sampled (CLI as wired)", res["plan"]["cli_sampled"])
+    add("plan, fast kernels, sampled (fresh process)", res["plan"]["fast_process_sampled"])
     add("plan, fast kernels, sampled (in process)", res["plan"]["fast_in_process_sampled"])
     add("make prove (cfmpa prove)", res["prove"])
     c = res["contracts"]
@@ -371,16 +389,21 @@ def table(res: dict[str, Any]) -> str:
             add("cfmpa plan --contracts", c)
     one = res["one_degree"]
     grid = "x".join(str(x) for x in one["grid"])
+    add(f"plan {grid}, fast kernels, sampled (fresh process)", one["plan_fast_process_sampled"])
     add(f"plan {grid}, fast kernels, sampled (in process)", one["plan_fast_in_process_sampled"])
-    add(f"cfmpa plan {grid}, sampled (CLI)", one["plan_cli_sampled"])
+    add(f"cfmpa plan {grid}, sampled (CLI as wired)", one["plan_cli_sampled"])
     lines.append("")
     r = sh["ratios"]
     lines.append(f"per-cell shapely loop: {sh['per_cell_loop']['rate_cells_per_s']:.0f} cells/s, "
                  f"full grid {sh['per_cell_loop']['extrapolated_full_grid_s']:.1f} s "
                  "(extrapolated from the sample)")
-    lines.append(f"ratios (theirs / ours): per-cell loop {r['loop_over_ours']:.0f}x, "
-                 f"vectorised intersects {r['intersects_over_ours']:.1f}x, "
-                 f"vectorised dwithin {r['dwithin_over_ours']:.1f}x (extrapolated)")
+    lines.append(f"ratios (theirs / ours, both given the right regions): per-cell loop "
+                 f"{r['loop_over_ours']:.0f}x, vectorised intersects "
+                 f"{r['intersects_over_ours']:.1f}x, vectorised dwithin "
+                 f"{r['dwithin_over_ours']:.1f}x (extrapolated)")
+    lines.append(f"ratios with our right regions computed too: per-cell loop "
+                 f"{r['loop_over_ours_with_right_regions']:.0f}x, vectorised intersects "
+                 f"{r['intersects_over_ours_with_right_regions']:.1f}x")
     if "ratios" in c:
         lines.append(f"contracts: sampled/off {c['ratios']['sampled_over_off']:.2f}x, "
                      f"full/off {c['ratios']['full_over_off']:.2f}x")

@@ -180,5 +180,7 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
                     res["one_degree"]["plan_cli_sampled"]):
         assert "skipped" in section or "error" not in section
     assert timing <= set(res["one_degree"]["plan_fast_in_process_sampled"])
+    assert timing <= set(res["one_degree"]["plan_fast_process_sampled"])
+    assert timing <= set(res["plan"]["fast_process_sampled"])
     assert all({"target", "limit", "measured", "met"} <= set(t) for t in res["targets"])
     assert "targets:" in proc.stdout and "results.json" in proc.stdout
