@@ -97,7 +97,7 @@ def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | P
 
 
 def read_dr(path: str | Path) -> npt.NDArray[Any]:
-    """dr.npy as an array (any dtype: the check says whether it is uint8); InputError if unreadable."""
+    """dr.npy as an array (of any dtype: the check judges it); InputError if unreadable."""
     source = str(path)
     try:
         arr = np.load(path, allow_pickle=False)

@@ -75,7 +75,8 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
          build: Builder = build_dr, search: Searcher = search_opt_path) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
 
-    ``contracts`` is off, sampled (``sample`` random cells, ``seed``) or full (see _contracts).
+    ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
+    (``sample`` random cells, ``seed``) or full (see _contracts).
     Unless off, a certificate that is not clear (a contact, or an interval left undecided) is a
     violation too. A violation raises ContractViolation; with ``stop=False`` postcondition and
     certificate violations are recorded in ``contracts`` and the run goes on (a failed

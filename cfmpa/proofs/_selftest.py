@@ -34,8 +34,8 @@ from ..spec._paths import J1, J2, SearchResult, SearchStatus, is_path_paper, opt
 from ._contracts import Mode
 from ._plan import plan
 
-__all__ = ["FAULTS", "Fault", "Outcome", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault",
-           "run_selftest", "selftest_rows", "selftest_table"]
+__all__ = ["FAULTS", "Fault", "FaultNotMade", "Mutant", "Outcome", "SAMPLE", "SelftestRow",
+           "WORKCELLS", "run_fault", "run_selftest", "selftest_rows", "selftest_table", "workcell"]
 
 #: Cells of the sampled mode's random sample in the self-check (the seed is 0).
 SAMPLE = 64
@@ -276,7 +276,7 @@ def workcell(name: str, **changes: Any) -> Scenario:
 
 def run_fault(fault: Fault, mode: Mode | str, *, scenario: Scenario | None = None,
               sample: int = SAMPLE, seed: int = 0) -> tuple[Outcome, str]:
-    """Plan with the fault seeded, under contracts in ``mode``: (what caught it, the fault's size)."""
+    """Plan with the fault seeded, contracts in ``mode``: (what caught it, the fault's size)."""
     s = scenario or workcell(fault.workcell)
     g = make_grid(s)
     m = fault.make(s, fault.variant, g)

@@ -97,7 +97,7 @@ class Triple:
 
     @property
     def label(self) -> str:
-        """The name and title, as a violation names the triple: ``Theorem 3 [BuiltDR, modified]``."""
+        """Name and title as violations name the triple: ``Theorem 3 [BuiltDR, modified]``."""
         return f"{self.name} [{self.title}]"
 
     def condition(self, cid: str) -> Condition:
@@ -133,8 +133,8 @@ class Triple:
 _GRID_PRE = (
     Condition("pre.grid.N", "N >= 1 and N * dt >= Tf in exact arithmetic: the layers cover the "
               "principal's whole motion"),
-    Condition("pre.grid.h", "h_q <= omega_q * dt for both joints in exact arithmetic, and the m x n "
-              "grid points span the subordinate's joint limits"),
+    Condition("pre.grid.h", "h_q <= omega_q * dt for both joints in exact arithmetic, and the "
+              "m x n grid points span the subordinate's joint limits"),
     Condition("pre.grid.scenario", "the grid's dt, Tf and lower limits are the scenario's"),
     Condition("pre.cells", "the start and goal cells lie inside the m x n grid"),
 )

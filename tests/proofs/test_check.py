@@ -157,8 +157,10 @@ def test_a_contact_fails_the_certificate(outputs, tmp_path, capsys):
     ("missing dr", lambda d: ("dr", d / "none.npy"), "dr cannot be read"),
     ("dr not npy", lambda d: ("dr", d / "x.npy", "not an array"), "dr is not a .npy array"),
     ("missing plan", lambda d: ("plan", d / "none.json"), "plan cannot be read"),
-    ("bad json", lambda d: ("plan", d / "p.json", '{\n  "variant": \n'), ":3: error: json is not valid"),
-    ("not an object", lambda d: ("plan", d / "p.json", "[1, 2]"), "<document> must be a JSON object"),
+    ("bad json", lambda d: ("plan", d / "p.json", '{\n  "variant": \n'),
+     ":3: error: json is not valid"),
+    ("not an object", lambda d: ("plan", d / "p.json", "[1, 2]"),
+     "<document> must be a JSON object"),
 ])
 def test_unreadable_input_exits_2_naming_the_file(outputs, tmp_path, capsys, what, make, message):
     spec = make(tmp_path)

@@ -131,3 +131,16 @@ def test_another_builder_can_be_run_under_the_contracts(s):
 
     p = plan(s, "tight", contracts="full", build=mine)
     assert seen == ["tight"] and p.violations == []
+
+
+@pytest.mark.slow
+def test_the_default_scenario_meets_every_triple_in_full_mode():
+    from pathlib import Path
+
+    from cfmpa.impl import build_dr_fast
+    from cfmpa.spec import load_scenario
+
+    s = load_scenario(Path(__file__).resolve().parents[2] / "scenarios" / "default.toml")
+    p = plan(s, "modified", contracts="full", build=build_dr_fast, stop=False)
+    assert p.violations == [] and p.certificate.clear
+    assert plan_json(p)["contracts"]["checked"] > p.dr.size

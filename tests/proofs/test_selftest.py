@@ -9,8 +9,8 @@ import pytest
 
 import cfmpa.proofs._selftest as st
 from cfmpa.proofs._contracts import Mode
-from cfmpa.proofs._selftest import (FAULTS, SAMPLE, WORKCELLS, FaultNotMade, run_fault, run_selftest,
-                                    selftest_rows, selftest_table, workcell)
+from cfmpa.proofs._selftest import (FAULTS, SAMPLE, WORKCELLS, FaultNotMade, run_fault,
+                                    run_selftest, selftest_rows, selftest_table, workcell)
 from cfmpa.spec import load_scenario, make_grid
 
 ROOT = Path(__file__).resolve().parents[2]
