@@ -48,7 +48,8 @@ def load(spec: dict[str, Any]):
     return parse_scenario(doc, check_budget=False)
 
 
-def timed(fn: Callable[[], Any], runs: int, warmup: int, budget_s: float) -> tuple[list[float], Any]:
+def timed(fn: Callable[[], Any], runs: int, warmup: int, budget_s: float
+          ) -> tuple[list[float], Any]:
     out = None
     first = None
     for _ in range(warmup):
@@ -131,7 +132,7 @@ def _shapely_setup(it: dict[str, Any]):
 
 
 def item_shapely_loop(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any]]:
-    """The obvious Python way: per cell, shapely polygons and distance <= eps, on a seeded sample."""
+    """The obvious Python way: per cell, shapely polygons, distance <= eps; a seeded sample."""
     import shapely
 
     from cfmpa.spec import EPS

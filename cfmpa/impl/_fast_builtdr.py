@@ -319,10 +319,10 @@ def _pair(ga, boxa, spa, a, gb, boxb, spb, b, eps, margin, hint, have, px, py
     _BLOCKED_AT with the common point (x, y) that proves it, or BLOCKED; or UNSURE.
 
     ``hint`` is an axis to try first; (px, py), if ``have``, a point known to lie in polygon a (a
-    vertex of it, or deeper than margin), tried first for b. Axis e is an edge normal of A (e < V_A) or of
-    B (e - V_A). Its gap is the min over the other polygon's vertices of (n.v - offset);
-    rounding is monotone, so "every vertex's term > t" is exactly "gap > t", and the scans may
-    stop early.
+    vertex of it, or deeper than margin), tried first for b. Axis e is an edge normal of A
+    (e < V_A) or of B (e - V_A). Its gap is the min over the other polygon's vertices of
+    (n.v - offset); rounding is monotone, so "every vertex's term > t" is exactly "gap > t", and
+    the scans may stop early.
     """
     if _box_gap(boxa, a, boxb, b) > eps:
         return FREE, 0.0, 0.0
