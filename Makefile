@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 prove: $(STAMP)
-	$(VENV)/bin/cfmpa prove
+	$(VENV)/bin/cfmpa prove --audit build/audit
 
 test: $(STAMP)
 	$(PY) -m pytest

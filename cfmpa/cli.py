@@ -27,21 +27,30 @@ def _variant(value: str) -> str:
             f"--variant must be one of {', '.join(v.value for v in Variant)}, got {value!r}") from None
 
 
+def _kernels(name: str):  # type: ignore[no-untyped-def]
+    """(build, search): the fast kernels (bit-identical, checked against) or the reference."""
+    from . import impl
+
+    if name == "reference":
+        return impl.build_dr, impl.search_opt_path
+    return impl.build_dr_fast, impl.search_opt_path_fast
+
+
 def cmd_dr(args: argparse.Namespace) -> int:
     """Build D_R for one scenario and variant; write DIR/dr.npy."""
     from ._io import save_npy_atomic
-    from .impl import build_dr
     from .spec import load_scenario, make_grid
 
     s = load_scenario(args.scenario)
     g = make_grid(s)
+    build, _ = _kernels(args.kernel)
     t0 = time.perf_counter()
-    dr = build_dr(s, args.variant, g)
+    dr = build(s, args.variant, g)
     seconds = time.perf_counter() - t0
     out = save_npy_atomic(Path(args.out) / "dr.npy", dr)
     free = 1.0 - float(dr.mean())
     print(f"scenario  {s.name} ({args.scenario})")
-    print(f"variant   {args.variant}")
+    print(f"variant   {args.variant} ({args.kernel} kernel)")
     print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad"
           f"  shape={tuple(dr.shape)}")
     print(f"free      {free:.4%} of cells")
@@ -56,8 +65,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from .spec import load_scenario
 
     s = load_scenario(args.scenario)
-    p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample)
+    build, search = _kernels(args.kernel)
+    p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample,
+             stop=False, build=build, search=search)
     dr_path, plan_path = write_plan(p, args.out)
+    violations = p.violations
     g, r, t = p.grid, p.search, p.timings_s
     print(f"scenario  {s.name} ({args.scenario})")
     print(f"variant   {p.variant}")
@@ -78,7 +90,64 @@ def cmd_plan(args: argparse.Namespace) -> int:
               f"{n_bad} violations")
     print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()))
     print(f"wrote     {dr_path}, {plan_path}")
-    return 0
+    for v in violations:
+        print(f"violation {v}", file=sys.stderr)
+    return 1 if violations else 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Check another planner's dr.npy and plan.json against the spec."""
+    from .proofs import run_check
+
+    return run_check(args.scenario, args.dr, args.plan)
+
+
+def cmd_selftest(args: argparse.Namespace) -> int:
+    """Seed faults and show which contract check catches each."""
+    from .proofs import run_selftest
+
+    return run_selftest()
+
+
+def cmd_prove(args: argparse.Namespace) -> int:
+    """Discharge every obligation; with --audit, also write the audit report."""
+    from .proofs import run_prove
+
+    code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only)
+    if args.audit is None:
+        return code
+    from .report import run_audit
+
+    print()
+    audit = run_audit(None, args.audit, argv=["cfmpa", *sys.argv[1:]],
+                      proofs_json=str(Path(args.out) / "results.json"),
+                      scenarios_dir=args.scenarios)
+    return code or audit
+
+
+def cmd_audit(args: argparse.Namespace) -> int:
+    """Write the audit report (HTML and its JSON twin)."""
+    from .report import run_audit
+
+    return run_audit(args.scenarios or None, args.out, argv=["cfmpa", *sys.argv[1:]],
+                     proofs_json=args.proofs, compare_n=args.compare_n)
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    """The paper's experimental claim, measured on seeded random workcells."""
+    from .report import run_compare
+
+    return run_compare(n=args.n, seed=args.seed, out=args.out)
+
+
+def _positive(value: str) -> int:
+    try:
+        n = int(value)
+    except ValueError:
+        n = -1
+    if n < 0:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {value!r}")
+    return n
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -91,6 +160,8 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--variant", type=_variant, default="modified",
                    help="original | modified | tight (default: modified)")
     d.add_argument("--out", required=True, help="output folder (dr.npy is written there)")
+    d.add_argument("--kernel", choices=["fast", "reference"], default="fast",
+                   help="fast (default; bit-identical to the reference) or reference")
     d.set_defaults(func=cmd_dr)
 
     pl = sub.add_parser("plan", help="plan the subordinate's path; write dr.npy and plan.json")
@@ -103,7 +174,42 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--seed", type=int, default=0, help="seed of the sampled contracts")
     pl.add_argument("--sample", type=int, default=None,
                     help="cells checked by sampled contracts (default: the mode's own)")
+    pl.add_argument("--kernel", choices=["fast", "reference"], default="fast",
+                    help="fast (default; bit-identical to the reference) or reference")
     pl.set_defaults(func=cmd_plan)
+
+    c = sub.add_parser("check", help="check another planner's dr.npy and plan.json")
+    c.add_argument("scenario", help="scenario TOML file the outputs are for")
+    c.add_argument("--dr", required=True, help="dr.npy (uint8, shape (N + 1, m, n))")
+    c.add_argument("--plan", required=True, help="plan.json (DESIGN §9)")
+    c.set_defaults(func=cmd_check)
+
+    st = sub.add_parser("selftest", help="seed faults; show which check catches each")
+    st.set_defaults(func=cmd_selftest)
+
+    pr = sub.add_parser("prove", help="discharge every obligation (make prove)")
+    pr.add_argument("--out", default="build/proofs", help="results folder (default build/proofs)")
+    pr.add_argument("--scenarios", default="scenarios", help="scenario folder (default scenarios)")
+    pr.add_argument("--only", action="append", default=None,
+                    help="an obligation id, prefix or glob (repeatable)")
+    pr.add_argument("--audit", metavar="DIR", default=None,
+                    help="then write the audit report to DIR")
+    pr.set_defaults(func=cmd_prove)
+
+    au = sub.add_parser("audit", help="write report.html and report.json")
+    au.add_argument("scenarios", nargs="*", help="scenario files (default: all bundled)")
+    au.add_argument("--out", required=True, help="output folder")
+    au.add_argument("--proofs", default=None,
+                    help="results.json of a prove run to report (default: prove afresh)")
+    au.add_argument("--compare-n", type=_positive, default=100,
+                    help="workcells in the campaign (0 skips it; default 100)")
+    au.set_defaults(func=cmd_audit)
+
+    co = sub.add_parser("compare", help="original vs modified vs tight on random workcells")
+    co.add_argument("--n", type=_positive, default=100, help="workcells (default 100)")
+    co.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
+    co.add_argument("--out", default=None, help="folder for compare.json")
+    co.set_defaults(func=cmd_compare)
     return p
 
 

@@ -19,7 +19,7 @@ import numpy.typing as npt
 from .. import __version__
 from .._io import dumps_json, save_npy_atomic, write_bytes_atomic
 from ..errors import ContractViolation
-from ..impl import build_dr, search_opt_path
+from ..impl import build_dr_fast, search_opt_path_fast
 from ..spec import Grid, Scenario, Variant, make_grid
 from ..spec._certificate import Certificate, certificate_json, certify, require_clear
 from ..spec._paths import SearchResult, SearchStatus
@@ -72,7 +72,7 @@ def versions() -> dict[str, str]:
 
 def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
          sample: int | None = None, stop: bool = True, grid: Grid | None = None,
-         build: Builder = build_dr, search: Searcher = search_opt_path) -> PlanResult:
+         build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
 
     ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
@@ -81,7 +81,8 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     violation too. A violation raises ContractViolation; with ``stop=False`` postcondition and
     certificate violations are recorded in ``contracts`` and the run goes on (a failed
     precondition always stops it). ``grid``, ``build`` and ``search`` replace the scenario's grid
-    and the reference implementation: for checking another implementation, or a seeded fault.
+    and the kernels (by default the fast ones, bit-identical to the reference and tested against
+    it): for the reference itself, another implementation, or a seeded fault.
     """
     v = Variant(variant)
     settings = Settings.of(contracts, seed, sample)

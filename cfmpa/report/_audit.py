@@ -365,7 +365,8 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     items.append(_item("found paths certified clear", not unclear if found else None,
                        f"{len(found) - len(unclear)} of {len(found)} found paths"
                        + (f"; not clear: {', '.join(unclear)}" if unclear else "")))
-    recorded = [(n, v) for n, v in plans if v["contracts"] is not None]
+    # Off mode still writes a record (checked = 0); only records that checked something count.
+    recorded = [(n, v) for n, v in plans if v["contracts"] and v["contracts"].get("checked", 0) > 0]
     violated = [f"{n}/{v['variant']}" for n, v in recorded if v["contracts"].get("violations")]
     items.append(_item("contracts hold", (not violated) if recorded else None,
                        f"{len(recorded)} of {len(plans)} plans recorded contracts"
