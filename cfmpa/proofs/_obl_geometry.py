@@ -170,12 +170,16 @@ def _distance() -> Z3Query:
     free = (("eps >= 0", eps >= 0), ("delta > eps", delta > eps),
             ("dist(A, B) >= delta", dist_ge(a, b, delta)))
     empty = tuple((x, _plane(False)) for x in (a, b, a2, b2))
+    # Pins for the negative test: A empty, B, A' and B' the whole plane (quantified sets are
+    # otherwise left to Z3's instantiation heuristics, whose answer varies with term order).
+    apart = ((a, _plane(False)), (b, _plane(True)), (a2, _plane(True)), (b2, _plane(True)))
     return Z3Query((
         # The same delta witnesses dist(A', B') > eps: the decision is monotone.
         VC("monotone", free + (("A' ⊆ A", subset(a2, a)), ("B' ⊆ B", subset(b2, b))),
-           dist_ge(a2, b2, delta), key_premise="A' ⊆ A", witness=empty),
+           dist_ge(a2, b2, delta), key_premise="A' ⊆ A", witness=empty, counter_witness=apart),
         VC("sound", free, z3.Not(z3.And(a[p[0], p[1]], b[p[0], p[1]])),
-           key_premise="dist(A, B) >= delta", witness=empty[:2]),
+           key_premise="dist(A, B) >= delta", witness=empty[:2],
+           counter_witness=((a, _plane(True)), (b, _plane(True)))),
     ))
 
 

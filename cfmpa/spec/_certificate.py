@@ -41,6 +41,7 @@ import numpy.typing as npt
 
 from ..errors import CertificateViolation, InputError
 from ._grid import EPS, Grid, exact_tf, left_angles
+from ._kinematics import corners, reach
 from ._polygon import polygon_distances
 from ._scenario import Arm, Scenario
 
@@ -327,11 +328,9 @@ def _merge(parts: list[tuple[FloatArray, FloatArray]]) -> tuple[tuple[float, flo
 
 
 def _reach(arm: Arm) -> tuple[FloatArray, FloatArray]:
-    """(R_base, R_elbow) per link: bounds on a link point's distance from the base / the elbow."""
-    l1, l2 = arm.links
-    r = arm.width / 2.0
-    far1, far2 = math.hypot(l1 + r, r), math.hypot(l2 + r, r)
-    return np.array([far1, l1 + far2]), np.array([0.0, far2])
+    """(R_base, R_elbow) per link, as arrays over the two links."""
+    per_link = [reach(arm, link) for link in (0, 1)]
+    return np.array([r[0] for r in per_link]), np.array([r[1] for r in per_link])
 
 
 def _link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
@@ -342,18 +341,6 @@ def _link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
 
 
 def _link_rects(arm: Arm, theta: FloatArray) -> FloatArray:
-    """Corners of both links at each configuration, (K, 2) -> (K, 2 links, 4, 2).
-
-    The batched twin of ``link_corners`` (same corner order); a test checks they agree.
-    """
-    l1, l2 = arm.links
+    """Corners of both links at each configuration, (K, 2) -> (K, 2 links, 4, 2)."""
     r = arm.width / 2.0
-    phi = np.stack([theta[:, 0], theta[:, 0] + theta[:, 1]], axis=1)      # (K, 2) link directions
-    u = np.stack([np.cos(phi), np.sin(phi)], axis=-1)                      # (K, 2, 2)
-    base = np.broadcast_to(np.asarray(arm.base, dtype=float), (len(theta), 2))
-    elbow = base + l1 * u[:, 0]
-    tip = elbow + l2 * u[:, 1]
-    start = np.stack([base, elbow], axis=1) - r * u                       # extended by w/2
-    end = np.stack([elbow, tip], axis=1) + r * u
-    n = r * np.stack([-u[..., 1], u[..., 0]], axis=-1)                    # left normal, length w/2
-    return np.stack([start - n, end - n, end + n, start + n], axis=2)
+    return np.stack([corners(arm, theta[:, 0], theta[:, 1], link, r) for link in (0, 1)], axis=1)

@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+import numpy.typing as npt
+
 from ._scenario import Arm
 
-__all__ = ["joints", "link_corners", "arm_corners"]
+__all__ = ["joints", "link_corners", "arm_corners", "corners", "reach"]
 
 Point = tuple[float, float]
 
@@ -42,3 +45,33 @@ def link_corners(arm: Arm, theta: tuple[float, float], link: int) -> list[Point]
 def arm_corners(arm: Arm, theta: tuple[float, float]) -> list[list[Point]]:
     """Both links' corners: the arm as two rectangles."""
     return [link_corners(arm, theta, 0), link_corners(arm, theta, 1)]
+
+
+def reach(arm: Arm, link: int) -> tuple[float, float]:
+    """(R_base, R_elbow): no point of the link is farther than these from the base / the elbow."""
+    r = arm.width / 2
+    if link == 0:
+        return math.hypot(arm.links[0] + r, r), 0.0
+    far = math.hypot(arm.links[1] + r, r)
+    return arm.links[0] + far, far
+
+
+def corners(arm: Arm, t1: npt.ArrayLike, t2: npt.ArrayLike, link: int, r: float
+            ) -> npt.NDArray[np.float64]:
+    """Corners (..., 4, 2) of the link at (t1, t2) as a rectangle of half-width r, capped by r."""
+    t1 = np.asarray(t1, dtype=float)
+    t2 = np.asarray(t2, dtype=float)
+    bx, by = arm.base
+    ex = bx + arm.links[0] * np.cos(t1)
+    ey = by + arm.links[0] * np.sin(t1)
+    if link == 0:
+        px, py, phi = np.full_like(ex, bx), np.full_like(ey, by), t1
+        qx, qy = ex, ey
+    else:
+        phi = t1 + t2
+        px, py = ex, ey
+        qx, qy = ex + arm.links[1] * np.cos(phi), ey + arm.links[1] * np.sin(phi)
+    ux, uy = r * np.cos(phi), r * np.sin(phi)
+    pts = [(px - ux + uy, py - uy - ux), (qx + ux + uy, qy + uy - ux),
+           (qx + ux - uy, qy + uy + ux), (px - ux - uy, py - uy + ux)]
+    return np.stack([np.stack(p, -1) for p in pts], -2)

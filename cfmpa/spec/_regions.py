@@ -15,21 +15,12 @@ import numpy.typing as npt
 import shapely
 
 from ._grid import Grid, Variant, left_angles, left_box
+from ._kinematics import corners, reach
 from ._scenario import Arm, Scenario
 
-__all__ = ["SNAP", "reach", "margin", "lattice", "corners", "left_region_polygons",
-           "right_region_polygons"]
+__all__ = ["SNAP", "margin", "lattice", "left_region_polygons", "right_region_polygons"]
 
 SNAP = 1e-9
-
-
-def reach(arm: Arm, link: int) -> tuple[float, float]:
-    """(R_base, R_elbow): no point of the link is farther than these from the base / the elbow."""
-    r = arm.width / 2
-    if link == 0:
-        return math.hypot(arm.links[0] + r, r), 0.0
-    far = math.hypot(arm.links[1] + r, r)
-    return arm.links[0] + far, far
 
 
 def lattice(lo: float, hi: float, anchor: float, g: float) -> npt.NDArray[np.float64]:
@@ -45,27 +36,6 @@ def margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int]) 
     R = reach(arm, link)
     return sum((g[q] ** 2 / 8 * R[q] if sizes[q] > 1 else 0.0) + SNAP * g[q] * R[q]
                for q in range(2))
-
-
-def corners(arm: Arm, t1: npt.ArrayLike, t2: npt.ArrayLike, link: int, r: float
-            ) -> npt.NDArray[np.float64]:
-    """Corners (..., 4, 2) of the link at (t1, t2) as a rectangle of half-width r, capped by r."""
-    t1 = np.asarray(t1, dtype=float)
-    t2 = np.asarray(t2, dtype=float)
-    bx, by = arm.base
-    ex = bx + arm.links[0] * np.cos(t1)
-    ey = by + arm.links[0] * np.sin(t1)
-    if link == 0:
-        px, py, phi = np.full_like(ex, bx), np.full_like(ey, by), t1
-        qx, qy = ex, ey
-    else:
-        phi = t1 + t2
-        px, py = ex, ey
-        qx, qy = ex + arm.links[1] * np.cos(phi), ey + arm.links[1] * np.sin(phi)
-    ux, uy = r * np.cos(phi), r * np.sin(phi)
-    pts = [(px - ux + uy, py - uy - ux), (qx + ux + uy, qy + uy - ux),
-           (qx + ux - uy, qy + uy + ux), (px - ux - uy, py - uy + ux)]
-    return np.stack([np.stack(p, -1) for p in pts], -2)
 
 
 def _hulls(points: npt.NDArray[np.float64]) -> npt.NDArray[np.object_]:
