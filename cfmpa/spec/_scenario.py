@@ -279,11 +279,12 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     try:
         data = p.read_bytes()
     except OSError as exc:
-        raise InputError("scenario", source, f"cannot be read ({exc.strerror or exc})") from None
+        raise InputError("scenario", MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=source) from None
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
-        raise InputError("scenario", source, "is not UTF-8 text") from None
+        raise InputError("scenario", MISSING, "is not UTF-8 text", source=source) from None
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
