@@ -25,7 +25,12 @@ interval split at its midpoint.) An interval is proved clear when the least such
 four link pairs exceeds EPS = 1e-9 m, a margin far above the float rounding (~1e-15 m) in the
 sampled positions and distances. Intervals are the motion's pieces (split at multiples of dt and
 at Tf, where velocities change), halved until proved clear; a sample at distance 0 is a contact.
-An interval still unproved at ``max_depth`` halvings is reported undecided, never clear.
+An interval still unproved at ``max_depth`` halvings is reported undecided, never clear. So is,
+at once, an atomic interval that is not proved: one of zero length (an all-static motion is the
+single instant [0, 0]), one whose midpoint rounds to an end, or one on which nothing moves
+(L_ab = 0, so d_ab is constant and the bound is the sample itself). Halving could not tighten
+its bound; a sampled distance in (0, EPS] there is within rounding of a touch, so neither proved
+clear nor a contact.
 The least of the proved interval bounds is a lower bound on the clearance over the whole motion.
 """
 
@@ -126,10 +131,15 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
         deepest = int(depth.max())
         lb = np.min((d0 + d1 - lip * (t1 - t0)[:, None, None]) / 2.0, axis=(1, 2))
         proved = lb > EPS
+        tm = (t0 + t1) / 2.0
+        # Halving cannot tighten an atomic interval's bound: it has no interior instant (zero
+        # length, or no float between its ends) or nothing moves on it (L = 0, d constant). Its
+        # samples decide it; splitting it would only double it every round up to the caps.
+        atomic = (tm <= t0) | (tm >= t1) | np.all(lip == 0.0, axis=(1, 2))
         at_cap = depth >= max_depth
         over_budget = examined + 2 * len(t0) > max_intervals
-        settled = proved & (at_cap | over_budget | (lb >= bound_ratio * best.d))
-        stuck = ~proved & (at_cap | over_budget)
+        settled = proved & (at_cap | over_budget | atomic | (lb >= bound_ratio * best.d))
+        stuck = ~proved & (at_cap | over_budget | atomic)
         if np.any(settled):
             proved_lb = min(proved_lb, float(lb[settled].min()))
         if np.any(stuck):
@@ -137,8 +147,8 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
         split = ~(settled | stuck)
         if not np.any(split):
             break
-        t0, t1, seg, d0, d1, lip, depth = (x[split] for x in (t0, t1, seg, d0, d1, lip, depth))
-        tm = (t0 + t1) / 2.0
+        t0, t1, tm, seg, d0, d1, lip, depth = (x[split] for x in (t0, t1, tm, seg, d0, d1, lip,
+                                                                   depth))
         dm = motion.distances(tm, seg)
         samples += len(tm)
         best = best.update(tm, dm)

@@ -268,6 +268,43 @@ def test_single_cell_path_with_resting_left_arm():
         executed_distance(s, g, [(0, 1)], 0.0), abs=0.0)
 
 
+def facing(gap: float):
+    """Both arms at rest for the whole motion, straight along the x axis and facing each other,
+    ``gap`` metres apart (negative: overlapping): the left's end at x = 0.68, the right's at
+    its base minus 0.68. The certificate's only intervals are atomic ones."""
+    s = scenario(0.05, {"start": [0.0, 0.0], "goal": [0.0, 0.0]},
+                 {"base": [1.36 + gap, 0.0], "start": [math.pi, 0.0], "goal": [math.pi, 0.0]})
+    g = make_grid(s)
+    cell = (cell_near(g, 0, math.pi), 0)
+    assert g.angles(cell)[0] == math.pi
+    return s, g, cell
+
+
+@pytest.mark.parametrize("waits", [1, 4])          # one cell (the instant [0, 0]), or waiting
+@pytest.mark.parametrize("gap, verdict", [
+    (1e-3, "clear"), (5e-10, "undecided"), (1e-15, "undecided"), (0.0, "undecided"),
+    (-1e-3, "contact")])
+def test_an_all_static_motion_is_decided_from_its_samples_without_splitting(gap, verdict, waits):
+    # Nothing moves, so halving cannot tighten any bound: before, a clearance below EPS doubled
+    # the intervals every round up to the caps (a million intervals, tens of seconds).
+    s, g, cell = facing(gap)
+    cert = certify(s, g, [cell] * waits)
+    assert cert.intervals <= max(1, waits - 1) and cert.max_depth_used == 0
+    seen = executed_distance(s, g, [cell], 0.0)
+    assert cert.min_clearance_m == seen
+    if verdict == "clear":
+        assert cert.clear and cert.lower_bound_m == seen == pytest.approx(gap, abs=1e-12)
+    elif verdict == "undecided":
+        # Within EPS of a touch: neither provably apart nor a sampled contact.
+        assert 0.0 < seen <= 1e-9
+        assert not cert.clear and cert.contact is None and cert.lower_bound_m == 0.0
+        assert cert.undecided == ((0.0, (waits - 1) * g.dt),)
+        with pytest.raises(CertificateViolation, match="neither proved clear"):
+            require_clear(cert)
+    else:
+        assert not cert.clear and cert.contact is not None and seen == 0.0
+
+
 @pytest.mark.parametrize("path, field", [
     ([], "path"),
     ([(0, 0), (4, 0)], "path[1]"),
