@@ -1,7 +1,13 @@
 """Scenario files (DESIGN §3): a frozen value object, validated before any work starts.
 
 Every refusal is an InputError naming the field and the value, e.g.
-``right.omega[1] must be > 0, got -1.0``.
+``right.omega[1] must be > 0, got -1.0``. Beyond finiteness and sign, values must lie in a
+physical range (so that no float in the geometry overflows): base coordinates within
+MAX_BASE_M = 1000 m, link lengths and widths in (0, MAX_LENGTH_M = 100 m], angles (start, goal,
+limits) within MAX_ANGLE_RAD = 1000 rad, and omega_q * dt <= MAX_STEP_RAD = 3.14 rad for every
+joint of both arms (the margin lemma, ``Lemma.sweep_margin``, is proved for lattice spacings
+g <= 3.14; the left spacing is omega dt, the right h_q <= omega_q dt). The grid's size is
+computed in exact integers and held to the memory budget before any float grid step exists.
 """
 
 from __future__ import annotations
@@ -28,6 +34,10 @@ __all__ = [
     "max_cells",
     "DEFAULT_MAX_CELLS",
     "ANGLE_TOLERANCE",
+    "MAX_BASE_M",
+    "MAX_LENGTH_M",
+    "MAX_ANGLE_RAD",
+    "MAX_STEP_RAD",
 ]
 
 #: Cells of D_R, (N + 1) * m * n, allowed before any work starts. About 1 byte per cell for
@@ -35,6 +45,18 @@ __all__ = [
 DEFAULT_MAX_CELLS = 60_000_000
 #: An angle given for the right arm's start or goal must be this close to a grid point (rad).
 ANGLE_TOLERANCE = 1e-9
+#: Physical range: |base coordinate| <= MAX_BASE_M (m); 0 < link length, width <= MAX_LENGTH_M (m).
+MAX_BASE_M = 1000.0
+MAX_LENGTH_M = 100.0
+#: |angle| <= MAX_ANGLE_RAD for start, goal and limits: the grid's angles keep ~1e-13 rad ulps.
+MAX_ANGLE_RAD = 1000.0
+#: omega_q * dt <= MAX_STEP_RAD per joint: the margin lemma holds for spacings g <= 3.14 rad.
+MAX_STEP_RAD = 3.14
+#: Cells beyond this are refused even with check_budget=False: no machine holds them, and
+#: counts this large no longer convert to floats.
+_HARD_MAX_CELLS = 2**53
+#: Numbers in messages are printed in full up to this many digits, else in scientific notation.
+_MAX_DIGITS = 15
 
 Pair = tuple[float, float]
 
@@ -123,7 +145,9 @@ class _Reader:
         for n, line in enumerate(self.text.splitlines(), start=1):
             stripped = line.strip()
             if stripped.startswith("["):
-                in_table = table is not None and stripped.strip("[] ") == table
+                # A header may carry a comment: `[left]   # principal`.
+                header = stripped.split("#", 1)[0].strip()
+                in_table = table is not None and header.strip("[] ") == table
                 if table is None:
                     in_table = False
                 continue
@@ -154,21 +178,30 @@ class _Reader:
             if key not in doc:
                 raise self.fail(f"{prefix}{key}", MISSING, "is required")
 
-    def number(self, value: Any, field: str, *, positive: bool = False) -> float:
+    def number(self, value: Any, field: str, *, positive: bool = False,
+               bound: float | None = None, unit: str = "") -> float:
+        """A finite float; > 0 if ``positive``; |x| <= ``bound`` if given (stated in the message)."""
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.fail(field, value, "must be a number")
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:  # an integer beyond the float range
+            raise self.fail(field, _short(value), "must be finite") from None
         if not math.isfinite(x):
             raise self.fail(field, value, "must be finite")
         if positive and not x > 0:
             raise self.fail(field, value, "must be > 0")
+        if bound is not None and not abs(x) <= bound:
+            within = f"<= {bound:g}{unit}" if positive else f"within [-{bound:g}, {bound:g}]{unit}"
+            raise self.fail(field, value, f"must be {within} (the physical range)")
         return x
 
-    def pair(self, value: Any, field: str, *, positive: bool = False) -> Pair:
+    def pair(self, value: Any, field: str, *, positive: bool = False,
+             bound: float | None = None, unit: str = "") -> Pair:
         if not isinstance(value, list) or len(value) != 2:
             raise self.fail(field, value, "must be a list of 2 numbers")
-        return (self.number(value[0], f"{field}[0]", positive=positive),
-                self.number(value[1], f"{field}[1]", positive=positive))
+        return (self.number(value[0], f"{field}[0]", positive=positive, bound=bound, unit=unit),
+                self.number(value[1], f"{field}[1]", positive=positive, bound=bound, unit=unit))
 
     def cell(self, value: Any, field: str) -> tuple[int, int]:
         if not isinstance(value, list) or len(value) != 2:
@@ -186,25 +219,68 @@ class _Reader:
         return value
 
 
-def _arm_common(r: _Reader, doc: dict[str, Any], side: str) -> dict[str, Any]:
-    return {
-        "base": r.pair(doc["base"], f"{side}.base"),
-        "links": r.pair(doc["links"], f"{side}.links", positive=True),
-        "width": r.number(doc["width"], f"{side}.width", positive=True),
+def _short(x: Any) -> Any:
+    """An integer too long to print usefully, as a string in scientific notation."""
+    if isinstance(x, int) and not isinstance(x, bool) and len(str(abs(x))) > _MAX_DIGITS:
+        digits = str(abs(x))
+        return f"{'-' if x < 0 else ''}{digits[0]}.{digits[1:4]}e+{len(digits) - 1}"
+    return x
+
+
+def _arm_common(r: _Reader, doc: dict[str, Any], side: str, dt: float) -> dict[str, Any]:
+    out = {
+        "base": r.pair(doc["base"], f"{side}.base", bound=MAX_BASE_M, unit=" m"),
+        "links": r.pair(doc["links"], f"{side}.links", positive=True, bound=MAX_LENGTH_M,
+                        unit=" m"),
+        "width": r.number(doc["width"], f"{side}.width", positive=True, bound=MAX_LENGTH_M,
+                          unit=" m"),
         "omega": r.pair(doc["omega"], f"{side}.omega", positive=True),
     }
+    for q in range(2):
+        step = out["omega"][q] * dt
+        if not step <= MAX_STEP_RAD:
+            raise r.fail(f"{side}.omega[{q}]", out["omega"][q],
+                         f"times dt = {dt!r} is {step!r} rad per step, must be <= {MAX_STEP_RAD} "
+                         "(the margin lemma holds for lattice spacings up to 3.14 rad)")
+    return out
+
+
+def _grid_sizes(limits: tuple[Pair, Pair], omega: Pair, dt: float) -> tuple[int, int]:
+    from ._grid import joint_points  # local: _grid imports this module
+
+    return (joint_points(limits[0][0], limits[0][1], omega[0], dt),
+            joint_points(limits[1][0], limits[1][1], omega[1], dt))
+
+
+def _check_budget(r: _Reader, N: int, m: int, n: int, budget: int | None) -> None:
+    """Refuse (N + 1) * m * n over ``budget`` (None: only the hard limit), in exact integers."""
+    cells = (N + 1) * m * n
+    if cells <= min(budget or _HARD_MAX_CELLS, _HARD_MAX_CELLS):
+        return
+    # Blame the largest factor's inputs: N comes from dt and the left arm's motion, m and n
+    # from the right arm's limits, omega and dt.
+    factors = {"N + 1": (N + 1, "dt, left.omega, left.start, left.goal"),
+               "m": (m, "right.limits[0], right.omega[0], dt"),
+               "n": (n, "right.limits[1], right.omega[1], dt")}
+    name, (_, inputs) = max(factors.items(), key=lambda kv: kv[1][0])
+    if budget is not None and cells > budget:
+        over = f"the memory budget of {_short(budget)} cells (raise it with CFMPA_MAX_CELLS)"
+    else:
+        over = f"the hard limit of 2**53 = {_short(_HARD_MAX_CELLS)} cells"
+    if budget is not None and cells > _HARD_MAX_CELLS and budget < _HARD_MAX_CELLS:
+        over += f"; no budget may exceed 2**53 = {_short(_HARD_MAX_CELLS)} cells"
+    raise r.fail("grid", f"N={_short(N)}, m={_short(m)}, n={_short(n)}",
+                 f"has (N + 1) * m * n = {_short(cells)} cells, over {over}; the largest factor "
+                 f"is {name} (from {inputs}): coarsen it")
 
 
 def _grid_point(r: _Reader, doc: dict[str, Any], which: str, limits: tuple[Pair, Pair],
-                omega: Pair, dt: float) -> tuple[int, int]:
+                sizes: tuple[int, int]) -> tuple[int, int]:
     """Reads ``which``_cell, or ``which`` as angles snapped to the grid (within ANGLE_TOLERANCE)."""
-    from ._grid import joint_points  # local: _grid imports this module
-
     cell_key, angle_key = f"{which}_cell", which
     if (cell_key in doc) == (angle_key in doc):
-        raise r.fail(f"right.{cell_key}", doc.get(cell_key, doc.get(angle_key)),
+        raise r.fail(f"right.{cell_key}", doc.get(cell_key, doc.get(angle_key, MISSING)),
                      f"exactly one of right.{cell_key} or right.{angle_key} must be given")
-    sizes = [joint_points(limits[q][0], limits[q][1], omega[q], dt) for q in range(2)]
     if cell_key in doc:
         cell = r.cell(doc[cell_key], f"right.{cell_key}")
         for q in range(2):
@@ -212,7 +288,7 @@ def _grid_point(r: _Reader, doc: dict[str, Any], which: str, limits: tuple[Pair,
                 raise r.fail(f"right.{cell_key}[{q}]", cell[q],
                              f"must be a grid index in [0, {sizes[q] - 1}]")
         return cell
-    angles = r.pair(doc[angle_key], f"right.{angle_key}")
+    angles = r.pair(doc[angle_key], f"right.{angle_key}", bound=MAX_ANGLE_RAD, unit=" rad")
     out = []
     for q in range(2):
         lo, hi = limits[q]
@@ -245,31 +321,39 @@ def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str 
     dt = r.number(doc["dt"], "dt", positive=True)
 
     ld = r.table(doc, "left", _LEFT_KEYS, _LEFT_KEYS)
-    left = LeftArm(**_arm_common(r, ld, "left"), start=r.pair(ld["start"], "left.start"),
-                   goal=r.pair(ld["goal"], "left.goal"))
+    angle = {"bound": MAX_ANGLE_RAD, "unit": " rad"}
+    left = LeftArm(**_arm_common(r, ld, "left", dt), start=r.pair(ld["start"], "left.start", **angle),
+                   goal=r.pair(ld["goal"], "left.goal", **angle))
 
     rd = r.table(doc, "right", _RIGHT_KEYS, _ARM_KEYS | {"limits"})
-    common = _arm_common(r, rd, "right")
+    common = _arm_common(r, rd, "right", dt)
     lim = rd["limits"]
     if not isinstance(lim, list) or len(lim) != 2:
         raise r.fail("right.limits", lim, "must be a list of 2 [lo, hi] pairs")
     limits = (r.pair(lim[0], "right.limits[0]"), r.pair(lim[1], "right.limits[1]"))
     for q in range(2):
-        if not limits[q][0] < limits[q][1]:
+        lo, hi = limits[q]
+        if not lo < hi:
             raise r.fail(f"right.limits[{q}]", list(limits[q]), "must have lo < hi")
+        if not math.isfinite(hi - lo):
+            raise r.fail(f"right.limits[{q}]", list(limits[q]),
+                         "must have a finite span hi - lo (as a float)")
+        for e in range(2):
+            r.number(limits[q][e], f"right.limits[{q}][{e}]", **angle)
     omega = common["omega"]
-    start_cell = _grid_point(r, rd, "start", limits, omega, dt)
-    goal_cell = _grid_point(r, rd, "goal", limits, omega, dt)
+    # The grid's size in exact integers, before any float grid step is formed.
+    from ._grid import exact_n  # local: _grid imports this module
+
+    sizes = _grid_sizes(limits, omega, dt)
+    probe = Scenario(name=name, purpose=purpose, dt=dt, left=left,
+                     right=RightArm(**common, limits=limits, start_cell=(0, 0), goal_cell=(0, 0)))
+    N = exact_n(probe)
+    _check_budget(r, N, sizes[0], sizes[1], max_cells() if check_budget else None)
+    start_cell = _grid_point(r, rd, "start", limits, sizes)
+    goal_cell = _grid_point(r, rd, "goal", limits, sizes)
     right = RightArm(**common, limits=limits, start_cell=start_cell, goal_cell=goal_cell)
-    scenario = Scenario(name=name, purpose=purpose, dt=dt, left=left, right=right,
-                        source=source or "<memory>", sha256=sha256)
-    if check_budget:
-        budget = max_cells()
-        cells = scenario.cells
-        if cells > budget:
-            raise r.fail("dt", dt, f"gives a grid of {cells} cells ((N + 1) * m * n), over the "
-                         f"memory budget of {budget} cells; raise CFMPA_MAX_CELLS to allow it")
-    return scenario
+    return Scenario(name=name, purpose=purpose, dt=dt, left=left, right=right,
+                    source=source or "<memory>", sha256=sha256)
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:

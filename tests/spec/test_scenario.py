@@ -12,7 +12,8 @@ import pytest
 from hypothesis import given, settings
 
 import factory
-from cfmpa.errors import InputError
+from cfmpa import cli
+from cfmpa.errors import MISSING, InputError
 from cfmpa.spec import exact_n, exact_tf, load_scenario, make_grid, parse_scenario
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
@@ -49,13 +50,63 @@ def refused(**changes: object) -> InputError:
     ({"right__goal_cell": None, "right__goal": [7.0, 0.0]}, "right.goal[0]", "within the limits"),
     ({"right__goal_cell": None}, "right.goal_cell", "exactly one of"),
     ({"name": ""}, "name", "non-empty"),
-    ({"dt": 0.0005}, "dt", "memory budget"),
+    ({"dt": 0.0005}, "grid", "memory budget"),
+    # Extreme magnitudes: refused by name, never an OverflowError or an unsound grid.
+    ({"right__limits": [[-1e308, 1e308], [0.0, 1.0]]}, "right.limits[0]", "finite span"),
+    ({"right__limits": [[-1e308, 1e308], [0.0, 6.3]], "right__goal_cell": None,
+      "right__goal": [0.0, 0.0]}, "right.limits[0]", "finite span"),
+    ({"right__limits": [[0.0, 6.3], [-1e300, 1e300]]}, "right.limits[1][0]", "within [-1000"),
+    ({"right__omega": [1e-300, 1.0]}, "grid", "no budget may exceed 2**53"),
+    ({"left__width": 1e160}, "left.width", "<= 100 m"),
+    ({"right__width": 1e308}, "right.width", "<= 100 m"),
+    ({"left__links": [1e200, 0.3]}, "left.links[0]", "<= 100 m"),
+    ({"right__links": [0.35, 5e-324], "right__goal_cell": [0, 0, 1]}, "right.goal_cell",
+     "list of 2"),  # a tiny link is fine: the next field is the first refused
+    ({"left__base": [0.0, -1001.0]}, "left.base[1]", "within [-1000, 1000] m"),
+    ({"right__base": [1e308, 0.0]}, "right.base[0]", "within [-1000, 1000] m"),
+    ({"left__start": [1e6, 0.0]}, "left.start[0]", "within [-1000, 1000] rad"),
+    ({"left__omega": [13.0, 1.0]}, "left.omega[0]", "must be <= 3.14"),
+    ({"right__omega": [1.0, 1e308]}, "right.omega[1]", "must be <= 3.14"),
+    ({"dt": 3.5}, "left.omega[0]", "must be <= 3.14"),
+    ({"dt": 10**400}, "dt", "must be finite"),
 ])
 def test_bad_input_is_refused_naming_field_and_value(changes, field, words):
     err = refused(**changes)
     assert err.field == field
     assert words in str(err)
     assert err.exit_code == 2
+    # The message shows the offending value, and it is the value the document held.
+    if err.value is MISSING:
+        assert "got" not in str(err)
+        return
+    assert str(err).endswith(f", got {err.value!r}")
+    if field == "grid":
+        assert err.value.startswith("N=")   # its sizes; numbers checked in the next test
+    elif changes == {"dt": 10**400}:
+        assert err.value == "1.000e+400"    # a 400-digit integer, shortened
+    else:
+        held = _parts(list(changes.values()))
+        # Either the field's own value was changed, or (omega * dt) the message shows the change.
+        assert err.value in held or any(f"= {v!r}" in str(err) for v in held)
+
+
+def _parts(v: object) -> list[object]:
+    """v and, for a list, every item at every depth."""
+    return [v] + [y for x in v for y in _parts(x)] if isinstance(v, list) else [v]
+
+
+def test_budget_message_names_the_grid_and_caps_its_numbers():
+    err = refused(dt=0.0005)
+    text = str(err)
+    assert "N=2801, m=12568, n=12568" in text
+    assert "442588856448 cells" in text and "60000000 cells" in text
+    assert "CFMPA_MAX_CELLS" in text and "largest factor is m" in text
+    huge = str(refused(right__omega=[1e-300, 1.0]))
+    assert "m=2.513e+301" in huge and "cells, over" in huge
+    assert max(len(w) for w in huge.replace(",", " ").split()) < 40  # no 300-digit numbers
+    # The factor blamed follows the grid: a long motion makes N + 1 the largest.
+    slow = str(refused(left__omega=[1e-5, 1e-5]))
+    assert "largest factor is N + 1 (from dt, left.omega" in slow
 
 
 def test_off_grid_angle_names_the_nearest_grid_points():
@@ -87,10 +138,33 @@ def test_file_errors_carry_file_and_line(tmp_path):
     err = pytest.raises(InputError, load_scenario, bad).value
     line = text.splitlines().index("dt = 0.02") + 1
     assert err.render() == f"{bad}:{line}: error: dt must be > 0, got -1.0"
+    right = text.splitlines().index("[right]                   # subordinate")
+    nested = tmp_path / "nested.toml"
+    nested.write_text(text.replace("width = 0.06\nomega = [1.0, 1.0]\nlimits",
+                                   "width = -2.0\nomega = [1.0, 1.0]\nlimits"))
+    err = pytest.raises(InputError, load_scenario, nested).value
+    assert err.line == right + 4 and err.field == "right.width"
     broken = tmp_path / "broken.toml"
     broken.write_text('name = "x\n')
     assert pytest.raises(InputError, load_scenario, broken).value.line == 1
     assert "cannot be read" in str(pytest.raises(InputError, load_scenario, tmp_path / "no.toml").value)
+
+
+def test_cli_reports_file_and_line_of_a_nested_field_under_a_commented_header(tmp_path, capsys):
+    # Every bundled scenario's table headers carry a comment (`[left]   # principal`).
+    text = SCENARIOS[0].read_text()
+    lines = text.splitlines()
+    header = next(n for n, line in enumerate(lines) if line.startswith("[left]"))
+    assert "#" in lines[header]
+    at = next(n for n in range(header + 1, len(lines)) if lines[n].startswith("omega = "))
+    lines[at] = "omega = [1.0, -3.5]"
+    bad = tmp_path / "bad.toml"
+    bad.write_text("\n".join(lines) + "\n")
+    code = cli.main(["dr", str(bad), "--variant", "modified", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err == f"{bad}:{at + 1}: error: left.omega[1] must be > 0, got -3.5\n"
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
@@ -114,11 +188,18 @@ def test_grid_formulas_on_the_tiny_scenario():
     assert g.h[0] <= 1.0 * 0.25
 
 
+_extreme = st.sampled_from([1e308, -1e308, 1.7976931348623157e308, 5e-324, -5e-324, 0.0, -0.0,
+                            1e160, 1e-300, 3.15, 10**400, 2**63])
+_floats = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(math.nan), _extreme)
 _scalars = st.one_of(st.none(), st.booleans(), st.integers(-5, 5), st.text(string.printable, max_size=4),
-                     st.floats(allow_nan=True, allow_infinity=True), st.just(math.nan))
-_values = st.recursive(_scalars, lambda inner: st.one_of(st.lists(inner, max_size=4),
-                                                        st.dictionaries(st.text(max_size=6), inner,
-                                                                        max_size=3)), max_leaves=8)
+                     _floats)
+# Well-formed pairs with extreme entries, so the fuzz reaches the arithmetic, not only the types.
+_pairs = st.lists(st.one_of(_floats, st.floats(-10, 10)), min_size=2, max_size=2)
+_values = st.one_of(
+    _pairs, st.lists(_pairs, min_size=2, max_size=2),
+    st.recursive(_scalars, lambda inner: st.one_of(st.lists(inner, max_size=4),
+                                                   st.dictionaries(st.text(max_size=6), inner,
+                                                                   max_size=3)), max_leaves=8))
 _paths = st.sampled_from(["name", "purpose", "dt", "left", "right", "left__base", "left__links",
                           "left__width", "left__omega", "left__start", "left__goal", "right__base",
                           "right__links", "right__width", "right__omega", "right__limits",
@@ -126,9 +207,7 @@ _paths = st.sampled_from(["name", "purpose", "dt", "left", "right", "left__base"
                           "left__extra"])
 
 
-@settings(max_examples=300, deadline=None)
-@given(st.dictionaries(_paths, _values, min_size=1, max_size=4))
-def test_malformed_documents_raise_only_input_errors(changes):
+def _apply(changes: dict[str, object]) -> dict[str, object]:
     d = factory.doc()
     for key, value in changes.items():
         parts = key.split("__")
@@ -139,7 +218,37 @@ def test_malformed_documents_raise_only_input_errors(changes):
                 break
         else:
             target[parts[-1]] = value
+    return d
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.dictionaries(_paths, _values, min_size=1, max_size=4))
+def test_malformed_documents_raise_only_input_errors(changes):
     try:
-        parse_scenario(d)
+        parse_scenario(_apply(changes))
     except InputError as err:
         assert err.field and err.exit_code == 2
+        assert f"got {err.value!r}" in str(err) or "is required" in str(err)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(["dt", "left__width", "right__width", "left__links", "right__links",
+                        "left__base", "right__base", "left__omega", "right__omega", "left__start",
+                        "left__goal", "right__limits"]),
+       st.lists(st.one_of(_extreme, st.floats(-1e3, 1e3)), min_size=4, max_size=4))
+def test_extreme_floats_are_refused_by_name_or_give_a_sane_grid(key, xs):
+    value: object = xs[0] if key.endswith(("dt", "width")) else xs[:2]
+    if key == "right__limits":
+        value = [xs[:2], xs[2:]]
+    d = _apply({key: value, "right__start_cell": [0, 0], "right__goal_cell": [0, 0]})
+    try:
+        s = parse_scenario(d)
+    except InputError as err:
+        assert err.field and err.exit_code == 2
+        assert f"got {err.value!r}" in str(err)
+        return
+    g = make_grid(s)   # an accepted scenario has a grid within the budget, every step finite
+    assert (g.N + 1) * g.m * g.n <= 60_000_000
+    assert all(math.isfinite(x) and x >= 0 for x in g.h)
+    assert all(s.left.omega[q] * s.dt <= 3.14 and s.right.omega[q] * s.dt <= 3.14
+               for q in range(2))
