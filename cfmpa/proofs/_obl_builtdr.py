@@ -141,8 +141,12 @@ def builtdr_obligations() -> list[Obligation]:
     P = Verdict.PROVED
     Z = Method.Z3
     term = ("BuiltDR terminates (for any N, m, n): each of its 7 loops has the variant "
-            "hi - counter, >= 0 while the loop runs and lowered by every iteration, the "
-            "invariant lo <= counter <= hi being inductive (VCs by WP).")
+            "hi - counter, >= 0 while the loop runs (from the guard) and lowered by every "
+            "iteration, the invariant lo <= counter <= hi being inductive (VCs by WP). The "
+            "termination is syntactic: every loop is a For loop whose body cannot change its "
+            "counter or bounds (checked when the program is built), so the counter is bounded "
+            "and increasing; no VC uses the precondition or the correctness invariants, and "
+            "the main VC (the bounds hold on entry) is valid without its hypothesis.")
     out = []
     for ident, suffix, variant, ref, rest in (
             ("Thm1", "", "original", "Theorem 1 (Algorithm 1)", "the region of layer N-1"),

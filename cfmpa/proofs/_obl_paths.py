@@ -52,22 +52,38 @@ def _setting(array: str = "P") -> _Setting:
                     (z3.Int("start.i"), z3.Int("start.j")), (z3.Int("goal.i"), z3.Int("goal.j")))
 
 
+#: Variants whose rest layer is an independent region (not layer N-1's): the tight variant's
+#: principal at rest at its goal, and the generic family X of Prop8.prestrength_thm4.
+_OWN_REST = ("tight", "X")
+
+
+def rest_region(variant: str) -> z3.ExprRef:
+    """The principal's region in the rest layer: ``regionRest_<variant>`` (the name
+    Thm3.builtdr_tight's postcondition uses) for the variants in ``_OWN_REST``, else layer
+    N-1's, as in the paper."""
+    if variant in _OWN_REST:
+        return z3.Const(f"regionRest_{variant}", REGION)
+    region_l = z3.Function(f"regionL_{variant}", z3.IntSort(), REGION)
+    return region_l(Z3Dims.named().N - 1)
+
+
 def _regions(variant: str) -> tuple[Blocked, Blocked, Callable[[z3.ArithRef], z3.ExprRef]]:
     """The blocked predicates of Theorem 1/3's postcondition for a region family, and the
-    principal's region at step k (the rest layer's from N on: layer N-1's, as in the paper)."""
+    principal's region at step k (the rest region from N on: ``rest_region(variant)``)."""
     ints = z3.IntSort()
     region_l = z3.Function(f"regionL_{variant}", ints, REGION)
     region_r = z3.Function("regionR", ints, ints, REGION)
     N = Z3Dims.named().N
+    at_rest = rest_region(variant)
 
     def motion(k: z3.ArithRef, i: z3.ArithRef, j: z3.ArithRef) -> z3.BoolRef:
         return inter(region_l(k), region_r(i, j))
 
     def rest(_: z3.ArithRef, i: z3.ArithRef, j: z3.ArithRef) -> z3.BoolRef:
-        return inter(region_l(N - 1), region_r(i, j))
+        return inter(at_rest, region_r(i, j))
 
     def at_step(k: z3.ArithRef) -> z3.ExprRef:
-        return z3.If(k < N, region_l(k), region_l(N - 1))
+        return z3.If(k < N, region_l(k), at_rest)
     return motion, rest, at_step
 
 
@@ -308,8 +324,13 @@ def _search_post(st: _Setting, found: z3.BoolRef, R: Z3PathVar, no_path: z3.Bool
         held = z3.And(pos[0] == i, pos[1] == j, in_grid(st.d, (i, j)))
         parts.append(z3.Implies(found, z3.ForAll([k, i, j], z3.Implies(
             z3.And(0 <= k, k < st.d.N, held), st.P[k, i, j] == 0))))
-        parts.append(z3.Implies(found, z3.ForAll([k, i, j], z3.Implies(
-            z3.And(st.d.N <= k, k < R.length, held), st.P[st.d.N - 1, i, j] == 0))))
+        if variant in _OWN_REST:
+            # No layer N-1 reading here: the rest layer P[N] is free wherever the path waits.
+            parts.append(z3.Implies(found, z3.ForAll([k, i, j], z3.Implies(
+                z3.And(st.d.N <= k, held), st.P[st.d.N, i, j] == 0))))
+        else:
+            parts.append(z3.Implies(found, z3.ForAll([k, i, j], z3.Implies(
+                z3.And(st.d.N <= k, k < R.length, held), st.P[st.d.N - 1, i, j] == 0))))
     return z3.And(parts)
 
 
@@ -339,11 +360,20 @@ def theorem_obligations() -> list[Obligation]:
             "valid path, collision-free at every step k >= 0 (no common point of SLarm and "
             "SRarm at the cell held), and the paper's postcondition: P[k] = 0 along it for k < N, "
             "P[N-1] = 0 for N <= k < LENGTH}}: WP of the top level, the search by its contract.")
+    tight = ("{P = Thm3.builtdr_tight's postcondition (tight regions regionL_tight(k) for k < N; "
+             "the rest layer P[N] from regionRest_tight, the principal at rest at its goal, an "
+             "opaque region independent of layer N-1)} searchoptpath {no path reported iff no "
+             "valid path; else the result is an optimal valid path, collision-free at every "
+             "step k >= 0 against regionL_tight(k) for k < N and regionRest_tight from N on, "
+             "with P[k] = 0 along it for k < N and P[N] = 0 for every k >= N}: WP of the top "
+             "level, the search by its contract. The tight variant's search safety.")
     return [
         Obligation("Thm2.searchoptpath", GROUP_THM, "Theorem 2",
                    text.format(n=1, v="original"), Z, P, lambda: _thm("original")),
         Obligation("Thm4.searchoptpath", GROUP_THM, "Theorem 4",
                    text.format(n=3, v="modified"), Z, P, lambda: _thm("modified")),
+        Obligation("Thm4.searchoptpath_tight", GROUP_THM, "Theorem 4, tight variant (DESIGN §4)",
+                   tight, Z, P, lambda: _thm("tight")),
     ]
 
 
@@ -512,8 +542,11 @@ def prop8_obligations() -> list[Obligation]:
                    "the optimal under D (for any costs J1, J2; D''s optimality instantiated at "
                    "D's optimum, named).", Z, P, _prop8_cost),
         Obligation("Prop8.prestrength_thm4", G, "Pre-strength rule, Theorems 2 and 4",
-                   "Theorem 2 holds for an arbitrary region family X under the weaker "
-                   "precondition 'P = 0 implies no intersection' (all its safety needs); Theorem "
+                   "Theorem 2 holds for an arbitrary region family X (motion layers "
+                   "regionL_X(k), and a rest region regionRest_X independent of them, so the "
+                   "generic theorem covers a rest layer of layer N-1 and the tight one alike) "
+                   "under the weaker precondition 'P = 0 implies no intersection' (all its "
+                   "safety needs); Theorem "
                    "4's precondition implies that precondition at X := S'; by the rule "
                    "(P' ⇒ P, {P} C {Q} give {P'} C {Q}) Theorem 4's safety follows. (The paper "
                    "derives it from Property 8, which runs the other way and is not valid.)",

@@ -52,7 +52,7 @@ FIXED_IDS: tuple[str, ...] = (
     "Prop1.state_meaning", "Prop2.endpoints", "Prop3.layer_free", "Prop4.rest_free",
     "Prop5.optpath_is_path", "Prop5.printed", "Prop6.opt_layer_free", "Prop7.opt_rest_free",
     "Def4.is_path_printed", "Def4.is_path_fixed_safe",
-    "Thm2.searchoptpath", "Thm4.searchoptpath",
+    "Thm2.searchoptpath", "Thm4.searchoptpath", "Thm4.searchoptpath_tight",
     "Prop8.printed", "Prop8.intersection_monotone", "Prop8.subset_monotone",
     "Prop8.valid_transfer", "Prop8.path_exists", "Prop8.optimal_cost", "Prop8.prestrength_thm4",
 )

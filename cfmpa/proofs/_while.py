@@ -214,11 +214,11 @@ def _wp_while(c: While, q: z3.BoolRef, g: _Gen) -> z3.BoolRef:
                      _wp(c.body, inv, g), key_premise="invariant", kind=kind))
     if g.termination:
         # The variant is bounded below while the loop runs, and every iteration lowers it; V0
-        # is its value at the start of the iteration. (For a For loop the bound follows from
-        # the guard and from the invariant alike: no single key premise.)
+        # is its value at the start of the iteration. The bound needs the guard: without it a
+        # For loop with hi < lo sits at var = lo > hi, a negative variant.
         v0 = z3.Int(f"{c.label}.V0")
         g.side.append(VC(f"{c.label}.variant_bounded", (("invariant", inv), ("guard", cond)),
-                         c.variant >= 0, kind=kind))
+                         c.variant >= 0, key_premise="guard", kind=kind))
         # Nested loops' side VCs do not depend on the postcondition and were just collected
         # by the preservation VC's wp: compute this one with a scratch collector.
         scratch = _Gen(termination=True)
