@@ -10,9 +10,13 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from . import __version__
 from .errors import CfmpaError, InputError
+
+if TYPE_CHECKING:
+    from .spec import Certificate
 
 __all__ = ["main"]
 
@@ -60,7 +64,12 @@ def cmd_dr(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy and DIR/plan.json."""
+    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy and DIR/plan.json.
+
+    Exit 0 when nothing was violated; 1 when a contract failed or the certificate is not clear
+    (a contact or an undecided interval is a violation in every --contracts mode, off included);
+    the files are written all the same, as the evidence, and the summary says so.
+    """
     from .proofs._plan import plan, write_plan
     from .spec import load_scenario
 
@@ -80,10 +89,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     else:
         print(f"status    {r.status}: {r.reason}")
     if p.certificate is not None:
-        c = p.certificate
-        verdict = "clear" if c.clear else "NOT CLEAR"
-        print(f"clearance {verdict}: min {c.min_clearance_m * 1000:.3f} mm at t={c.t_min_s:.4f} s "
-              f"({c.intervals} intervals)")
+        print(_clearance_line(p.certificate))
     if p.contracts is not None:
         n_bad = len(p.contracts.get("violations", []))
         print(f"contracts {p.contracts.get('mode')}: {p.contracts.get('checked')} checks, "
@@ -92,7 +98,25 @@ def cmd_plan(args: argparse.Namespace) -> int:
     print(f"wrote     {dr_path}, {plan_path}")
     for v in violations:
         print(f"violation {v}", file=sys.stderr)
+    if violations:
+        print(f"result    {len(violations)} violation(s): exit 1; the files above are written as "
+              f"the evidence", file=sys.stderr)
     return 1 if violations else 0
+
+
+def _clearance_line(c: Certificate) -> str:
+    """The certificate in one line: the PROVED lower bound first, then the least sampled distance
+    (an upper bound on the true minimum) and its instant."""
+    sampled = (f"sampled minimum {c.min_clearance_m * 1000:.6g} mm at t={c.t_min_s:.4f} s "
+               f"({c.intervals} intervals)")
+    if c.clear:
+        return f"clearance clear: proved >= {c.lower_bound_m * 1000:.6g} mm at every instant; {sampled}"
+    if c.contact_detail is not None:
+        d = c.contact_detail
+        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, left link {d.links[0]} and "
+                f"right link {d.links[1]}, {d.segment}; {sampled}")
+    return (f"clearance NOT CLEAR: {len(c.undecided)} interval(s) neither proved clear nor in "
+            f"contact, first {c.undecided[0]} s; {sampled}")
 
 
 def cmd_check(args: argparse.Namespace) -> int:

@@ -99,3 +99,36 @@ def test_plan_into_an_unwritable_place_exits_2(tiny_file, tmp_path, capsys):
     blocker.write_text("not a folder")
     assert main(["plan", str(tiny_file), "--out", str(blocker / "x"), "--contracts", "off"]) == 2
     assert "error" in capsys.readouterr().err
+
+
+def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_path, monkeypatch,
+                                                                           capsys):
+    # The early-arrival fault's path waits at its goal while the principal sweeps it: a real
+    # contact. --contracts off waives the triples, not the certificate.
+    import json
+
+    import cfmpa.cli as cli
+    from cfmpa.impl import build_dr_fast
+    from cfmpa.proofs._selftest import FAULTS, WORKCELLS
+
+    fault = next(f for f in FAULTS if "early" in f.name)
+    doc = WORKCELLS[fault.workcell]
+    lines = [f"{k} = {json.dumps(doc[k])}" for k in ("name", "purpose", "dt")]
+    for side in ("left", "right"):
+        lines += [f"[{side}]"] + [f"{k} = {json.dumps(v)}" for k, v in doc[side].items()]
+    toml = tmp_path / "early.toml"
+    toml.write_text("\n".join(lines) + "\n")
+    s = load_scenario(toml)
+    bad = fault.make(s, fault.variant, make_grid(s)).search
+    monkeypatch.setattr(cli, "_kernels", lambda name: (build_dr_fast, bad))
+    for mode in ("off", "sampled"):
+        out = tmp_path / mode
+        assert main(["plan", str(toml), "--variant", fault.variant.value, "--out", str(out),
+                     "--contracts", mode]) == 1
+        text, err = capsys.readouterr()
+        assert "clearance NOT CLEAR: contact at t=" in text and "resting at the last cell" in text
+        assert "violation continuous-time certificate: the arms' link rectangles touch" in err
+        assert "exit 1; the files above are written as the evidence" in err
+        plan_doc = json.loads((out / "plan.json").read_text())
+        assert plan_doc["clearance"]["clear"] is False and (out / "dr.npy").exists()
+        assert plan_doc["contracts"]["violations"][-1]["triple"] == "continuous-time certificate"

@@ -338,7 +338,8 @@ def contracts_json(settings: Settings, runs: Sequence[TripleRun],
     """plan.json's ``contracts``: {mode, checked, seed, sample, violations, triples, ...}.
 
     ``checked`` counts the items examined (cells, path steps, conditions). The certificate is
-    not a triple; ``certificate_enforced`` says whether a contact counted as a violation.
+    not a triple; ``certificate_enforced`` says whether a contact counted as a violation (since
+    a contact is one in every mode, plan() always passes True; the key stays for readers).
     """
     sampled = settings.mode is Mode.SAMPLED
     violations = [violation_json(v) for r in runs for v in r.violations()]

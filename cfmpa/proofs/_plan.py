@@ -1,7 +1,10 @@
 """`cfmpa plan`: BuiltDR, searchoptpath (under contracts) and the certificate, as DESIGN §9's files.
 
 Output is deterministic: the same scenario bytes, variant and version give byte-identical JSON
-apart from the ``timings_s`` object.
+apart from the ``timings_s`` object. A found path whose certificate is not clear (a contact, or
+an interval left undecided) is a violation in every contract mode, ``off`` included: the
+certificate is the safety result, not a contract. Files are written even when there are
+violations (they are the evidence); `cfmpa plan` then exits 1.
 """
 
 from __future__ import annotations
@@ -55,8 +58,7 @@ class PlanResult:
         """Every violation recorded (empty unless the run was asked not to stop at one)."""
         out = [v for r in self.runs for v in r.violations()]
         cert = self.certificate
-        enforced = self.contracts is not None and self.contracts["certificate_enforced"]
-        if enforced and cert is not None and not cert.clear:
+        if cert is not None and not cert.clear:
             out.append(_certificate_violation(cert))
         return out
 
@@ -77,10 +79,10 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
 
     ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
     (``sample`` random cells, ``seed``) or full (see _contracts).
-    Unless off, a certificate that is not clear (a contact, or an interval left undecided) is a
-    violation too. A violation raises ContractViolation; with ``stop=False`` postcondition and
-    certificate violations are recorded in ``contracts`` and the run goes on (a failed
-    precondition always stops it). ``grid``, ``build`` and ``search`` replace the scenario's grid
+    In every mode, off included, a certificate that is not clear (a contact, or an interval left
+    undecided) is a violation. A violation raises ContractViolation; with ``stop=False``
+    postcondition and certificate violations are recorded in ``contracts`` and the run goes on
+    (a failed precondition always stops it). ``grid``, ``build`` and ``search`` replace the scenario's grid
     and the kernels (by default the fast ones, bit-identical to the reference and tested against
     it): for the reference itself, another implementation, or a seeded fault.
     """
@@ -104,11 +106,11 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
         t0 = time.perf_counter()
         cert = certify(s, g, result.path)
         t["certificate"] = time.perf_counter() - t0
-        if enforce and stop:
+        if stop:
             require_clear(cert, name=CERTIFICATE)
     record = contracts_json(settings, runs,
-                            _certificate_violation(cert) if enforce and cert and not cert.clear
-                            else None, certificate_checked=enforce)
+                            _certificate_violation(cert) if cert and not cert.clear else None,
+                            certificate_checked=True)
     return PlanResult(scenario=s, variant=v, grid=g, dr=dr, search=result, certificate=cert,
                       contracts=record, timings_s=t, runs=tuple(runs))
 

@@ -2,7 +2,7 @@
 
 from ._grid import (EPS, Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
                     make_grid, rest_is_goal, right_box)
-from ._certificate import Certificate, certificate_json, certify, require_clear
+from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
 from ._kinematics import arm_corners, joints, link_corners
 from ._paths import (J1, J2, PathViolation, SearchResult, SearchStatus, is_path, is_path_paper,
                      opt_path, path_violations)
@@ -12,7 +12,7 @@ from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightA
 from ._triples import TRIPLES, Triple, builtdr_triple, search_triple
 
 __all__ = [
-    "ANGLE_TOLERANCE", "Certificate", "certificate_json", "certify", "require_clear", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
+    "ANGLE_TOLERANCE", "Certificate", "ContactDetail", "certificate_json", "certify", "require_clear", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
     "Variant", "arm_corners", "exact_n", "joints", "link_corners", "exact_tf", "joint_points", "left_angles", "left_box", "load_scenario",
     "make_grid", "max_cells", "parse_scenario", "polygon_distance", "polygon_distances", "rest_is_goal", "right_box",
     "J1", "J2", "PathViolation", "SearchResult", "SearchStatus", "is_path", "is_path_paper", "opt_path",

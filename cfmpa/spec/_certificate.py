@@ -52,6 +52,7 @@ from ._scenario import Arm, Scenario
 
 __all__ = [
     "Certificate",
+    "ContactDetail",
     "certify",
     "certificate_json",
     "require_clear",
@@ -74,14 +75,35 @@ Contact = tuple[float, tuple[int, int]]
 
 
 @dataclass(frozen=True)
+class ContactDetail:
+    """Where a sampled contact is: the instant, the links, both arms' joint angles then, and the
+    path segment the subordinate was on (``step`` k: moving from cells[0] to cells[1] during
+    [k dt, (k+1) dt]; ``step`` None: resting at its last cell, cells[0] == cells[1])."""
+
+    t_s: float
+    links: tuple[int, int]
+    left_angles_rad: tuple[float, float]
+    right_angles_rad: tuple[float, float]
+    step: int | None
+    cells: tuple[tuple[int, int], tuple[int, int]]
+
+    @property
+    def segment(self) -> str:
+        """``step 4->5`` or ``resting at the last cell (step 7)``, as violations print it."""
+        return "resting at the last cell" if self.step is None else (
+            f"step {self.step}->{self.step + 1}")
+
+
+@dataclass(frozen=True)
 class Certificate:
     """Whether the executed motion is contact-free at every instant, and by how much.
 
     ``clear`` is True only when every interval was proved clear; then ``lower_bound_m`` (> EPS)
-    is a proven lower bound on the distance between the arms over the whole motion, else 0.0.
-    ``min_clearance_m`` / ``t_min_s`` are the least sampled distance and its instant (an upper
-    bound on the true minimum). ``contact`` is (t, (left link, right link)) for a sampled
-    contact; ``undecided`` lists the merged (t0, t1) intervals left unproved at the caps.
+    is THE PROVED figure: a lower bound on the distance between the arms over the whole motion
+    (else 0.0). ``min_clearance_m`` / ``t_min_s`` are only the least SAMPLED distance and its
+    instant: an upper bound on the true minimum, not a guarantee. ``contact`` is
+    (t, (left link, right link)) for a sampled contact, and ``contact_detail`` the same with the
+    angles and path segment; ``undecided`` lists the merged (t0, t1) intervals left unproved.
     """
 
     clear: bool
@@ -93,6 +115,7 @@ class Certificate:
     undecided: tuple[tuple[float, float], ...]
     samples: int
     max_depth_used: int
+    contact_detail: ContactDetail | None = None
 
 
 def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
@@ -122,7 +145,7 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
     depth = np.zeros(len(t0), dtype=np.int64)
     samples = 2 * len(t0)
 
-    best = _Best.of(np.concatenate([t0, t1]), np.concatenate([d0, d1]))
+    best = _Best.of(np.concatenate([t0, t1]), np.concatenate([d0, d1]), np.concatenate([seg, seg]))
     examined = len(t0)
     proved_lb = math.inf
     undecided: list[tuple[FloatArray, FloatArray]] = []
@@ -151,7 +174,7 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
                                                                    depth))
         dm = motion.distances(tm, seg)
         samples += len(tm)
-        best = best.update(tm, dm)
+        best = best.update(tm, dm, seg)
         t0, t1 = np.concatenate([t0, tm]), np.concatenate([tm, t1])
         d0, d1 = np.concatenate([d0, dm]), np.concatenate([dm, d1])
         seg, lip = np.concatenate([seg, seg]), np.concatenate([lip, lip])
@@ -170,14 +193,23 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
         undecided=merged,
         samples=samples,
         max_depth_used=deepest,
+        contact_detail=None if best.contact is None else motion.detail(best.contact,
+                                                                      best.contact_seg),
     )
 
 
 def certificate_json(cert: Certificate) -> dict[str, Any]:
-    """The certificate for plan.json's ``clearance`` (DESIGN §9): ``min_m`` and ``t_s`` first."""
+    """plan.json's ``clearance`` (DESIGN §9). ``min_m`` / ``t_s`` (stable keys) are the least
+    SAMPLED distance and its instant, an upper bound on the true minimum; ``lower_bound_m`` is
+    the PROVED lower bound over every instant (> 1e-9 when ``clear``, else 0.0)."""
     contact = None
     if cert.contact is not None:
         contact = {"t_s": cert.contact[0], "links": list(cert.contact[1])}
+        c = cert.contact_detail
+        if c is not None:
+            contact.update(left_angles_rad=list(c.left_angles_rad),
+                           right_angles_rad=list(c.right_angles_rad), step=c.step,
+                           segment=c.segment, cells=[list(x) for x in c.cells])
     return {
         "min_m": cert.min_clearance_m,
         "t_s": cert.t_min_s,
@@ -197,9 +229,15 @@ def require_clear(cert: Certificate, *, name: str = "continuous-time certificate
         return
     if cert.contact is not None:
         t, (a, b) = cert.contact
+        values: dict[str, Any] = {"t_s": t, "left link": a, "right link": b, "distance_m": 0.0}
+        c = cert.contact_detail
+        if c is not None:
+            values.update({"left angles_rad": list(c.left_angles_rad),
+                           "right angles_rad": list(c.right_angles_rad),
+                           "path segment": c.segment,
+                           "cells": [list(x) for x in c.cells]})
         raise CertificateViolation(name, "the arms' link rectangles touch during the motion",
-                                   {"t_s": t, "left link": a, "right link": b,
-                                    "distance_m": 0.0})
+                                   values)
     first = cert.undecided[0] if cert.undecided else None
     raise CertificateViolation(name, "some time intervals could be neither proved clear nor "
                                "shown in contact", {"undecided intervals": len(cert.undecided),
@@ -226,28 +264,31 @@ def _check_path(path: Sequence[Sequence[int]], grid: Grid) -> IntArray:
 
 @dataclass(frozen=True)
 class _Best:
-    """The least sampled clearance so far, its instant, and the earliest sampled contact."""
+    """The least sampled clearance so far, its instant, and the earliest sampled contact (with
+    the path segment of the interval it was sampled in)."""
 
     d: float
     t: float
     contact: Contact | None
+    contact_seg: int = -1
 
     @staticmethod
-    def of(t: FloatArray, d: FloatArray) -> _Best:
-        return _Best(math.inf, 0.0, None).update(t, d)
+    def of(t: FloatArray, d: FloatArray, seg: IntArray) -> _Best:
+        return _Best(math.inf, 0.0, None).update(t, d, seg)
 
-    def update(self, t: FloatArray, d: FloatArray) -> _Best:
+    def update(self, t: FloatArray, d: FloatArray, seg: IntArray) -> _Best:
         if len(t) == 0:
             return self
         arm = d.min(axis=(1, 2))
         k = int(np.argmin(arm))
-        best = self if self.d <= arm[k] else _Best(float(arm[k]), float(t[k]), self.contact)
+        best = self if self.d <= arm[k] else _Best(float(arm[k]), float(t[k]), self.contact,
+                                                   self.contact_seg)
         touching = np.flatnonzero(arm == 0.0)
         if best.contact is None and len(touching):
             first = touching[np.argmin(t[touching])]
             a, b = np.unravel_index(int(np.argmin(d[first])), (2, 2))
             contact = (float(t[first]), (int(a), int(b)))
-            best = _Best(0.0, contact[0], contact)
+            best = _Best(0.0, contact[0], contact, int(seg[first]))
         return best
 
 
@@ -259,11 +300,12 @@ class _Motion:
     dt: float
     tf: float
     path_angles: FloatArray          # (len, 2)
+    cells: IntArray                  # (len, 2)
 
     @staticmethod
     def of(s: Scenario, g: Grid, cells: IntArray) -> _Motion:
         angles = np.stack([g.lo[0] + cells[:, 0] * g.h[0], g.lo[1] + cells[:, 1] * g.h[1]], axis=1)
-        return _Motion(s, g.dt, float(exact_tf(s)), angles)
+        return _Motion(s, g.dt, float(exact_tf(s)), angles, cells)
 
     def pieces(self) -> tuple[FloatArray, FloatArray, IntArray, npt.NDArray[np.bool_]]:
         """Intervals on which both arms' joint velocities are constant: (t0, t1, seg, moving).
@@ -309,6 +351,22 @@ class _Motion:
         u = np.clip((t - k * self.dt) / self.dt, 0.0, 1.0)[:, None]
         moving = a[k] + u * (a[k + 1] - a[k])
         return np.where(seg[:, None] >= 0, moving, a[-1])
+
+    def detail(self, contact: Contact, seg: int) -> ContactDetail:
+        """The contact with both arms' angles at its instant and the subordinate's segment."""
+        t, links = contact
+        tt, ss = np.array([t]), np.array([seg], dtype=np.int64)
+        left = left_angles(self.scenario, tt)[0]
+        right = self.right_angles(tt, ss)[0]
+        last = len(self.path_angles) - 1
+        k = seg if 0 <= seg < last else None
+        a, b = (seg, seg + 1) if k is not None else (last, last)
+        return ContactDetail(t, links, (float(left[0]), float(left[1])),
+                             (float(right[0]), float(right[1])), k,
+                             (self.cell(a), self.cell(b)))
+
+    def cell(self, k: int) -> tuple[int, int]:
+        return (int(self.cells[k, 0]), int(self.cells[k, 1]))
 
     def distances(self, t: FloatArray, seg: IntArray) -> FloatArray:
         """d[k, a, b]: distance between left link a and right link b at time t[k]."""

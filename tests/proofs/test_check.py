@@ -142,7 +142,7 @@ def test_a_contact_fails_the_certificate(outputs, tmp_path, capsys):
     fault = next(f for f in FAULTS if "early" in f.name)
     (tmp_path / "early.toml").write_text(_toml(WORKCELLS[fault.workcell]))
     s = load_scenario(tmp_path / "early.toml")
-    p = plan(s, fault.variant, contracts="off",
+    p = plan(s, fault.variant, contracts="off", stop=False,
              search=fault.make(s, fault.variant, make_grid(s)).search)
     write_plan(p, tmp_path / "out")
     code = run_check(tmp_path / "early.toml", tmp_path / "out" / "dr.npy",

@@ -34,7 +34,7 @@ def test_off_records_the_mode_and_checks_nothing(s):
     p = plan(s, "modified", contracts="off")
     rec = plan_json(p)["contracts"]
     assert rec == {"mode": "off", "seed": None, "sample": None, "checked": 0, "violations": [],
-                   "triples": [], "certificate_enforced": False}
+                   "triples": [], "certificate_enforced": True}
     assert not any(k.startswith("contracts_") for k in p.timings_s)
 
 
@@ -107,19 +107,27 @@ def test_a_postcondition_violation_stops_the_run_unless_recording(s):
         "violations"] == []
 
 
-def test_a_contact_is_a_violation_unless_contracts_are_off():
+@pytest.mark.parametrize("mode", ["off", "sampled"])
+def test_a_contact_is_a_violation_in_every_mode(mode):
+    # The certificate is the safety result, not a contract: --contracts off does not waive it.
     fault = next(f for f in FAULTS if "early" in f.name)
     s = workcell(fault.workcell)
     m = fault.make(s, fault.variant, make_grid(s))
-    p = plan(s, fault.variant, contracts="sampled", search=m.search, stop=False)
+    p = plan(s, fault.variant, contracts=mode, search=m.search, stop=False)
     assert not p.certificate.clear and p.certificate.contact is not None
-    kinds = [type(v) for v in p.violations]
-    assert CertificateViolation in kinds
+    assert CertificateViolation in [type(v) for v in p.violations]
     rec = plan_json(p)["contracts"]
     assert rec["violations"][-1]["triple"] == CERTIFICATE
-    assert rec["violations"][-1]["values"]["distance_m"] == 0.0
-    off = plan(s, fault.variant, contracts="off", search=m.search)
-    assert not off.certificate.clear and off.violations == []
+    values = rec["violations"][-1]["values"]
+    assert values["distance_m"] == 0.0 and values["path segment"] == "resting at the last cell"
+    assert values["cells"] == [list(p.search.path[-1])] * 2
+    assert len(values["left angles_rad"]) == len(values["right angles_rad"]) == 2
+    if mode == "off":                   # only the certificate: off checks no triple
+        assert [v["triple"] for v in rec["violations"]] == [CERTIFICATE]
+    # stop=True: off raises the contact itself; sampled stops earlier, at post.is_path
+    with pytest.raises(CertificateViolation if mode == "off" else ContractViolation,
+                       match="touch" if mode == "off" else "post.is_path"):
+        plan(s, fault.variant, contracts=mode, search=m.search)
 
 
 def test_another_builder_can_be_run_under_the_contracts(s):

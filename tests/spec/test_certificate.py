@@ -108,6 +108,38 @@ def test_path_through_the_left_arm_has_a_contact():
         require_clear(cert)
 
 
+@pytest.mark.parametrize("left, path", [
+    ({"start": [1.2, 0.3], "goal": [1.9, 0.0]}, [(i, 0) for i in range(159)]),
+    ({"start": [1.9, 0.0], "goal": [1.2, 0.3]}, [(124, 0)] * 3)])
+def test_a_contact_names_both_arms_angles_the_segment_and_the_cells(left, path):
+    # Moving through the left arm, or resting (after a short list) where the left arm arrives.
+    s = scenario(0.02, left, {"start_cell": [0, 0], "goal_cell": [158, 0]})
+    g = make_grid(s)
+    cert = certify(s, g, path)
+    c = cert.contact_detail
+    assert c is not None and (c.t_s, c.links) == cert.contact
+    assert c.left_angles_rad == tuple(float(x) for x in left_angles(s, c.t_s))
+    if c.step is None:                               # resting at the last cell
+        assert c.t_s >= (len(path) - 1) * g.dt and c.cells == (path[-1], path[-1])
+        assert c.right_angles_rad == g.angles(path[-1]) and c.segment == "resting at the last cell"
+    else:
+        assert c.step * g.dt <= c.t_s <= (c.step + 1) * g.dt
+        assert c.cells == (path[c.step], path[c.step + 1])
+        assert c.segment == f"step {c.step}->{c.step + 1}"
+        lo, hi = sorted(g.angles(x)[0] for x in c.cells)
+        assert lo <= c.right_angles_rad[0] <= hi
+    assert (len(path) == 3) == (c.step is None)
+    with pytest.raises(CertificateViolation) as info:
+        require_clear(cert)
+    v = info.value.values
+    assert v["left angles_rad"] == list(c.left_angles_rad)
+    assert v["right angles_rad"] == list(c.right_angles_rad)
+    assert v["path segment"] == c.segment and v["cells"] == [list(x) for x in c.cells]
+    out = certificate_json(cert)["contact"]
+    assert out["step"] == c.step and out["cells"] == [list(x) for x in c.cells]
+    assert json.loads(json.dumps(out)) == out
+
+
 # (c) contact strictly between samples ---------------------------------------------------------
 
 
@@ -255,6 +287,7 @@ def test_certificate_json_shape():
     assert len(out["contact"]["links"]) == 2
     assert json.loads(json.dumps(out)) == out
     clear = certificate_json(certify(s, g, [(0, 1), (0, 1)]))
+    assert {"min_m", "t_s", "lower_bound_m"} <= set(clear)   # DESIGN §9's stable keys, and the proof's
     assert clear["clear"] is True and clear["contact"] is None and clear["undecided"] == []
     assert clear["min_m"] > 0.0 and clear["lower_bound_m"] > 0.0
 
