@@ -1,8 +1,10 @@
 """`make prove`: collect the obligations, discharge them, compare with the last run, report.
 
-The run passes only if every verdict is the expected one and the set of obligation ids equals
-the expected list (the fixed ids below plus three per scenario file found): nothing can be
-dropped silently. Every obligation's query is saved under the output directory with its
+The run passes only if every verdict is the one pinned in EXPECTED_VERDICTS (and agrees with
+``Obligation.expected``) and the set of obligation ids equals the expected list, without
+repeats: the fixed ids below plus three per scenario, by name for the bundled folder's five
+scenarios (so a deleted file is a missing id) and per file found for any other folder (said in
+the report). Nothing can be dropped silently. Every obligation's query is saved under the output directory with its
 sha256, and results.json says which obligations are new, changed or the same since last time.
 """
 
@@ -27,35 +29,76 @@ from ._obl_builtdr import builtdr_obligations
 from ._obl_geometry import geometry_obligations
 from ._obl_margin import margin_obligations
 from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
-from ._obl_scenario import scenario_files, scenario_ids, scenario_obligations
+from ._obl_scenario import CHECKS, scenario_files, scenario_ids, scenario_obligations
 from ._obligation import Method, Obligation, Proof, Verdict, discharge
 
 __all__ = [
+    "BUNDLED_DIR",
+    "BUNDLED_SCENARIOS",
+    "EXPECTED_VERDICTS",
     "FIXED_IDS",
     "ProveRun",
     "collect_obligations",
     "expected_ids",
+    "is_bundled",
+    "pinned_verdict",
     "render_report",
     "run_obligations",
+    "scenarios_note",
     "selected",
 ]
 
-#: The obligations every run must produce, besides three per scenario file. Kept by hand, on
-#: purpose: an obligation that disappears from the code makes the run fail.
-FIXED_IDS: tuple[str, ...] = (
-    "Def1.segment", "Def1.segment_printed", "Def2.is_convex", "Def3.convex_hull",
-    "Lemma1.convex_monotone", "Lemma2.convex_union",
-    "Sep.separating_axis", "Sep.distance_monotone",
-    "Margin.cos_bound", "Margin.arc_chord", "Lemma.sweep_margin", "Margin.naive_hull",
-    "Thm1.builtdr", "Thm1.termination", "Thm3.builtdr", "Thm3.termination",
-    "Thm3.builtdr_tight", "Thm3.termination_tight",
-    "Prop1.state_meaning", "Prop2.endpoints", "Prop3.layer_free", "Prop4.rest_free",
-    "Prop5.optpath_is_path", "Prop5.printed", "Prop6.opt_layer_free", "Prop7.opt_rest_free",
-    "Def4.is_path_printed", "Def4.is_path_fixed_safe",
-    "Thm2.searchoptpath", "Thm4.searchoptpath", "Thm4.searchoptpath_tight",
-    "Prop8.printed", "Prop8.intersection_monotone", "Prop8.subset_monotone",
-    "Prop8.valid_transfer", "Prop8.path_exists", "Prop8.optimal_cost", "Prop8.prestrength_thm4",
-)
+_P, _R = Verdict.PROVED, Verdict.REFUTED_AS_EXPECTED
+
+#: Every fixed obligation id and the verdict it must get: the one place the expectation is
+#: pinned. Kept by hand, on purpose: an obligation that disappears from the code, or whose
+#: ``Obligation.expected`` drifts from this, makes the run fail.
+EXPECTED_VERDICTS: dict[str, Verdict] = {
+    "Def1.segment": _P, "Def1.segment_printed": _R, "Def2.is_convex": _P,
+    "Def3.convex_hull": _P, "Lemma1.convex_monotone": _P, "Lemma2.convex_union": _P,
+    "Sep.separating_axis": _P, "Sep.distance_monotone": _P,
+    "Margin.cos_bound": _P, "Margin.arc_chord": _P, "Lemma.sweep_margin": _P,
+    "Margin.naive_hull": _R,
+    "Thm1.builtdr": _P, "Thm1.termination": _P, "Thm3.builtdr": _P, "Thm3.termination": _P,
+    "Thm3.builtdr_tight": _P, "Thm3.termination_tight": _P,
+    "Prop1.state_meaning": _P, "Prop2.endpoints": _P, "Prop3.layer_free": _P,
+    "Prop4.rest_free": _P, "Prop5.optpath_is_path": _P, "Prop5.printed": _R,
+    "Prop6.opt_layer_free": _P, "Prop7.opt_rest_free": _P,
+    "Def4.is_path_printed": _R, "Def4.is_path_fixed_safe": _P,
+    "Thm2.searchoptpath": _P, "Thm4.searchoptpath": _P, "Thm4.searchoptpath_tight": _P,
+    "Prop8.printed": _R, "Prop8.intersection_monotone": _P, "Prop8.subset_monotone": _P,
+    "Prop8.valid_transfer": _P, "Prop8.path_exists": _P, "Prop8.optimal_cost": _P,
+    "Prop8.prestrength_thm4": _P,
+}
+
+#: The obligations every run must produce, besides the per-scenario ones.
+FIXED_IDS: tuple[str, ...] = tuple(EXPECTED_VERDICTS)
+
+#: The bundled scenario files (stems) of ``BUNDLED_DIR``: their checks are expected by name, so
+#: a deleted file is a missing id, not a quietly shorter run. Every scenario check must prove.
+BUNDLED_SCENARIOS: tuple[str, ...] = ("default", "early-arrival", "limited-joints",
+                                      "narrow-gap", "original-fails")
+BUNDLED_DIR = Path(__file__).resolve().parents[2] / "scenarios"
+
+
+def is_bundled(scenarios_dir: str | Path) -> bool:
+    """Whether ``scenarios_dir`` is the repository's own scenarios folder."""
+    try:
+        return Path(scenarios_dir).resolve() == BUNDLED_DIR.resolve()
+    except OSError:
+        return False
+
+
+def pinned_verdict(ident: str) -> Verdict | None:
+    """The verdict ``ident`` must get: from EXPECTED_VERDICTS, PROVED for a scenario check, None
+    for an id this module does not know (it is then an unexpected id)."""
+    if ident in EXPECTED_VERDICTS:
+        return EXPECTED_VERDICTS[ident]
+    parts = ident.split(".")
+    if len(parts) >= 3 and parts[0] == "Scenario" and parts[-1] in CHECKS:
+        return Verdict.PROVED
+    return None
+
 
 _COLUMNS = ("total", "proved (Z3)", "proved (sympy)", "checked on data", "refuted as expected",
             "unknown", "failed")
@@ -71,8 +114,26 @@ def collect_obligations(scenarios_dir: str | Path = "scenarios",
 
 
 def expected_ids(scenarios_dir: str | Path = "scenarios") -> tuple[str, ...]:
-    """The ids a full run must produce: FIXED_IDS and three per scenario file found."""
-    return FIXED_IDS + tuple(scenario_ids(scenario_files(scenarios_dir)))
+    """The ids a full run must produce: FIXED_IDS, then three per scenario: for the bundled
+    folder the pinned BUNDLED_SCENARIOS (whatever files are there), for any other folder one
+    set per file found in it (``scenarios_note`` says so)."""
+    if is_bundled(scenarios_dir):
+        stems = list(BUNDLED_SCENARIOS)
+    else:
+        stems = [f.stem for f in scenario_files(scenarios_dir)]
+    return FIXED_IDS + tuple(f"Scenario.{s}.{c}" for s in stems for c in CHECKS)
+
+
+def scenarios_note(scenarios_dir: str | Path) -> str:
+    """What the run expects from the scenario folder, in words (printed at the top)."""
+    if is_bundled(scenarios_dir):
+        return (f"scenarios: the bundled folder; expecting {len(CHECKS)} checks for each of "
+                + ", ".join(BUNDLED_SCENARIOS))
+    files = scenario_files(scenarios_dir)
+    return (f"scenarios: {scenarios_dir} is not the bundled folder ({BUNDLED_DIR}); expecting "
+            f"from its {len(files)} file(s) the ids "
+            + (", ".join(f"Scenario.{f.stem}.{{{','.join(CHECKS)}}}" for f in files) or "(none)")
+            + "; the bundled scenarios' checks are not run")
 
 
 def selected(ident: str, only: Iterable[str] | None) -> bool:
@@ -98,16 +159,21 @@ class ProveRun:
     unexpected_ids: tuple[str, ...]    # produced but not expected
     seconds: float
     assumptions: tuple[Assumption, ...] = field(default=ASSUMPTIONS)
+    verdict_mismatch: tuple[str, ...] = ()   # verdict or Obligation.expected != the pinned one
+    duplicate_ids: tuple[str, ...] = ()      # produced more than once
+    scenarios_note: str = ""
 
     @property
     def ok(self) -> bool:
         return (all(p.as_expected for p in self.proofs) and not self.missing_ids
-                and not self.unexpected_ids)
+                and not self.unexpected_ids and not self.verdict_mismatch
+                and not self.duplicate_ids)
 
 
 def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
-                    expected: Sequence[str]) -> ProveRun:
-    """Discharge each obligation, save its query and the results, compare with the last run."""
+                    expected: Sequence[str], *, note: str = "") -> ProveRun:
+    """Discharge each obligation, save its query and the results, compare with the last run;
+    every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     previous = _load_previous(out / "results.json")
@@ -122,10 +188,18 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
         _write_atomic(out / _query_file(p), p.smtlib)
     ids = [p.id for p in proofs]
     exp = list(expected)
+    mismatch = []
+    for p in proofs:
+        pin = pinned_verdict(p.id)
+        if pin is not None and (p.verdict is not pin or p.expected is not pin):
+            mismatch.append(p.id)
+    dups = sorted({i for i in ids if ids.count(i) > 1})
     run = ProveRun(proofs=proofs, obligations=tuple(obligations), changes=changes,
                    removed=tuple(sorted(set(previous) - set(exp) - set(ids))),
                    missing_ids=tuple(i for i in exp if i not in ids),
-                   unexpected_ids=tuple(i for i in ids if i not in exp), seconds=seconds)
+                   unexpected_ids=tuple(i for i in dict.fromkeys(ids) if i not in exp),
+                   seconds=seconds, verdict_mismatch=tuple(mismatch), duplicate_ids=tuple(dups),
+                   scenarios_note=note)
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run
 
@@ -202,6 +276,8 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
         "summary": {g: _counts(ps) for g, ps in _groups(run.proofs).items()},
         "totals": _counts(run.proofs),
         "missing_ids": list(run.missing_ids), "unexpected_ids": list(run.unexpected_ids),
+        "verdict_mismatch": list(run.verdict_mismatch), "duplicate_ids": list(run.duplicate_ids),
+        "scenarios_note": run.scenarios_note,
         "removed_since_last_run": list(run.removed),
         "obligations": entries + carried,
         "assumptions": [{"id": a.id, "what": a.what, "why": a.why, "used_by": a.used_by}
@@ -216,7 +292,8 @@ def render_report(run: ProveRun) -> str:
     groups = _groups(run.proofs)
     width = max([len(g) for g in groups] + [len("Total")])
     heads = [f"{c:>{max(len(c), 5)}}" for c in _COLUMNS]
-    lines = ["Summary of proof obligations", "",
+    lines = ["Summary of proof obligations", ""] + ([run.scenarios_note, ""] if run.scenarios_note
+                                                  else []) + [
              f"{'Group':<{width}}  " + "  ".join(heads),
              "-" * (width + 2 + sum(len(h) + 2 for h in heads))]
 
@@ -229,7 +306,9 @@ def render_report(run: ProveRun) -> str:
     lines += ["", "Obligations", ""]
     idw = max([len(p.id) for p in run.proofs] + [10])
     for p in run.proofs:
-        flag = "" if p.as_expected else f"  << expected {p.expected}"
+        pin = pinned_verdict(p.id)
+        want = pin if pin is not None else p.expected
+        flag = "" if p.as_expected and p.verdict is want else f"  << expected {want}"
         lines.append(f"{p.id:<{idw}}  {p.verdict.value:<20} {p.seconds:7.2f}s  "
                      f"[{run.changes[p.id]}]{flag}")
         if p.verdict in (Verdict.UNKNOWN, Verdict.FAILED) or not p.as_expected:
@@ -245,6 +324,11 @@ def render_report(run: ProveRun) -> str:
     if run.unexpected_ids:
         lines.append("UNEXPECTED obligations (produced, not in the expected list): "
                      + ", ".join(run.unexpected_ids))
+    if run.verdict_mismatch:
+        lines.append("VERDICTS differing from the pinned expectation (EXPECTED_VERDICTS): "
+                     + ", ".join(run.verdict_mismatch))
+    if run.duplicate_ids:
+        lines.append("DUPLICATE obligation ids: " + ", ".join(run.duplicate_ids))
     lines += ["", "Assumptions (not proved)", ""]
     for a in run.assumptions:
         lines += [f"{a.id}: {a.what}", f"    why: {a.why}", f"    used by: {a.used_by}"]

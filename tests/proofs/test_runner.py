@@ -9,6 +9,7 @@ import json
 import shutil
 from pathlib import Path
 
+import pytest
 import z3
 
 from cfmpa.proofs import (ASSUMPTIONS, FIXED_IDS, Verdict, collect_obligations, expected_ids,
@@ -122,3 +123,72 @@ def test_full_run_discharges_everything_as_expected(tmp_path: Path):
     for o in doc["obligations"]:
         assert (tmp_path / o["file"]).is_file()
     assert Verdict(doc["obligations"][0]["verdict"]) is Verdict.PROVED
+
+
+def test_verdicts_are_checked_against_the_pinned_map(tmp_path: Path):
+    # An obligation claiming its own (wrong) expectation passes Obligation.expected, not the pin.
+    from cfmpa.proofs import (EXPECTED_VERDICTS, CheckOutcome, CheckQuery, Method, Obligation,
+                              pinned_verdict)
+    assert EXPECTED_VERDICTS["Margin.cos_bound"] is Verdict.PROVED
+    assert pinned_verdict("Scenario.x.time_grid") is Verdict.PROVED
+    assert pinned_verdict("Ghost.id") is None
+    liar = Obligation("Margin.cos_bound", "g", "ref", "s", Method.SYMPY,
+                      Verdict.REFUTED_AS_EXPECTED,
+                      lambda: CheckQuery(lambda: CheckOutcome(False, "no", "no"), "c"))
+    run = run_obligations([liar], tmp_path, ["Margin.cos_bound"])
+    assert run.proofs[0].as_expected and not run.ok
+    assert run.verdict_mismatch == ("Margin.cos_bound",)
+    assert "VERDICTS differing" in render_report(run)
+
+
+def test_duplicate_ids_fail_the_run(tmp_path: Path):
+    obs = collect_obligations("/nonexistent", ["Def1.segment"])
+    run = run_obligations(list(obs) + list(obs[:1]), tmp_path, [o.id for o in obs])
+    assert not run.ok and run.duplicate_ids == ("Def1.segment",) and not run.unexpected_ids
+    assert "DUPLICATE" in render_report(run)
+
+
+def test_only_that_selects_nothing_is_an_input_error(tmp_path: Path, capsys):
+    from cfmpa.cli import main
+    from cfmpa.errors import InputError
+    with pytest.raises(InputError, match="selects no obligation") as exc:
+        run_prove(out_dir=tmp_path, scenarios_dir=REPO / "scenarios", only=["Nonexistent"],
+                  stream=io.StringIO())
+    assert exc.value.value == "Nonexistent"
+    rc = main(["prove", "--out", str(tmp_path), "--scenarios", str(REPO / "scenarios"),
+               "--only", "Def1.segment", "--only", "Nonexistent"])
+    assert rc == 2 and "'Nonexistent'" in capsys.readouterr().err
+    assert not (tmp_path / "results.json").exists()
+
+
+def test_an_empty_or_missing_scenarios_folder_is_an_input_error(tmp_path: Path):
+    from cfmpa.errors import InputError
+    for d in (tmp_path, tmp_path / "missing"):
+        with pytest.raises(InputError, match="--scenarios"):
+            run_prove(out_dir=tmp_path / "out", scenarios_dir=d, only=["Def1"],
+                      stream=io.StringIO())
+
+
+def test_a_deleted_bundled_scenario_is_a_missing_id(tmp_path: Path, monkeypatch):
+    import cfmpa.proofs._runner as runner
+    from cfmpa.proofs import BUNDLED_SCENARIOS
+    copy = tmp_path / "scenarios"
+    shutil.copytree(REPO / "scenarios", copy)
+    assert sorted(f.stem for f in copy.glob("*.toml")) == sorted(BUNDLED_SCENARIOS)
+    (copy / "narrow-gap.toml").unlink()
+    monkeypatch.setattr(runner, "BUNDLED_DIR", copy)
+    out = io.StringIO()
+    rc = run_prove(out_dir=tmp_path / "out", scenarios_dir=copy,
+                   only=["Scenario.narrow-gap", "Scenario.default.time_grid"], stream=out)
+    assert rc == 1
+    assert "MISSING obligations (expected, not produced): Scenario.narrow-gap.time_grid" in out.getvalue()
+
+
+def test_another_scenarios_folder_says_what_it_expects(tmp_path: Path):
+    shutil.copy(REPO / "scenarios" / "default.toml", tmp_path / "mine.toml")
+    out = io.StringIO()
+    rc = run_prove(out_dir=tmp_path / "out", scenarios_dir=tmp_path,
+                   only=["Scenario.mine.time_grid"], stream=out)
+    assert rc == 0
+    assert (f"scenarios: {tmp_path} is not the bundled folder" in out.getvalue()
+            and "Scenario.mine.{time_grid,cspace_grid,containment}" in out.getvalue())
