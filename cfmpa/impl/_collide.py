@@ -1,7 +1,9 @@
 """The free/blocked decision between convex polygons (DESIGN §4), vectorised over many polygons.
 
-Blocked means Euclidean distance <= eps. The decision is monotone under containment because
-distance is: shrinking either polygon can only increase it. Cheap tests settle most pairs
+Free means Euclidean distance > eps; everything else is blocked, including a NaN anywhere in
+the arithmetic (every test is written "free iff gap > eps", so an undefined gap never frees a
+cell). The decision is monotone under containment because distance is: shrinking either polygon
+can only increase it. Cheap tests settle most pairs
 (bounding boxes, then separating axes, both lower bounds on the distance); only pairs whose
 best separating gap lies in (0, eps] get the exact vertex-edge distance.
 """
@@ -97,20 +99,23 @@ def polygon_distance_batch(a: Polygons, b: Polygons) -> npt.NDArray[np.float64]:
 
 
 def blocked_against(a: Polygon, b: PolygonSet, eps: float) -> BoolArray:
-    """For one polygon ``a`` (V, 2) and many ``b``: distance(a, b[c]) <= eps, per c."""
+    """For one polygon ``a`` (V, 2) and many ``b``: not distance(a, b[c]) > eps, per c.
+
+    Every comparison frees only on ``> eps`` (or ``> 0``), so NaN coordinates give "blocked".
+    """
     blocked = np.zeros(len(b), dtype=bool)
     aset = PolygonSet.of(a[None])
     box_gap = np.maximum(b.lo - aset.hi, aset.lo - b.hi).max(-1)
-    idx = np.flatnonzero(box_gap <= eps)        # a box gap > eps already proves distance > eps
+    idx = np.flatnonzero(~(box_gap > eps))      # a box gap > eps already proves distance > eps
     if len(idx) == 0:
         return blocked
     near = b.take(idx)
     gap = _separation(aset, near)
-    hit = gap <= 0.0                             # no separating axis: they intersect
-    unsure = (gap > 0.0) & (gap <= eps)          # apart, but maybe not by more than eps
+    hit = ~(gap > 0.0)                           # no separating axis: they intersect
+    unsure = (gap > 0.0) & ~(gap > eps)          # apart, but maybe not by more than eps
     if unsure.any():
         u = np.flatnonzero(unsure)
         dist = polygon_distance_batch(np.broadcast_to(a, (len(u),) + a.shape), near.verts[u])
-        hit[u] = dist <= eps
+        hit[u] = ~(dist > eps)
     blocked[idx] = hit
     return blocked

@@ -17,6 +17,10 @@ certain despite rounding, and hands every other pair to the reference's own ``bl
   disc of radius d around it), and symmetrically. The points tried: one that proved the
   previous cell of the row (it lies in A: a vertex of A, or deeper than MARGIN in A), points
   of the links' centre lines checked deeper than MARGIN in both, and the vertices of each;
+- a polygon with a coordinate that is not finite or beyond MAX_COORD (where the kernel's
+  unguarded sqrt and the reference's hypot could differ) has its box packed as NaN, and every
+  pair with it is "unsure"; every comparison that frees or blocks is written so that NaN does
+  neither (free iff gap > eps + MARGIN, blocked iff depth > MARGIN);
 - everything else (gaps within MARGIN of 0 or eps) is "unsure" and goes to ``blocked_against`` on
   the same polygon arrays, whose per-pair arithmetic does not depend on which other pairs share
   the batch (the reference itself runs it on the box-filtered subset).
@@ -44,7 +48,7 @@ from ._builtdr import DR, RightRegions, left_regions, right_regions
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._progress import progress_bar
 
-__all__ = ["MARGIN_REL", "build_dr_fast", "decision_margin"]
+__all__ = ["MARGIN_REL", "MAX_COORD", "build_dr_fast", "decision_margin"]
 
 #: Safety margin around the thresholds 0 and eps, relative to the largest coordinate (at least
 #: 1 m). Rounding differences between two evaluations of one gap are ~1e-15 of the coordinates.
@@ -54,14 +58,25 @@ MARGIN_REL = 1e-12
 #: thread gained nothing, and with numba's OpenMP layer it lost 2.5x to the other processes.
 KERNEL_THREADS = 1
 
+#: Polygons with a coordinate beyond this (metres) are left to the reference: the loader's
+#: physical range keeps every coordinate far below it, so this never costs time in practice.
+MAX_COORD = 1e100
+
 FREE, BLOCKED, UNSURE = 0, 1, 2
 _BLOCKED_AT = 3  # BLOCKED, proved by a common point, returned with it (the next cell tries it)
 _SEPARATED = 4   # FREE, found on axis (code - _SEPARATED): the next cell tries that axis first
 
 
 def decision_margin(*coords: npt.NDArray[np.float64]) -> float:
-    """MARGIN: pairs whose computed gaps are this close to 0 or eps go to the reference routine."""
-    scale = max([1.0] + [float(np.abs(c).max()) for c in coords if c.size])
+    """MARGIN: pairs whose computed gaps are this close to 0 or eps go to the reference routine.
+
+    Scaled by the largest coordinate the kernel decides on (finite, at most MAX_COORD)."""
+    scale = 1.0
+    for c in coords:
+        a = np.abs(c)
+        a = a[a <= MAX_COORD]                  # NaN and the rest go to the reference anyway
+        if a.size:
+            scale = max(scale, float(a.max()))
     return MARGIN_REL * scale
 
 
@@ -160,11 +175,22 @@ def _settle_unsure(pair: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]
 
 @njit(cache=True)
 def _pack(verts):  # pragma: no cover - compiled; PolygonSet.of's formulas, per polygon
-    """geo (C, V, 6) and box (C, 4) of CCW polygons (C, V, 2), see the module docstring."""
+    """geo (C, V, 6) and box (C, 4) of CCW polygons (C, V, 2), see the module docstring.
+
+    A polygon with a coordinate that is NaN, infinite or beyond MAX_COORD gets a NaN box: the
+    kernel then leaves every pair with it to the reference."""
     C, V = verts.shape[0], verts.shape[1]
     geo = np.zeros((C, V, 6))
     box = np.empty((C, 4))
     for c in range(C):
+        sane = True
+        for v in range(V):
+            if not (abs(verts[c, v, 0]) <= MAX_COORD and abs(verts[c, v, 1]) <= MAX_COORD):
+                sane = False
+        if not sane:
+            for e in range(4):
+                box[c, e] = np.nan
+            continue
         box[c, 0], box[c, 1] = verts[c, 0, 0], verts[c, 0, 1]
         box[c, 2], box[c, 3] = verts[c, 0, 0], verts[c, 0, 1]
         for v in range(V):
@@ -232,7 +258,10 @@ def _row(i, ga, boxa, spa, g1, box1, sp1, g2, box2, sp2, row_box, n, eps, margin
 
 @njit(cache=True, forceinline=True)
 def _box_gap(boxa, a, boxb, b):  # pragma: no cover - compiled
-    """The reference's bounding-box gap, in its own float operations (so exactly equal)."""
+    """The reference's bounding-box gap, in its own float operations (so exactly equal); NaN
+    when either box is NaN (a polygon left to the reference, see _pack)."""
+    if boxa[a, 0] != boxa[a, 0] or boxb[b, 0] != boxb[b, 0]:
+        return np.nan
     return max(max(boxb[b, 0] - boxa[a, 2], boxa[a, 0] - boxb[b, 2]),
                max(boxb[b, 1] - boxa[a, 3], boxa[a, 1] - boxb[b, 3]))
 
@@ -242,7 +271,7 @@ def _separates(gp, p, gq, q, e, above):  # pragma: no cover - compiled
     """Whether every vertex of polygon p lies beyond edge line e of polygon q by > ``above``."""
     nx, ny, off = gq[q, e, 2], gq[q, e, 3], gq[q, e, 4]
     for v in range(gp.shape[1]):
-        if gp[p, v, 0] * nx + gp[p, v, 1] * ny - off <= above:
+        if not gp[p, v, 0] * nx + gp[p, v, 1] * ny - off > above:  # NaN: not separated
             return False
     return True
 
@@ -261,8 +290,8 @@ def _overlaps(gp, p, gq, q, e, below):  # pragma: no cover - compiled
 def _deep(x, y, gq, q, d):  # pragma: no cover - compiled
     """Whether (x, y) lies inside every edge line of polygon q by more than d."""
     for e in range(gq.shape[1]):
-        if gq[q, e, 5] != 0.0 and gq[q, e, 2] * x + gq[q, e, 3] * y - gq[q, e, 4] >= -d:
-            return False
+        if gq[q, e, 5] != 0.0 and not gq[q, e, 2] * x + gq[q, e, 3] * y - gq[q, e, 4] < -d:
+            return False  # NaN: not deep
     return True
 
 
@@ -324,8 +353,11 @@ def _pair(ga, boxa, spa, a, gb, boxb, spb, b, eps, margin, hint, have, px, py
     (n.v - offset); rounding is monotone, so "every vertex's term > t" is exactly "gap > t", and
     the scans may stop early.
     """
-    if _box_gap(boxa, a, boxb, b) > eps:
+    box_gap = _box_gap(boxa, a, boxb, b)
+    if box_gap > eps:
         return FREE, 0.0, 0.0
+    if box_gap != box_gap:
+        return UNSURE, 0.0, 0.0               # a polygon _pack left to the reference
     if have and _deep(px, py, gb, b, margin):
         return _BLOCKED_AT, px, py
     free_at = eps + margin

@@ -4,17 +4,26 @@ Construction: sample the box on a lattice of angles anchored at ``anchor`` with 
 (the box rounded outward to the lattice), take the convex hull of the link rectangles at the
 lattice points, each grown by the interpolation margin ``delta`` (see ``sweep_margin``).
 
-Margin lemma (discharged in proofs as ``Lemma.sweep_margin``). Let a configuration theta lie in
-a lattice cell [c1, c1 + g1] x [c2, c2 + g2]. Any point of the link at distance <= R_base from the
+Margin lemma (discharged in proofs as ``Lemma.sweep_margin``; stated for spacings g1, g2 <= 3.14
+rad, which the loader ensures: it refuses omega_q dt > 3.14, and every spacing used is the left
+arm's omega_q dt or the right arm's h_q <= omega_q dt). Let a configuration theta lie in a
+lattice cell [c1, c1 + g1] x [c2, c2 + g2]. Any point of the link at distance <= R_base from the
 base and <= R_elbow from the elbow is within
     delta = g1^2/8 * R_base + g2^2/8 * R_elbow
 of the convex hull of its positions at the cell's four corners. Proof: with theta2 fixed, moving
-theta1 rotates the point about the base through at most g1, so it stays within
-R_base * (1 - cos(g1/2)) <= R_base * g1^2/8 of the chord between its two end positions; each end
-position, moving theta2 with theta1 fixed, rotates about the elbow through at most g2 and stays
-within R_elbow * g2^2/8 of the chord between corner positions; distance to a convex set is convex,
-so the two bounds add. Hence the link rectangle at theta lies in the hull of the corner rectangles
-offset by delta, which the hull of the rectangles grown by delta contains.
+theta1 rotates the point about the base through at most g1 (< pi, so the arc's half-angle is at
+most pi/2), so it stays within R_base * (1 - cos(g1/2)) <= R_base * g1^2/8 of the chord between
+its two end positions; each end position, moving theta2 with theta1 fixed, rotates about the
+elbow through at most g2 and stays within R_elbow * g2^2/8 of the chord between corner
+positions; distance to a convex set is convex, so the two bounds add. Hence the link rectangle
+at theta lies in the hull of the corner rectangles offset by delta, which the hull of the
+rectangles grown by delta contains.
+
+The margin used (``sweep_margin``) adds the snap slack SNAP * (g1 R_base + g2 R_elbow): a box end
+within SNAP * g of a lattice point is rounded onto it, so a configuration may lie up to
+SNAP * g_q beyond the sampled lattice in joint q, which moves any link point by at most
+SNAP * g_q * R_q (a rotation through angle x moves a point at radius R by <= R x). A joint with
+a single lattice point gets only that slack, not its g^2/8 term.
 
 Monotonicity: lattice index ranges are computed by monotone float operations (correctly rounded
 subtraction and division, then floor/ceil), so box A within box B gives lattice(A) within
@@ -48,28 +57,43 @@ Box = tuple[tuple[float, float], tuple[float, float]]
 #: Relative tolerance for snapping a box end onto a lattice point; its cost (SNAP * g * R) is
 #: added to the margin so that snapping never loses soundness.
 SNAP = 1e-9
+#: Above this coordinate magnitude (m) the hull's orientation tests run on scaled points.
+HULL_SCALE_ABOVE = 1e100
 
 
 def convex_hull(points: npt.ArrayLike) -> Polygon:
-    """The convex hull (Andrew's monotone chain), counter-clockwise, collinear points dropped."""
+    """The convex hull (Andrew's monotone chain), counter-clockwise, collinear points dropped.
+
+    Coordinates above HULL_SCALE_ABOVE are scaled by a power of two (exact) for the orientation
+    tests, whose products would otherwise overflow and give a non-convex "hull".
+    """
     pts = np.unique(np.asarray(points, dtype=float).reshape(-1, 2), axis=0)  # sorted by x, y
     if len(pts) <= 2:
         return pts
+    big = float(np.abs(pts).max())
+    if big > HULL_SCALE_ABOVE and np.isfinite(big):
+        scale = 2.0 ** -math.frexp(big)[1]           # exact: the points keep their order
+        return pts[_hull_indices(pts * scale)]
+    return pts[_hull_indices(pts)]
+
+
+def _hull_indices(pts: np.ndarray) -> list[int]:
+    """Indices into sorted, distinct pts of their hull's vertices, counter-clockwise."""
 
     def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
         return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
 
-    lower: list[np.ndarray] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+    lower: list[int] = []
+    for i in range(len(pts)):
+        while len(lower) >= 2 and cross(pts[lower[-2]], pts[lower[-1]], pts[i]) <= 0:
             lower.pop()
-        lower.append(p)
-    upper: list[np.ndarray] = []
-    for p in pts[::-1]:
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+        lower.append(i)
+    upper: list[int] = []
+    for i in range(len(pts) - 1, -1, -1):
+        while len(upper) >= 2 and cross(pts[upper[-2]], pts[upper[-1]], pts[i]) <= 0:
             upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
+        upper.append(i)
+    return lower[:-1] + upper[:-1]
 
 
 def lattice_range(lo: float, hi: float, anchor: float, g: float) -> tuple[int, int]:

@@ -95,3 +95,18 @@ def test_containment_and_nesting_on_random_scenarios(base, start, goal, omega, d
         return
     drs = [build_dr(s, v, g) for v in (Variant.TIGHT, Variant.MODIFIED, Variant.ORIGINAL)]
     assert (drs[0] <= drs[1]).all() and (drs[1] <= drs[2]).all()
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_decision_frees_only_pairs_proved_apart_nan_blocks():
+    from cfmpa.impl._collide import PolygonSet, blocked_against
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    far, near, apart, undefined = sq + [5.0, 0.0], sq + [1.0 + 5e-10, 0.0], sq + [1.0 + 2e-9, 0.0], \
+        sq + [5.0, 0.0]
+    undefined[2, 1] = np.nan
+    got = blocked_against(sq, PolygonSet.of(np.stack([far, near, apart, undefined])), 1e-9)
+    assert got.tolist() == [False, True, False, True]
+    nan_a = sq.copy()
+    nan_a[0, 0] = np.nan
+    assert blocked_against(nan_a, PolygonSet.of(far[None]), 1e-9).tolist() == [True]

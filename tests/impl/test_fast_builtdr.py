@@ -184,3 +184,48 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     assert timing <= set(res["plan"]["fast_process_sampled"])
     assert all({"target", "limit", "measured", "met"} <= set(t) for t in res["targets"])
     assert "targets:" in proc.stdout and "results.json" in proc.stdout
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")   # inf - inf in the reference's normals
+@pytest.mark.parametrize("poison", ["nan", "inf", "huge"])
+def test_polygons_the_kernel_cannot_decide_go_to_the_reference(poison):
+    # A NaN or infinite vertex, or a polygon far beyond MAX_COORD, is left to blocked_against:
+    # identical output, and a NaN vertex blocks its cell in every layer (an infinite one need
+    # not: its bounding box can still prove the pair apart).
+    from cfmpa.impl._builtdr import RightRegions
+
+    s = factory.scenario()
+    g = make_grid(s)
+    rr = right_regions(s, g)
+    link1, link2 = rr.link1.copy(), rr.link2.copy()
+    if poison == "huge":
+        link2[3, 5] *= 1e150
+        link1[7] *= 1e150
+    else:
+        bad = math.nan if poison == "nan" else math.inf
+        link2[3, 5, 0, 0] = bad
+        link1[7, 2, 1] = bad
+    poisoned = RightRegions(link1=link1, link2=link2)
+    for variant in Variant:
+        ref = build_dr(s, variant, g, right=poisoned)
+        fast = build_dr_fast(s, variant, g, right=poisoned)
+        assert np.array_equal(ref, fast)
+        if poison == "nan":
+            assert ref[:, 3, 5].all() and ref[:, 7, :].all()
+            assert not ref.all()
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@pytest.mark.parametrize("field, value", [("width", 1e160), ("width", 1e308),
+                                          ("links", (1e200, 0.3))])
+def test_absurd_magnitudes_past_the_loader_block_every_cell_in_both_kernels(field, value):
+    # The loader refuses these; built anyway, the arm covers the workcell: all blocked.
+    import dataclasses
+
+    s0 = factory.scenario()
+    s = dataclasses.replace(s0, left=dataclasses.replace(s0.left, **{field: value}))
+    g = make_grid(s)
+    for variant in (Variant.ORIGINAL, Variant.TIGHT):
+        ref = build_dr(s, variant, g)
+        assert ref.all()
+        assert np.array_equal(build_dr_fast(s, variant, g), ref)

@@ -87,3 +87,13 @@ def test_naive_hull_search_finds_a_protrusion_that_grows_with_the_box():
                          for a in ts for b in ts))
     assert 0 < worst[0] < worst[1]
     assert worst[1] > 5e-3  # millimetres at a 0.3 rad sweep
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e160, 1e300])
+def test_convex_hull_stays_convex_at_huge_coordinates(scale):
+    # Orientation products of 1e160 coordinates overflow; the hull scales them exactly first.
+    from cfmpa.impl import convex_hull
+
+    pts = np.array([[0.0, 0.0], [1.0, 0.2], [0.5, 0.5], [1.2, 1.0], [-0.1, 0.9], [0.4, 0.1]])
+    hull = convex_hull(pts * scale)
+    assert (hull / scale).tolist() == [[-0.1, 0.9], [0.0, 0.0], [1.0, 0.2], [1.2, 1.0]]
