@@ -25,6 +25,7 @@ from ..errors import MISSING, ContractViolation, InputError
 from ..spec import Grid, Scenario, Variant, load_scenario, make_grid
 from ..spec._certificate import certify, require_clear
 from ..spec._paths import SearchResult, SearchStatus
+from ..spec._triples import cost_failures, search_triple
 from ._contracts import Mode, Settings, TripleRun, builtdr_post, search_post, search_pre
 from ._plan import CERTIFICATE
 
@@ -192,8 +193,16 @@ def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc) -> CheckRepor
         lines += _run_lines(search_pre(doc.variant, g, dr, start, goal, post))
         lines += _run_lines(search_post(doc.variant, dr, start, goal, r, full))
     else:
-        lines.append(CheckLine("skip", "the path (is_path, J1, J2, optimality): D_R has the "
-                               "wrong shape"))
+        # J1 and J2 are the path's alone: a bad D_R does not excuse misreported costs.
+        costs = cost_failures(r)
+        what = f"{search_triple(doc.variant).name} post.costs"
+        if r.status is not SearchStatus.FOUND:
+            lines.append(CheckLine("ok", f"{what}: nothing to check: no path reported"))
+        elif not costs:
+            lines.append(CheckLine("ok", f"{what}: J1 and J2 recomputed"))
+        else:
+            lines += [CheckLine("FAIL", f"{what}: {f.message}", f.values) for f in costs]
+        lines.append(CheckLine("skip", "the path (is_path, optimality): D_R has the wrong shape"))
     found = r.status is SearchStatus.FOUND
     if found and doc.angles is not None:
         lines.append(_angles_line(g, r.path, doc.angles))

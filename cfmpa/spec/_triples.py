@@ -43,6 +43,7 @@ __all__ = [
     "dr_shape_failures",
     "dr_cell_failures",
     "path_cells",
+    "cost_failures",
     "search_failures",
 ]
 
@@ -326,15 +327,30 @@ def path_cells(path: Sequence[Sequence[int]], N: int) -> npt.NDArray[np.int64]:
     return np.unique(out, axis=0)
 
 
+def cost_failures(result: SearchResult) -> list[Failure]:
+    """post.costs: a found path's reported J1 and J2 are J1(L) and J2(L) (needs no D_R)."""
+    if result.status is not SearchStatus.FOUND:
+        return []
+    path = list(result.path)
+    costs = [J1(path), J2(path)]
+    if [result.J1, result.J2] == costs:
+        return []
+    return [Failure("post.costs", "the reported costs are not the path's",
+                    (("reported J1, J2", [result.J1, result.J2]), ("recomputed J1, J2", costs)))]
+
+
 def search_failures(dr: npt.NDArray[np.integer], start: Sequence[int], goal: Sequence[int],
                     result: SearchResult, optimum: SearchResult | None = None) -> list[Failure]:
     """post.is_path, post.costs and (when ``optimum`` is given) post.optimal.
 
-    ``optimum`` is an independent search's answer over the same D_R. Reasons for "no path" are
-    not compared (only that no path exists): another planner may word them differently.
+    ``optimum`` is an independent search's answer over the same D_R. post.optimal judges the
+    path's own (J1, J2), recomputed, never the reported numbers: a misreported cost is
+    post.costs's failure alone. Reasons for "no path" are not compared (only that no path
+    exists): another planner may word them differently.
     """
     out: list[Failure] = []
     found = result.status is SearchStatus.FOUND
+    costs: tuple[int, int] | None = None
     if found:
         path = list(result.path)
         bad = path_violations(path, dr, tuple(start), tuple(goal))
@@ -345,17 +361,14 @@ def search_failures(dr: npt.NDArray[np.integer], start: Sequence[int], goal: Seq
                 ("cell", None if v.cell is None else list(v.cell)), ("layer", v.layer))
                 if value is not None)
             out.append(Failure("post.is_path", v.message, values, count=len(bad)))
-        j1, j2 = J1(path), J2(path)
-        if (result.J1, result.J2) != (j1, j2):
-            out.append(Failure("post.costs", "the reported costs are not the path's",
-                               (("reported J1, J2", [result.J1, result.J2]),
-                                ("recomputed J1, J2", [j1, j2]))))
+        costs = (J1(path), J2(path))
+        out += cost_failures(result)
     if optimum is None:
         return out
     if optimum.status is not result.status:
-        if found:
+        if costs is not None:
             msg = "a path is reported where no valid path exists"
-            values = (("reported J1, J2", [result.J1, result.J2]),
+            values = (("path's J1, J2", list(costs)),
                       ("independent search", f"no path ({optimum.reason})"))
         else:
             msg = "no path is reported but a valid path exists"
@@ -363,13 +376,12 @@ def search_failures(dr: npt.NDArray[np.integer], start: Sequence[int], goal: Seq
                       ("optimal J1, J2", [optimum.J1, optimum.J2]),
                       ("optimal path starts", [list(c) for c in optimum.path[:5]]))
         out.append(Failure("post.optimal", msg, values))
-    elif found and (result.J1, result.J2) != (optimum.J1, optimum.J2):
-        below = (result.J1, result.J2) < (optimum.J1, optimum.J2)
-        out.append(Failure("post.optimal", "the reported (J1, J2) is below the least over valid "
+    elif costs is not None and costs != (optimum.J1, optimum.J2):
+        below = costs < (optimum.J1, optimum.J2)
+        out.append(Failure("post.optimal", "the path's (J1, J2) is below the least over valid "
                            "paths (so the path is not valid)" if below else
-                           "the reported (J1, J2) is not the least",
-                           (("reported J1, J2", [result.J1, result.J2]),
+                           "the path's (J1, J2) is not the least",
+                           (("path's J1, J2 (recomputed)", list(costs)),
                             ("optimal J1, J2", [optimum.J1, optimum.J2]),
                             ("optimal path length", len(optimum.path)))))
     return out
-

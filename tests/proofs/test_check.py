@@ -82,6 +82,18 @@ def test_the_wrong_dtype_fails_the_shape_check_and_skips_the_path(outputs, tmp_p
     assert "FAIL  Theorem 3 post.shape: D_R has the wrong shape or element type" in out
     assert "dtype was 'int64'" in out
     assert "skip  Theorem 3 post.cells" in out and "skip  the path" in out
+    assert "ok    Theorem 4 post.costs: J1 and J2 recomputed" in out
+
+
+def test_costs_are_checked_even_when_dr_has_the_wrong_shape(outputs, tmp_path, capsys):
+    dr = np.load(outputs / "ref" / "dr.npy")[:-1]           # the rest layer missing
+    doc = _plan_doc(outputs)
+    doc["J2"] += 3
+    code, out, _ = _run(outputs, tmp_path, capsys, dr=dr, doc=doc)
+    assert code == 1
+    assert _fails(out) == ["FAIL  Theorem 3 post.shape", "FAIL  Theorem 4 post.costs"]
+    assert f"reported J1, J2 was {[doc['J1'], doc['J2']]}" in out
+    assert f"recomputed J1, J2 was {[doc['J1'], doc['J2'] - 3]}" in out
 
 
 def test_the_dr_of_another_variant_fails_the_stated_variant(outputs, tmp_path, capsys):
@@ -97,6 +109,9 @@ def test_misreported_costs_and_a_jump_fail_their_checks(outputs, tmp_path, capsy
     doc["J1"] += 1
     code, out, _ = _run(outputs, tmp_path, capsys, doc=doc)
     assert code == 1 and "FAIL  Theorem 4 post.costs" in out and "reported J1, J2 was" in out
+    # the path itself is the optimum: optimality judges the path, not the misreported number
+    assert _fails(out) == ["FAIL  Theorem 4 post.costs"]
+    assert "ok    Theorem 4 post.optimal" in out
     doc = _plan_doc(outputs)
     del doc["path"][5], doc["angles"][5]
     doc["J1"], doc["J2"] = J1(doc["path"]), J2(doc["path"])
@@ -118,6 +133,31 @@ def test_a_valid_but_worse_path_fails_optimality_only(outputs, tmp_path, capsys)
     assert code == 1
     assert [x.split(":")[0] for x in out.splitlines() if x.startswith("FAIL")] == [
         "FAIL  Theorem 4 post.optimal"]
+
+
+def test_a_worse_path_reported_with_the_optimal_costs_fails_costs_and_optimality(
+        outputs, tmp_path, capsys):
+    # The numbers claimed are the optimum's: only recomputing the path's own costs shows that
+    # the path is not the least.
+    s = load_scenario(outputs / "small.toml")
+    fault = next(f for f in FAULTS if f.name == "non-optimal path")
+    dr = np.load(outputs / "ref" / "dr.npy")
+    worse = fault.make(s, fault.variant, make_grid(s)).search(dr, s.right.start_cell,
+                                                              s.right.goal_cell)
+    doc = _plan_doc(outputs)
+    best = [doc["J1"], doc["J2"]]
+    doc.update(path=[list(c) for c in worse.path])
+    doc.pop("angles")
+    code, out, _ = _run(outputs, tmp_path, capsys, doc=doc)
+    assert code == 1
+    assert _fails(out) == ["FAIL  Theorem 4 post.costs", "FAIL  Theorem 4 post.optimal"]
+    assert "the path's (J1, J2) is not the least" in out
+    assert f"path's J1, J2 (recomputed) was {[worse.J1, worse.J2]}" in out
+    assert f"optimal J1, J2 was {best}" in out
+
+
+def _fails(out: str) -> list[str]:
+    return [x.split(":")[0] for x in out.splitlines() if x.startswith("FAIL")]
 
 
 def test_claiming_no_path_when_one_exists_fails(outputs, tmp_path, capsys):
