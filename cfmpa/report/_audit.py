@@ -15,7 +15,7 @@ given, else a fresh run).
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -34,12 +34,14 @@ from ._findings import (Finding, early_arrival_finding, inconsistency_finding, n
 from ._obligations import ProofData, load_proofs, load_selftest, summary_table
 from ._provenance import provenance
 
-__all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "render_html", "run_audit",
-           "write_report", "default_scenarios_dir"]
+__all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
+           "render_html", "run_audit", "write_report", "default_scenarios_dir"]
 
 #: report.json's format name and version (bump the version when a key changes meaning).
 FORMAT = {"name": "cfmpa-audit-report", "version": 1}
 DEFAULT_COMPARE_N = 100
+#: plan.json keys a variant's entry copies when the plan has them (the schema allows them).
+_OPTIONAL_PLAN_KEYS = ("kernel", "dr_sha256")
 #: The scenarios the findings are shown on (file stems under the scenarios folder).
 FINDING_SCENARIOS = {"naive_hull": "default", "inconsistency": "original-fails",
                      "prop8_literal": "original-fails", "is_path_flaw": "early-arrival"}
@@ -62,17 +64,18 @@ def default_scenarios_dir() -> Path:
 def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | None = None,
               proofs_json: str | None = None, scenarios_dir: str | None = None,
               contracts: str = "sampled", compare_n: int = DEFAULT_COMPARE_N,
-              compare_seed: int = 0) -> int:
+              compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> int:
     """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
 
     ``scenarios``: scenario files (None: every scenarios/*.toml). ``proofs_json``: a results.json
     of ``make prove`` to report (None: run the obligations afresh). Exit code 0 when everything
     the report checks holds (see the report's first table), 1 otherwise (the report is written
-    either way), 2 for bad input.
+    either way), 2 for bad input. ``expected_ids``: the obligation ids the report must find
+    (None: every obligation of the prove machinery).
     """
     result = build_audit(scenarios, argv=argv, proofs_json=proofs_json,
                          scenarios_dir=scenarios_dir, contracts=contracts, compare_n=compare_n,
-                         compare_seed=compare_seed)
+                         compare_seed=compare_seed, expected_ids=expected_ids)
     html_path, json_path = write_report(result, out_dir)
     v = result.doc["verdict"]
     for item in v["items"]:
@@ -93,7 +96,7 @@ def write_report(result: AuditResult, out_dir: str | Path) -> tuple[Path, Path]:
 def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None = None,
                 proofs_json: str | None = None, scenarios_dir: str | None = None,
                 contracts: str = "sampled", compare_n: int = DEFAULT_COMPARE_N,
-                compare_seed: int = 0) -> AuditResult:
+                compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> AuditResult:
     """Compute everything the report shows (no files written)."""
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
     paths = _scenario_paths(scenarios, sdir)
@@ -103,7 +106,7 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     plans = _Plans(contracts)
     figures: dict[str, F.Figure] = {}
 
-    proofs = load_proofs(proofs_json, sdir)
+    proofs = load_proofs(proofs_json, sdir, expected_ids)
     doc = {
         "format": FORMAT,
         "provenance": provenance(argv, loaded),
@@ -232,22 +235,18 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
             variants.append({"variant": v.value, "status": "contract_violation",
                              "reason": str(p), "J1": None, "J2": None, "path_length": 0,
                              "path": [], "free_fraction": None, "clearance": None,
-                             "contracts": {"violations": [str(p)]}, "timings_s": {}})
+                             "contracts": {"violations": [str(p)]}, "timings_s": {},
+                             **{k: None for k in _OPTIONAL_PLAN_KEYS}})
             continue
         j = plan_json(p)
-        variants.append({k: j[k] for k in ("variant", "status", "reason", "J1", "J2",
-                                            "path_length", "path", "free_fraction", "clearance",
-                                            "contracts", "timings_s")})
-    checks: dict[tuple[str, str, str], dict[str, Any]] = {}
-    for v, p in ok.items():                # condition x variant: how many items, whether all held
-        for tr in (p.contracts or {}).get("triples", []):
-            command = tr["title"].split(",")[0].split(" over")[0]   # BuiltDR | searchoptpath
-            for c in tr["checks"]:
-                row = checks.setdefault((command, c["part"], c["condition"]), {
-                    "command": command, "part": c["part"], "condition": c["condition"],
-                    "scope": c["scope"], "variants": {}})
-                row["variants"][v.value] = {"triple": tr["name"], "count": c["count"],
-                                            "ok": c["ok"], "scope": c["scope"]}
+        entry_v = {k: j[k] for k in ("variant", "status", "reason", "J1", "J2", "path_length",
+                                     "path", "free_fraction", "clearance", "contracts",
+                                     "timings_s")}
+        # Keys plan.json may carry (added, never renamed): null when this version has none, so
+        # report.json keeps one key set.
+        entry_v.update({k: j.get(k) for k in _OPTIONAL_PLAN_KEYS})
+        variants.append(entry_v)
+    checks = contract_rows({v.value: p.contracts for v, p in ok.items()})
     any_plan = next(iter(ok.values()), None)
     grid = any_plan.grid.as_json() if any_plan is not None else None
     entry: dict[str, Any] = {
@@ -255,12 +254,62 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
         "parameters": {"dt": s.dt, "left": _arm_json(s.left), "right": _arm_json(s.right)},
         "grid": None if grid is None else {
             **grid, "cells": (grid["N"] + 1) * grid["m"] * grid["n"]},
-        "variants": variants, "contract_checks": list(checks.values()), "figures": [],
+        "variants": variants, "contract_checks": checks, "figures": [],
     }
     if any_plan is None:
         return entry
     entry["figures"] = _scenario_figures(s, ok, figures)
     return entry
+
+
+def contract_rows(records: Mapping[str, Mapping[str, Any] | None]) -> list[dict[str, Any]]:
+    """The per-condition contract table: one row per (command, part, condition), one cell per
+    variant; ``records`` maps a variant to its plan's ``contracts`` record (or None).
+
+    A condition checked by several records (BuiltDR's post.cells: the random sample, then the
+    path's cells) is one cell whose counts add up and whose ``ok`` is False if any record failed,
+    None if none was checked, else True; ``records`` keeps each record and ``state`` says what
+    the report shows: held, FAILED, not checked, n/a (nothing to check) or delegated.
+    """
+    rows: dict[tuple[str, str, str], dict[str, Any]] = {}
+    for variant, rec in records.items():
+        for tr in (rec or {}).get("triples", []):
+            command = str(tr["title"]).split(",")[0].split(" over")[0]   # BuiltDR | searchoptpath
+            for c in tr["checks"]:
+                row = rows.setdefault((command, c["part"], c["condition"]), {
+                    "command": command, "part": c["part"], "condition": c["condition"],
+                    "scope": None, "variants": {}})
+                cell = row["variants"].setdefault(variant, {"triple": tr["name"], "records": []})
+                cell["records"].append({"count": int(c["count"]), "ok": c["ok"],
+                                        "scope": str(c["scope"])})
+    out = []
+    for row in rows.values():
+        for cell in row["variants"].values():
+            cell.update(_aggregate(cell["records"]))
+        first = next(iter(row["variants"].values()))
+        row["scope"] = first["scope"]
+        # Key order as report.json prints it: the row's fields, then its cells.
+        out.append({k: row[k] for k in ("command", "part", "condition", "scope", "variants")})
+    return out
+
+
+def _aggregate(recs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    oks = [r["ok"] for r in recs]
+    count = sum(r["count"] for r in recs)
+    ok = False if False in oks else (None if all(o is None for o in oks) else True)
+    if ok is False:
+        state = "failed"
+    elif ok is None:
+        state = "not checked"
+    elif count == 0:
+        # Nothing examined here: either another check stands for it (pre.dr.spec is BuiltDR's
+        # post.cells) or there was nothing to examine (no path): never a green "0 held".
+        checked = [r for r in recs if r["ok"] is not None]
+        state = "delegated" if all(r["scope"].startswith("by ") for r in checked) else "n/a"
+    else:
+        state = "held"
+    return {"count": count, "ok": ok, "state": state,
+            "scope": "; ".join(r["scope"] for r in recs)}
 
 
 def _triples(plans: _Plans) -> list[dict[str, str]]:

@@ -5,14 +5,16 @@ Where the obligations come from (decided here, printed in the report):
   read from that file, so the report shows exactly the run that ``make prove`` printed;
 - otherwise a fresh run of the prove machinery (``cfmpa.proofs.collect_obligations``, each
   obligation discharged in this process by ``discharge``; nothing is written under build/proofs).
-Either way the ids are checked against ``cfmpa.proofs.expected_ids``: none missing, none extra.
+Either way the ids are checked here against ``cfmpa.proofs.expected_ids`` (or the list the caller
+gives): none missing, none extra, none twice; what a results.json says of its own ids is not taken
+on trust.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,6 +25,7 @@ __all__ = [
     "ObligationRow",
     "ProofData",
     "SUMMARY_COLUMNS",
+    "check_ids",
     "load_proofs",
     "summary_table",
     "load_selftest",
@@ -85,11 +88,35 @@ class ProofData:
     unexpected_ids: tuple[str, ...] = ()   # in the data, not expected
 
 
-def load_proofs(proofs_json: str | None, scenarios_dir: str | Path) -> ProofData:
-    """Obligations and ledger from ``proofs_json``, else from a fresh run (module docstring)."""
+def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
+                expected: Sequence[str] | None = None) -> ProofData:
+    """Obligations and ledger from ``proofs_json``, else from a fresh run (module docstring).
+
+    ``expected``: the ids the data must hold (None: ``expected_ids(scenarios_dir)``, every
+    obligation; a prove run restricted with ``--only`` is then reported with ids missing).
+    """
+    from ..proofs import expected_ids
+
+    want = tuple(expected) if expected is not None else expected_ids(Path(scenarios_dir))
     if proofs_json is not None:
-        return _from_file(Path(proofs_json))
-    return _fresh(Path(scenarios_dir))
+        return _from_file(Path(proofs_json), want)
+    return _fresh(Path(scenarios_dir), want)
+
+
+def check_ids(ids: Sequence[str], expected: Sequence[str]) -> tuple[tuple[str, ...],
+                                                                     tuple[str, ...]]:
+    """(missing, unexpected): expected ids absent from ``ids``, and ids not expected or repeated
+    (a repeated id is listed as ``"<id> (twice)"``, or the count)."""
+    have = set(ids)
+    want = set(expected)
+    missing = tuple(i for i in expected if i not in have)
+    seen: dict[str, int] = {}
+    for i in ids:
+        seen[i] = seen.get(i, 0) + 1
+    unexpected = tuple(i for i in seen if i not in want)
+    repeated = tuple(f"{i} ({'twice' if n == 2 else f'{n} times'})" for i, n in seen.items()
+                     if n > 1)
+    return missing, unexpected + repeated
 
 
 def summary_table(rows: Iterable[ObligationRow]) -> dict[str, Any]:
@@ -123,7 +150,7 @@ def _column(r: ObligationRow) -> str:
 
 # --- from results.json ------------------------------------------------------------------------
 
-def _from_file(path: Path) -> ProofData:
+def _from_file(path: Path, expected: Sequence[str]) -> ProofData:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
@@ -138,11 +165,11 @@ def _from_file(path: Path) -> ProofData:
     rows = tuple(_row_from_json(item, k, path) for k, item in enumerate(items))
     ledger_doc = doc.get("assumptions")
     ledger = _ledger_entries(ledger_doc) if isinstance(ledger_doc, list) else ()
+    missing, unexpected = check_ids([r.id for r in rows], expected)
     return ProofData(available=True, source=f"read from {path}",
                      note="the results the prove run recorded, not re-run for this report",
                      rows=rows, ledger=ledger, ledger_available=isinstance(ledger_doc, list),
-                     missing_ids=tuple(doc.get("missing_ids") or ()),
-                     unexpected_ids=tuple(doc.get("unexpected_ids") or ()))
+                     missing_ids=missing, unexpected_ids=unexpected)
 
 
 def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
@@ -165,8 +192,8 @@ def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
 
 # --- a fresh run --------------------------------------------------------------------------------
 
-def _fresh(scenarios_dir: Path) -> ProofData:
-    from ..proofs import ASSUMPTIONS, collect_obligations, discharge, expected_ids
+def _fresh(scenarios_dir: Path, expected: Sequence[str]) -> ProofData:
+    from ..proofs import ASSUMPTIONS, collect_obligations, discharge
 
     rows = []
     for ob in collect_obligations(scenarios_dir):
@@ -176,15 +203,13 @@ def _fresh(scenarios_dir: Path) -> ProofData:
             method=p.method.value, verdict=p.verdict.value, expected=p.expected.value,
             seconds=float(p.seconds), counterexample=p.counterexample, reason=p.reason,
             sha256=p.sha256))
-    ids = [r.id for r in rows]
-    expected = expected_ids(scenarios_dir)
+    missing, unexpected = check_ids([r.id for r in rows], expected)
     return ProofData(available=True, source="a fresh run of the prove machinery for this report",
                      note=f"{len(rows)} obligations discharged in this process, "
                      f"{sum(r.seconds or 0.0 for r in rows):.1f} s in all; nothing written under "
                      "build/proofs",
                      rows=tuple(rows), ledger=_ledger_entries(ASSUMPTIONS), ledger_available=True,
-                     missing_ids=tuple(i for i in expected if i not in ids),
-                     unexpected_ids=tuple(i for i in ids if i not in expected))
+                     missing_ids=missing, unexpected_ids=unexpected)
 
 
 def _ledger_entries(entries: Iterable[Any]) -> tuple[dict[str, str], ...]:

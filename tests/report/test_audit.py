@@ -32,9 +32,10 @@ from markupsafe import escape
 
 from cfmpa._io import dumps_json
 from cfmpa.errors import InputError
-from cfmpa.proofs import run_prove
+from cfmpa.proofs import expected_ids, run_prove
+from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
-from cfmpa.report._audit import _proof_sections, _verdict
+from cfmpa.report._audit import _proof_sections, _verdict, contract_rows
 from cfmpa.report._obligations import load_proofs
 from cfmpa.report._provenance import git_state
 
@@ -44,6 +45,8 @@ SCHEMA = ROOT / "cfmpa" / "report" / "schema.json"
 CHROMIUM = Path("/usr/bin/chromium")
 #: A subset of obligations that discharges in a few seconds, across several groups and verdicts.
 OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival"]
+#: The ids that subset must produce, picked the way `cfmpa prove --only` picks them.
+EXPECTED = [i for i in expected_ids(ROOT / "scenarios") if selected(i, OBLIGATIONS)]
 
 
 @pytest.fixture(scope="module")
@@ -71,7 +74,7 @@ def report(tiny_file, results_json, tmp_path_factory):
     out = tmp_path_factory.mktemp("audit")
     argv = ["cfmpa", "audit", str(tiny_file), "--out", str(out)]
     result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
-                         compare_n=4, compare_seed=3)
+                         compare_n=4, compare_seed=3, expected_ids=EXPECTED)
     write_report(result, out)
     doc = json.loads((out / "report.json").read_text())
     html = (out / "report.html").read_text()
@@ -190,6 +193,77 @@ def test_scenario_section_reports_each_variant(report):
                                                                 "clearance"}
 
 
+def _record(*checks):
+    """A contracts record of one BuiltDR and one searchoptpath triple with the given checks."""
+    def check(part, condition, scope, count, ok):
+        return {"part": part, "condition": condition, "scope": scope, "count": count, "ok": ok}
+    built = [check(*c) for c in checks if c[1].startswith("post.cells")]
+    search = [check(*c) for c in checks if not c[1].startswith("post.cells")]
+    return {"triples": [
+        {"name": "Theorem 3", "title": "BuiltDR over the modified box", "checks": built},
+        {"name": "Theorem 4", "title": "searchoptpath, modified", "checks": search}]}
+
+
+def test_contract_table_shows_a_failed_first_record_as_failed():
+    # BuiltDR's post.cells is recorded twice: the random sample, then the path's cells. A failed
+    # sample with held path cells must not read "held".
+    rec = _record(("post", "post.cells", "4096 random cells of 9000 (seed 0)", 4096, False),
+                  ("post", "post.cells", "the 13 cells the path occupies", 13, True),
+                  ("pre", "pre.dr.spec", "by Theorem 3's post.cells check: 4096 random", 0, False),
+                  ("post", "post.is_path", "0 cells, 0 step checks", 0, True),
+                  ("post", "post.optimal", "not checked in sampled mode", 0, None))
+    held = _record(("post", "post.cells", "4096 random cells of 9000 (seed 0)", 4096, True),
+                   ("post", "post.cells", "the 13 cells the path occupies", 13, True),
+                   ("pre", "pre.dr.spec", "by Theorem 3's post.cells check: 4096 random", 0, True))
+    rows = {r["condition"]: r for r in contract_rows({"modified": rec, "tight": held})}
+    cells = rows["post.cells"]["variants"]
+    assert (cells["modified"]["count"], cells["modified"]["ok"], cells["modified"]["state"]) == (
+        4096 + 13, False, "failed")
+    assert [r["ok"] for r in cells["modified"]["records"]] == [False, True]
+    assert (cells["tight"]["ok"], cells["tight"]["state"]) == (True, "held")
+    assert rows["pre.dr.spec"]["variants"]["modified"]["state"] == "failed"
+    assert rows["pre.dr.spec"]["variants"]["tight"]["state"] == "delegated"
+    assert rows["post.is_path"]["variants"]["modified"]["state"] == "n/a"
+    assert rows["post.optimal"]["variants"]["modified"]["state"] == "not checked"
+    # Swapping the records' order changes nothing but the order of "records".
+    swapped = _record(*[(c["part"], c["condition"], c["scope"], c["count"], c["ok"])
+                        for c in rec["triples"][0]["checks"][::-1]])
+    again = {r["condition"]: r for r in contract_rows({"modified": swapped})}
+    assert again["post.cells"]["variants"]["modified"]["state"] == "failed"
+
+
+def test_contract_table_renders_failed_and_zero_counts_honestly(report):
+    audit = copy.deepcopy(report["result"].doc)
+    (s,) = audit["scenarios"]
+    rec = _record(("post", "post.cells", "4096 random cells of 9000 (seed 0)", 4096, False),
+                  ("post", "post.cells", "the 13 cells the path occupies", 13, True),
+                  ("pre", "pre.dr.spec", "by Theorem 3's post.cells check: 4096 random", 0, True),
+                  ("post", "post.costs", "J1 and J2 recomputed", 0, True))
+    s["contract_checks"] = contract_rows({"original": rec})
+    text = render_html(AuditResult(audit, report["result"].figures))
+    table = text[text.index("<th>command</th><th>condition</th>"):]
+    table = table[:table.index("</table>")]
+    row = table[table.index("post.cells"):]
+    row = row[:row.index("</tr>")]
+    assert "4096 + 13" in row and "FAILED" in row and ">held<" not in row
+    assert "by post.cells" in table and ">n/a<" in table
+    assert "0 <span" not in table, "a zero count is shown with a badge"
+
+
+def test_additive_plan_keys_validate_and_render(report):
+    # plan.json may gain keys (kernel, dr_sha256, more violation fields): the report keeps them.
+    audit = copy.deepcopy(report["result"].doc)
+    v = audit["scenarios"][0]["variants"][1]
+    v.update(kernel={"builtdr": "fast", "search": "fast"}, dr_sha256="ab" * 32)
+    v["clearance"]["lower_bound_m"] = 0.001
+    v["contracts"]["violations"] = [{"triple": "Theorem 3", "condition": "post.cells",
+                                     "values": {"cell": [0, 1, 2]}, "message": "a new field"}]
+    jsonschema.validate(audit, json.loads(SCHEMA.read_text()))
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert "ab" * 32 in text and "builtdr: fast" in text
+    assert "message: a new field" in text and "cell was [0, 1, 2]" in text
+
+
 def test_findings_text_matches_golden(report):
     text = "\n\n".join(f"[{f['id']}] {f['title']}\n{f['text']}" for f in report["doc"]["findings"])
     _golden("findings.txt", text + "\n")
@@ -207,12 +281,43 @@ def test_a_failed_obligation_fails_the_audit(report, tmp_path):
     bad = tmp_path / "results.json"
     bad.write_text(json.dumps(doc))
     audit = copy.deepcopy(report["result"].doc)
-    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios")))
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
     audit["verdict"] = _verdict(audit)
     assert audit["verdict"]["ok"] is False
+    assert not audit["obligations"]["missing_ids"] and not audit["obligations"]["unexpected_ids"]
     assert audit["obligations"]["summary"]["total"]["unproved"] == 1
     text = render_html(AuditResult(audit, report["result"].figures))
     assert f"expected: {doc['obligations'][0]['expected']}" in text and "FAILED" in text
+
+
+def test_ids_of_a_doctored_results_json_are_checked_not_copied(report, tmp_path):
+    # One id deleted, one renamed, and the file still claims none missing and none extra.
+    doc = json.loads(_results(report)["text"])
+    assert not doc["missing_ids"] and not doc["unexpected_ids"]
+    gone, renamed = doc["obligations"][0]["id"], doc["obligations"][1]["id"]
+    doc["obligations"] = doc["obligations"][1:]
+    doc["obligations"][0]["id"] = renamed + ".typo"
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    proofs = load_proofs(str(bad), ROOT / "scenarios", EXPECTED)
+    assert proofs.missing_ids == (gone, renamed)
+    assert proofs.unexpected_ids == (renamed + ".typo",)
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(proofs))
+    audit["verdict"] = _verdict(audit)
+    assert audit["verdict"]["ok"] is False and audit["obligations"]["all_as_expected"] is False
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert "all present, none extra" not in text
+    assert f"missing</span> {gone}, {renamed}" in text and renamed + ".typo" in text
+    # A repeated id is not "present" twice over: it is reported.
+    doc = json.loads(_results(report)["text"])
+    doc["obligations"].append(dict(doc["obligations"][0]))
+    bad.write_text(json.dumps(doc))
+    twice = load_proofs(str(bad), ROOT / "scenarios", EXPECTED)
+    assert twice.unexpected_ids == (f"{doc['obligations'][0]['id']} (twice)",)
+    # Without a list, every obligation is expected: a partial run shows what it left out.
+    partial = load_proofs(str(_results(report)["path"]), ROOT / "scenarios")
+    assert set(partial.missing_ids) == set(expected_ids(ROOT / "scenarios")) - set(EXPECTED)
 
 
 def test_missing_parts_are_labelled_not_available(report):
@@ -272,6 +377,7 @@ def _golden(name: str, text: str) -> None:
 #: Parts of report.json whose keys belong to other modules' records (contracts, certificate,
 #: a finding's own numbers, the campaign's cases) or to the environment (versions).
 _OPEN = ("findings[].data", "scenarios[].variants[].contracts", "scenarios[].variants[].clearance",
+         "scenarios[].variants[].kernel",
          "scenarios[].variants[].timings_s", "selftest.rows[]", "provenance.versions",
          "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks")
 
