@@ -47,7 +47,9 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "sound; Python's Fraction arithmetic is exact.",
         "Widely used, heavily tested tools; every Z3 proof also passes a vacuity check, and "
         "negative tests show each encoding fails when a premise is removed. The SMT-LIB of "
-        "every query is saved for replay in another solver.",
+        "every query is saved with its hash and is replayable in Z3 (the tests replay it); it "
+        "uses Z3's extensions (lambda terms, arrays indexed by several sorts) and sets no logic, "
+        "so another solver may reject it. sympy and data checks run under a wall-clock limit.",
         "every Z3 and sympy obligation"),
     Assumption(
         "A5.while_model",
@@ -85,4 +87,16 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "The theorems then hold for any region construction; the construction's soundness is "
         "the margin lemma, and its monotonicity the per-scenario containment check.",
         "Thm1-Thm4, Prop1, Prop8.*"),
+    Assumption(
+        "A10.snap_slack",
+        "impl.lattice_range snaps a box end onto a lattice point when it is within SNAP = 1e-9 "
+        "of a spacing g (relative), so the sampled lattice may stop up to SNAP g (rad) short "
+        "of the box; sweep_margin adds SNAP g R per joint (R the link's reach about that "
+        "joint) to the margin.",
+        "Turning a joint by an angle a moves any point at distance <= R from it by at most "
+        "R a (chord <= arc), so a configuration in the uncovered sliver is within SNAP g R of "
+        "one that the lemma's delta already covers; the triangle inequality adds the two. "
+        "That sweep_margin adds at least this much is checked per scenario; the chord <= arc "
+        "bound itself is assumed (as A3's facts).",
+        "Scenario.*.margin_side, Lemma.sweep_margin, Scenario.*.containment"),
 )

@@ -12,7 +12,8 @@ from __future__ import annotations
 import sympy as sp
 import z3
 
-from ._obligation import VC, CheckOutcome, CheckQuery, Method, Obligation, Verdict, Z3Query
+from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Verdict, Z3Query,
+                          check_source)
 
 __all__ = ["margin_obligations"]
 
@@ -175,7 +176,8 @@ def _cos_bound() -> CheckQuery:
         return CheckOutcome(True, "f = x^2/2 - 1 + cos x: f(0) = f'(0) = 0, f'' = 1 - cos x >= 0, "
                             "f even; hence f >= 0 (mean value theorem twice), i.e. "
                             "1 - cos x <= x^2/2")
-    return CheckQuery(run, f"f = {sp.srepr(f)}\nchecks: f(0), f', f'(0), f'', evenness")
+    return CheckQuery(run, f"f = {sp.srepr(f)}\nchecks: f(0), f', f'(0), f'', evenness\n\n"
+                      + check_source(_cos_bound))
 
 
 def _naive_hull() -> CheckQuery:
@@ -202,7 +204,8 @@ def _naive_hull() -> CheckQuery:
             return CheckOutcome(False, "refuted exactly: a barycentric coordinate is negative", cex)
         return CheckOutcome(True, "the point is inside (unexpected)")
     return CheckQuery(run, "segment (0,0)-(1,0) turning by pi/2, tip at pi/4 vs triangle "
-                      "(0,0), (1,0), (0,1); sympy exact barycentric coordinates")
+                      "(0,0), (1,0), (0,1); sympy exact barycentric coordinates\n\n"
+                      + check_source(_naive_hull))
 
 
 def margin_obligations() -> list[Obligation]:

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import inspect
+import signal
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -30,6 +33,7 @@ __all__ = [
     "VCResult",
     "Verdict",
     "Z3Query",
+    "check_source",
     "discharge",
     "render_query",
 ]
@@ -125,10 +129,16 @@ class CheckOutcome:
 
 @dataclass(frozen=True)
 class CheckQuery:
-    """A sympy or data check: ``content`` is the canonical text hashed for replay."""
+    """A sympy or data check: ``content`` is the canonical text hashed for replay (the check's
+    source and its inputs); the outcome it computes is appended to the hashed text when run."""
 
     run: Callable[[], CheckOutcome]
     content: str
+
+
+def check_source(*objs: Callable[..., Any]) -> str:
+    """The source text of the functions a check runs: hashed, so editing the check is a change."""
+    return "\n".join(inspect.getsource(o).rstrip() for o in objs)
 
 
 Query = Z3Query | CheckQuery
@@ -195,7 +205,11 @@ def discharge(ob: Obligation) -> Proof:
         if isinstance(query, Z3Query):
             fields = _run_z3(ob, query)
         else:
-            fields = _run_check(ob, query)
+            outcome = _guarded(query.run, ob.timeout_ms)
+            fields = _check_fields(ob, outcome)
+            # The result is part of the hashed text: new data or a changed computation that
+            # gives another N, h or slack is reported "changed", not "same".
+            text += _outcome_text(outcome)
     except Exception as exc:  # noqa: BLE001 - an obligation must end in a verdict, not a crash
         tb = traceback.format_exception_only(type(exc), exc)[-1].strip()
         fields = dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
@@ -277,8 +291,53 @@ def _run_z3(ob: Obligation, q: Z3Query) -> dict[str, Any]:
                 vcs=tuple(results))
 
 
-def _run_check(ob: Obligation, q: CheckQuery) -> dict[str, Any]:
-    out = q.run()
+class _CheckTimeout(Exception):
+    pass
+
+
+def _guarded(run: Callable[[], CheckOutcome], timeout_ms: int) -> CheckOutcome:
+    """Run a sympy or data check under a wall-clock limit (sympy has none of its own): SIGALRM
+    interrupts it in the main thread; elsewhere a watcher thread stops waiting (the check runs
+    on, but its answer is dropped). A timeout is UNKNOWN, never proved."""
+    limit = timeout_ms / 1000
+    what = f"timed out after {limit:g} s (wall clock)"
+    if hasattr(signal, "SIGALRM") and threading.current_thread() is threading.main_thread():
+        def on_alarm(signum: int, frame: object) -> None:
+            raise _CheckTimeout
+        old = signal.signal(signal.SIGALRM, on_alarm)
+        signal.setitimer(signal.ITIMER_REAL, limit)
+        try:
+            return run()
+        except _CheckTimeout:
+            return CheckOutcome(None, what)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, old)
+    box: list[CheckOutcome | BaseException] = []
+
+    def target() -> None:
+        try:
+            box.append(run())
+        except BaseException as exc:  # noqa: BLE001 - handed back to the caller below
+            box.append(exc)
+    t = threading.Thread(target=target, daemon=True)
+    t.start()
+    t.join(limit)
+    if not box:
+        return CheckOutcome(None, what + "; the check was left running in its thread")
+    if isinstance(box[0], BaseException):
+        raise box[0]
+    return box[0]
+
+
+def _outcome_text(out: CheckOutcome) -> str:
+    lines = ["", "; outcome (part of the hash)", f"holds: {out.holds}", f"detail: {out.detail}"]
+    if out.counterexample:
+        lines.append(f"counterexample: {out.counterexample}")
+    return "\n".join(lines) + "\n"
+
+
+def _check_fields(ob: Obligation, out: CheckOutcome) -> dict[str, Any]:
     if out.holds is None:
         verdict = Verdict.UNKNOWN
     elif out.holds:
@@ -309,8 +368,10 @@ def render_query(ob: Obligation, query: Query) -> str:
     if isinstance(query, CheckQuery):
         return "\n".join(head + ["", query.content.rstrip(), ""])
     out = head
+    second = ("refutation (expect sat: the counterexample)"
+              if ob.expected is Verdict.REFUTED_AS_EXPECTED else "proof (expect unsat)")
     for vc in query.vcs:
-        for label, negate in (("vacuity (expect sat)", False), ("proof (expect unsat)", True)):
+        for label, negate in (("vacuity (expect sat)", False), (second, True)):
             s = z3.Solver()
             s.add([h for _, h in vc.hypotheses])
             if negate:

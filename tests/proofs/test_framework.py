@@ -99,3 +99,31 @@ def test_vc_without_removes_one_premise():
     assert [n for n, _ in vc.without("a").hypotheses] == ["b"]
     with pytest.raises(KeyError):
         vc.without("c")
+
+
+def test_a_check_hashes_its_outcome_and_source():
+    # Same inputs, another computed result: another hash (a data change is not "same").
+    same = lambda holds, detail: _ob(  # noqa: E731
+        lambda: CheckQuery(lambda: CheckOutcome(holds, detail), "inputs"), method=Method.DATA)
+    a, b = discharge(same(True, "N = 70")), discharge(same(True, "N = 71"))
+    assert a.verdict is b.verdict is Verdict.PROVED and a.sha256 != b.sha256
+    assert "N = 71" in b.smtlib and a.sha256 == discharge(same(True, "N = 70")).sha256
+    from cfmpa.proofs._obl_margin import _cos_bound
+    assert "def _cos_bound" in _cos_bound().content
+
+
+def test_a_check_that_runs_too_long_is_unknown():
+    def slow() -> CheckOutcome:
+        time.sleep(5)
+        return CheckOutcome(True, "late")
+    pr = discharge(_ob(lambda: CheckQuery(slow, "slow"), method=Method.SYMPY, timeout_ms=200))
+    assert pr.verdict is Verdict.UNKNOWN and "timed out" in pr.reason
+
+
+def test_refuted_obligations_label_their_second_check_as_a_refutation():
+    x = z3.Real("x")
+    q = lambda: Z3Query((VC("v", (("x > 1", x > 1),), x > 2),))  # noqa: E731
+    refuted = discharge(_ob(q, expected=Verdict.REFUTED_AS_EXPECTED))
+    assert refuted.verdict is Verdict.REFUTED_AS_EXPECTED
+    assert "refutation (expect sat" in refuted.smtlib and "expect unsat" not in refuted.smtlib
+    assert "proof (expect unsat)" in discharge(_ob(q)).smtlib

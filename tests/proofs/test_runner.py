@@ -39,7 +39,8 @@ def test_scenario_ids_come_from_the_files_found(tmp_path: Path):
     ids = expected_ids(tmp_path)
     assert ids[: len(FIXED_IDS)] == FIXED_IDS
     assert ids[len(FIXED_IDS):] == tuple(f"Scenario.{s}.{c}" for s in ("a", "b")
-                                         for c in ("time_grid", "cspace_grid", "containment"))
+                                         for c in ("time_grid", "cspace_grid", "margin_side",
+                                                   "containment"))
     assert [o.id for o in collect_obligations(tmp_path, ["Scenario"])] == list(ids[len(FIXED_IDS):])
 
 
@@ -100,7 +101,7 @@ def test_a_scenario_that_does_not_load_fails_instead_of_vanishing(tmp_path: Path
     doc = json.loads((tmp_path / "out" / "results.json").read_text())
     verdicts = {o["id"]: o["verdict"] for o in doc["obligations"]}
     assert verdicts == {f"Scenario.broken.{c}": "failed"
-                        for c in ("time_grid", "cspace_grid", "containment")}
+                        for c in ("time_grid", "cspace_grid", "margin_side", "containment")}
 
 
 def test_full_run_discharges_everything_as_expected(tmp_path: Path):
@@ -191,4 +192,4 @@ def test_another_scenarios_folder_says_what_it_expects(tmp_path: Path):
                    only=["Scenario.mine.time_grid"], stream=out)
     assert rc == 0
     assert (f"scenarios: {tmp_path} is not the bundled folder" in out.getvalue()
-            and "Scenario.mine.{time_grid,cspace_grid,containment}" in out.getvalue())
+            and "Scenario.mine.{time_grid,cspace_grid,margin_side,containment}" in out.getvalue())
