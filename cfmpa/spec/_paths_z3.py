@@ -130,12 +130,22 @@ def z3_J2(p: Z3Path) -> z3.ArithRef:
 
 
 def dr_free(dr: npt.NDArray[np.integer]) -> FreeFn:
-    """``free`` for a concrete D_R: (x, y) is none of the layer's blocked cells."""
-    blocked = [list(zip(*np.nonzero(np.asarray(dr)[k]))) for k in range(dr.shape[0])]
+    """``free`` for a concrete D_R: (x, y) is one of the layer's free cells, and none of its
+    blocked ones.
+
+    Inside the grid either half alone says "free"; both are given because Z3 proves "no path"
+    far faster with the first (a 4 x 4 wall: under a second, against no answer in 60 s with the
+    second alone) and finds optima faster with the second.
+    """
+    layers = np.asarray(dr)
+    free_cells = [list(zip(*np.nonzero(layers[k] == 0))) for k in range(layers.shape[0])]
+    blocked = [list(zip(*np.nonzero(layers[k]))) for k in range(layers.shape[0])]
 
     def free(layer: int, x: z3.ArithRef, y: z3.ArithRef) -> z3.BoolRef:
-        return z3.And([z3.Not(z3.And(x == int(i), y == int(j))) for i, j in blocked[layer]]
-                      or [z3.BoolVal(True)])
+        one_of = z3.Or([z3.And(x == int(i), y == int(j)) for i, j in free_cells[layer]]
+                       or [z3.BoolVal(False)])
+        none_of = [z3.Not(z3.And(x == int(i), y == int(j))) for i, j in blocked[layer]]
+        return z3.And(one_of, *none_of)
     return free
 
 

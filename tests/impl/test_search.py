@@ -120,7 +120,8 @@ def test_search_matches_on_larger_grids(seed: int) -> None:
 Z3_TIMEOUT_MS = 60_000
 
 
-def check_against_z3(dr: np.ndarray, start: Cell, goal: Cell) -> None:
+def check_against_z3(dr: np.ndarray, start: Cell, goal: Cell) -> SearchResult:
+    """Z3's optimum over the spec's encoding equals the search's: (J1, J2), or both no path."""
     z = z3_opt_path(dr, start, goal, timeout_ms=Z3_TIMEOUT_MS)
     assert z.status is not None, f"Z3 answered unknown: {z.reason_unknown}"
     got = search_opt_path(dr, start, goal)
@@ -128,24 +129,52 @@ def check_against_z3(dr: np.ndarray, start: Cell, goal: Cell) -> None:
     if z.status == SearchStatus.FOUND:
         assert is_path(z.path, dr, start, goal)
         assert (J1(z.path), J2(z.path)) == (z.J1, z.J2)
+    return got
 
 
-def _z3_case(seed: int, N: int, m: int, n: int, density: float) -> tuple[np.ndarray, Cell, Cell]:
-    rng = np.random.default_rng(seed)
-    dr = (rng.random((N + 1, m, n)) < density).astype(np.uint8)
-    dr[0, 0, 0] = 0
-    dr[N, m - 1, n - 1] = 0
-    return dr, (0, 0), (m - 1, n - 1)
+@st.composite
+def z3_cases(draw: st.DrawFn) -> tuple[np.ndarray, Cell, Cell]:
+    """A tiny random D_R for Z3 (N <= 4, m, n <= 4), any start and goal, with densities up to
+    0.8 so that a good share of cases have no path (unreachable, or an end blocked)."""
+    N = draw(st.integers(1, 4))
+    m, n = draw(st.integers(1, 4)), draw(st.integers(1, 4))
+    density = draw(st.sampled_from([0.0, 0.2, 0.4, 0.6, 0.8]))
+    seed = draw(st.integers(0, 2**32 - 1))
+    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
+    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    if draw(st.booleans()):
+        dr[0][start] = 0     # free ends, so that "no path" is often "unreachable"
+        dr[N][goal] = 0
+    return dr, start, goal
 
 
-@pytest.mark.parametrize("seed, N, m, n, density", [
-    (0, 4, 5, 5, 0.0),     # the largest bound, B = 4 + 25
-    (1, 4, 5, 5, 0.3),
-    (2, 3, 4, 5, 0.4),
-    (3, 4, 5, 4, 0.6),     # dense: often no path
-])
-def test_search_matches_z3(seed: int, N: int, m: int, n: int, density: float) -> None:
-    check_against_z3(*_z3_case(seed, N, m, n, density))
+@settings(max_examples=50, deadline=None)
+@given(z3_cases())
+def test_search_matches_z3_on_random_tiny_drs(case: tuple[np.ndarray, Cell, Cell]) -> None:
+    got = check_against_z3(*case)
+    event(f"{got.status}: {got.reason}")
+
+
+def test_search_matches_z3_on_the_largest_free_grid() -> None:
+    # N = 4, 5 x 5, nothing blocked: the largest length bound here, B = 4 + 25 cells.
+    dr = np.zeros((5, 5, 5), dtype=np.uint8)
+    assert check_against_z3(dr, (0, 0), (4, 4)).status is SearchStatus.FOUND
+
+
+def test_search_and_z3_agree_on_an_unreachable_goal() -> None:
+    # A wall across the grid from step 1 on: both ends are free, yet no path reaches the goal.
+    dr = np.zeros((4, 4, 4), dtype=np.uint8)
+    dr[1:, 2, :] = 1
+    got = check_against_z3(dr, (0, 1), (3, 2))
+    assert (got.status, got.reason) == (SearchStatus.NO_PATH, REASON_UNREACHABLE)
+
+
+def test_search_and_z3_agree_when_the_start_is_blocked() -> None:
+    dr = np.zeros((3, 3, 3), dtype=np.uint8)
+    dr[0, 1, 1] = 1
+    got = check_against_z3(dr, (1, 1), (2, 2))
+    assert (got.status, got.reason) == (SearchStatus.NO_PATH, REASON_START_BLOCKED)
 
 
 def test_search_matches_z3_on_the_early_arrival_case() -> None:
