@@ -6,14 +6,15 @@ import itertools
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+import z3
+from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
 from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                                J1, J2, SearchResult, SearchStatus, is_path, is_path_paper, opt_path,
                                path_violations)
-from cfmpa.spec._paths_z3 import length_bound
+from cfmpa.spec._paths_z3 import dr_free, length_bound, path_vars, z3_is_path, z3_J1, z3_J2
 
 
 def free_dr(N: int, m: int, n: int) -> np.ndarray:
@@ -223,3 +224,73 @@ def test_opt_path_is_the_minimum_over_all_short_paths(data: st.DataObject) -> No
         assert got.status == SearchStatus.FOUND and (got.J1, got.J2) == want
         assert is_path(got.path, dr, start, goal)
         assert (J1(got.path), J2(got.path)) == want
+
+
+# --- the Z3 encoding that Optimize minimises, against the executable definitions ----------------
+
+@st.composite
+def pinned_cases(draw: st.DrawFn) -> tuple[np.ndarray, list[tuple[int, int]], tuple[int, int],
+                                           tuple[int, int], int]:
+    """A tiny D_R, a list of cells (a walk with some jumps and cells just outside the grid, so
+    valid and invalid lists both come up), start, goal, and a Z3 bound of at least its length."""
+    N, m, n = draw(st.integers(1, 3)), draw(st.integers(1, 3)), draw(st.integers(1, 3))
+    dr = np.array(draw(st.lists(st.sampled_from([0, 0, 0, 1]), min_size=(N + 1) * m * n,
+                                max_size=(N + 1) * m * n)), dtype=np.uint8).reshape(N + 1, m, n)
+    cell = st.tuples(st.integers(-1, m), st.integers(-1, n))
+    inside = st.tuples(st.integers(0, m - 1), st.integers(0, n - 1))
+    length = draw(st.integers(1, length_bound(dr)))
+    path = [draw(inside)]
+    for _ in range(length - 1):
+        di, dj = draw(st.integers(-1, 1)), draw(st.integers(-1, 1))
+        step = (path[-1][0] + di, path[-1][1] + dj)
+        path.append(step if draw(st.integers(0, 5)) else draw(cell))
+    start = path[0] if draw(st.integers(0, 5)) else draw(inside)
+    goal = path[-1] if draw(st.integers(0, 5)) else draw(inside)
+    # Bounds below N too, where z3_is_path checks the goal at the steps past the bound.
+    bound = draw(st.integers(length, length + N + 1))
+    return dr, path, start, goal, bound
+
+
+def _z3_verdict(dr: np.ndarray, path: list[tuple[int, int]], start: tuple[int, int],
+                goal: tuple[int, int], bound: int) -> tuple[int, int] | None:
+    """(J1, J2) that z3_is_path, z3_J1 and z3_J2 force on the pinned list, or None if
+    z3_is_path rejects it; fails if the terms leave either cost undetermined."""
+    N, m, n = dr.shape[0] - 1, dr.shape[1], dr.shape[2]
+    p = path_vars(bound)
+    pinned = [p.length == len(path)]
+    pinned += [z3.And(p.xs[k] == i, p.ys[k] == j) for k, (i, j) in enumerate(path)]
+    solver = z3.Solver()
+    solver.set(timeout=10_000)
+    solver.add(z3_is_path(p, dr_free(dr), N, m, n, start, goal), *pinned)
+    verdict = solver.check()
+    assert verdict != z3.unknown, solver.reason_unknown()
+    if verdict == z3.unsat:
+        return None
+    model = solver.model()
+    j1, j2 = (model.eval(t, model_completion=True).as_long() for t in (z3_J1(p), z3_J2(p)))
+    # The costs are functions of the list: no other model of the same list gives other values.
+    solver.add(z3.Or(z3_J1(p) != j1, z3_J2(p) != j2))
+    assert solver.check() == z3.unsat
+    return j1, j2
+
+
+@settings(max_examples=120, deadline=None)
+@given(pinned_cases())
+def test_z3_encoding_agrees_with_is_path_J1_J2_on_pinned_lists(
+        case: tuple[np.ndarray, list[tuple[int, int]], tuple[int, int], tuple[int, int], int]
+) -> None:
+    dr, path, start, goal, _ = case
+    got = _z3_verdict(*case)
+    valid = is_path(path, dr, start, goal)
+    event("valid" if valid else f"invalid: {path_violations(path, dr, start, goal)[0].clause}")
+    assert got == ((J1(path), J2(path)) if valid else None)
+
+
+def test_z3_encoding_on_hand_lists() -> None:
+    dr = free_dr(3, 2, 3)
+    dr[2, 1, 2] = 1        # the goal (1, 2) is swept at step 2
+    late = [(0, 0), (0, 1), (0, 1), (1, 2)]
+    early = [(0, 0), (1, 1), (1, 2)]
+    assert _z3_verdict(dr, late, (0, 0), (1, 2), 6) == (J1(late), J2(late)) == (3, 6)
+    assert _z3_verdict(dr, early, (0, 0), (1, 2), 3) is None     # held at the goal at step 2
+    assert _z3_verdict(dr, [(0, 0), (1, 2)], (0, 0), (1, 2), 4) is None    # not one move
