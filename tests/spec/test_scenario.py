@@ -8,13 +8,17 @@ from fractions import Fraction
 from pathlib import Path
 
 import hypothesis.strategies as st
+import numpy as np
 import pytest
+import shapely
 from hypothesis import given, settings
 
 import factory
 from cfmpa import cli
 from cfmpa.errors import MISSING, InputError
-from cfmpa.spec import exact_n, exact_tf, load_scenario, make_grid, parse_scenario
+from cfmpa.spec import (Variant, exact_n, exact_tf, left_angles, left_box, link_corners,
+                        load_scenario, make_grid, parse_scenario, right_box)
+from cfmpa.spec._regions import SNAP, right_region_polygons
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 
@@ -252,3 +256,89 @@ def test_extreme_floats_are_refused_by_name_or_give_a_sane_grid(key, xs):
     assert all(math.isfinite(x) and x >= 0 for x in g.h)
     assert all(s.left.omega[q] * s.dt <= 3.14 and s.right.omega[q] * s.dt <= 3.14
                for q in range(2))
+
+
+# ---- The principal's PTP motion and the variants' boxes (DESIGN §2, §4) ----
+
+_angle = st.floats(-3.2, 3.2)
+
+
+@st.composite
+def _motions(draw):
+    """Random left-arm motions, goal below start in either joint included (s = -1)."""
+    start = [draw(_angle), draw(_angle)]
+    goal = [start[q] + draw(st.one_of(st.just(0.0), st.floats(-1.6, 1.6))) for q in range(2)]
+    omega = [draw(st.floats(0.3, 2.5)), draw(st.floats(0.3, 2.5))]
+    dt = draw(st.sampled_from([0.02, 0.1, 0.125, 0.25, 0.4]))
+    return factory.scenario(dt=dt, left__start=start, left__goal=goal, left__omega=omega,
+                            right__start_cell=[0, 0], right__goal_cell=[0, 0])
+
+
+def _within(x: np.ndarray, box: tuple[float, float], tol: float) -> float:
+    return bool((x >= box[0] - tol).all() and (x <= box[1] + tol).all())
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # t / Tf, Tf ~ 1e-16
+@settings(max_examples=60, deadline=None)
+@given(_motions())
+def test_each_layers_box_holds_the_motion_and_the_variants_nest(s):
+    g = make_grid(s)
+    assert Fraction(g.N) * Fraction(s.dt) >= exact_tf(s)
+    # Original and modified boxes are a + (-1, 0, 1) omega dt: rounding may leave the motion a few
+    # ulps outside, which the regions' snap slack SNAP * omega_q dt covers; allow 1% of it.
+    tol = [SNAP * s.left.omega[q] * s.dt / 100 for q in range(2)]
+    for k in range(g.N):
+        t = np.linspace(k * s.dt, (k + 1) * s.dt, 65)
+        theta = left_angles(s, t)
+        boxes = {v: left_box(s, v, k) for v in Variant}
+        for q in range(2):
+            assert _within(theta[:, q], boxes[Variant.TIGHT][q], 0.0)
+            for v in (Variant.MODIFIED, Variant.ORIGINAL):
+                assert _within(theta[:, q], boxes[v][q], tol[q])
+            assert _within(np.array(boxes[Variant.TIGHT][q]), boxes[Variant.MODIFIED][q], tol[q])
+            assert _within(np.array(boxes[Variant.MODIFIED][q]), boxes[Variant.ORIGINAL][q], 0.0)
+            # The modified box lies on the side the joint moves to (s = -1 when goal < start).
+            lo, hi = boxes[Variant.MODIFIED][q]
+            a = float(left_angles(s, k * s.dt)[q])
+            assert (lo == a) if s.left.goal[q] > s.left.start[q] else (hi == a)
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")
+@settings(max_examples=150, deadline=None)
+@given(_motions())
+def test_every_joint_arrives_exactly_at_tf(s):
+    tf = exact_tf(s)
+    start, goal = np.array(s.left.start), np.array(s.left.goal)
+    assert tuple(left_angles(s, float(tf))) == s.left.goal
+    assert tuple(left_angles(s, float(tf) + 1.0)) == s.left.goal      # and rests there
+    assert tuple(left_angles(s, 0.0)) == s.left.start
+    moving = np.abs(goal - start) > 1e-6    # an ulp-sized move may round onto the goal early
+    if moving.any():
+        before = left_angles(s, float(tf) * (1 - 1e-6))
+        assert (before[moving] != goal[moving]).all()      # no joint arrives early
+        # Synchronised: every joint has covered the same fraction of its way at any time.
+        mid = left_angles(s, float(tf) / 3)
+        frac = (mid - start)[moving] / (goal - start)[moving]
+        assert np.allclose(frac, 1 / 3, rtol=0, atol=1e-12)
+    # At least one joint runs at its speed limit, none faster.
+    speeds = [abs(Fraction(s.left.goal[q]) - Fraction(s.left.start[q])) / tf if tf else 0
+              for q in range(2)]
+    assert all(v <= Fraction(s.left.omega[q]) for q, v in enumerate(speeds))
+    assert tf == 0 or any(v == Fraction(s.left.omega[q]) for q, v in enumerate(speeds))
+
+
+@settings(max_examples=40, deadline=None)
+@given(_motions(), st.integers(0, 10**6), st.floats(0, 1), st.floats(0, 1))
+def test_right_box_is_the_cell_swept_by_its_region(s, seed, f1, f2):
+    # right_box(cell) = [t_i -+ h1] x [t_j -+ h2]; the spec's S_RArm[i][j] holds the arm there.
+    g = make_grid(s)
+    i, j = seed % g.m, (seed // g.m) % g.n
+    box = right_box(g, (i, j))
+    for q, idx in enumerate((i, j)):
+        t = float(g.angle(q, idx))
+        assert box[q] == (t - g.h[q], t + g.h[q])
+    theta = (box[0][0] + f1 * (box[0][1] - box[0][0]), box[1][0] + f2 * (box[1][1] - box[1][0]))
+    r1, r2 = right_region_polygons(s, g, np.array([i]), np.array([j]))
+    for link, region in enumerate((r1[0], r2[0])):
+        rect = shapely.Polygon(link_corners(s.right, theta, link))
+        assert shapely.difference(rect, region).area <= 1e-15
