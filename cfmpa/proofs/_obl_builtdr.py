@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import z3
 
 from ..spec._z3defs import REGION, Z3Dims, blocked_exact, inter
-from ._obligation import Method, Obligation, Verdict, Z3Query
+from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 from ._while import Cmd, For, If, Seq, Store, verification_conditions
 
 __all__ = ["BuiltDRModel", "builtdr_model", "builtdr_obligations"]
@@ -135,6 +135,35 @@ def _query(variant: str, kind: str, bug: str | None = None) -> Z3Query:
                                            model.post, termination=kind == "termination"))
 
 
+def _box_nesting() -> Z3Query:
+    """spec.left_box's three rules for one joint at layer k, with the PTP motion of spec's
+    left_angles: tight ⊆ modified ⊆ original. Quantifier-free polynomial real arithmetic."""
+    s0, g0, w, dt, tf, k = z3.Reals("start goal omega dt Tf k")
+    a0, a1 = z3.Reals("a_k a_k1")
+    t0, t1 = k * dt, (k + 1) * dt
+
+    def at(a: z3.ArithRef, t: z3.ArithRef) -> z3.BoolRef:
+        # theta(t) = start + (goal - start) min(t/Tf, 1), multiplied out by Tf > 0.
+        return z3.If(t >= tf, a == g0, tf * (a - s0) == (g0 - s0) * t)
+    sign = z3.If(g0 > s0, z3.RealVal(1), z3.RealVal(-1))         # the s_q rule
+    step = w * dt
+
+    def lo_hi(x: z3.ArithRef, y: z3.ArithRef) -> tuple[z3.ArithRef, z3.ArithRef]:
+        return z3.If(x <= y, x, y), z3.If(x <= y, y, x)
+    orig = (a0 - step, a0 + step)
+    mod = lo_hi(a0, a0 + sign * step)
+    tight = lo_hi(a0, a1)
+    base = (("omega > 0", w > 0), ("dt > 0", dt > 0), ("k >= 0", k >= 0),
+            ("a_k = theta(k dt)", at(a0, t0)))
+    speed = ("|goal - start| <= omega Tf (Tf = max_q |goal_q - start_q| / omega_q)",
+             z3.And(tf > 0, g0 - s0 <= w * tf, s0 - g0 <= w * tf))
+    outer = VC("modified_in_original", base, z3.And(orig[0] <= mod[0], mod[1] <= orig[1]),
+               key_premise="omega > 0")
+    inner = VC("tight_in_modified", base + (speed, ("a_k1 = theta((k+1) dt)", at(a1, t1))),
+               z3.And(mod[0] <= tight[0], tight[1] <= mod[1]), key_premise=speed[0])
+    return Z3Query((outer, inner))
+
+
 def builtdr_obligations() -> list[Obligation]:
     """Theorem 1 (original), Theorem 3 (modified), and the tight variant: correctness and
     termination of BuiltDR."""
@@ -156,9 +185,22 @@ def builtdr_obligations() -> list[Obligation]:
         statement = (f"{{N >= 1, m, n >= 1}} BuiltDR ({variant}) {{for all k < N, i < m, j < n: "
                      f"P[k,i,j] = (SLarm_k ∩ SRarm_ij = Φ -> 0 | 1) with SLarm_k = "
                      f"regionL_{variant}(k), and the rest layer P[N,i,j] likewise with {rest}}}: "
-                     "WP of the loop nest with invariants; Inter uninterpreted.")
+                     "WP of the loop nest with invariants; Inter uninterpreted. Thm1.builtdr, "
+                     "Thm3.builtdr and Thm3.builtdr_tight are the same proof over a different "
+                     "opaque region function; what distinguishes the variants is the box "
+                     "nesting (Thm3.box_nesting) and the per-scenario containment check "
+                     "(Scenario.*.containment).")
         out.append(Obligation(f"{ident}.builtdr{suffix}", GROUP, ref, statement, Z, P,
                               lambda v=variant: _query(v, "correctness")))
         out.append(Obligation(f"{ident}.termination{suffix}", GROUP, ref, term, Z, P,
                               lambda v=variant: _query(v, "termination")))
+    out.append(Obligation(
+        "Thm3.box_nesting", GROUP, "Section IV.A (modified box), DESIGN §4 (tight box)",
+        "Per joint, for symbolic start, goal, omega > 0, dt > 0, layer k >= 0 and Tf with "
+        "|goal - start| <= omega Tf: with a_k = theta(k dt) on the PTP motion theta(t) = start + "
+        "(goal - start) min(t/Tf, 1), the tight box [min, max of a_k, a_k+1] lies within the "
+        "modified box [a_k, a_k + s_q omega dt] (s_q = +1 if goal > start, else -1), which "
+        "lies within the original box [a_k - omega dt, a_k + omega dt]: spec.left_box's rules. "
+        "Quantifier-free polynomial real arithmetic (products of the symbols), no quantifier.",
+        Z, P, _box_nesting))
     return out

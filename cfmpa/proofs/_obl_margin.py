@@ -123,13 +123,39 @@ def _sweep_margin() -> Z3Query:
         body = z3.Implies(z3.And([f for _, f in vc.hypotheses]), vc.goal)
         return _abstract_norms(z3.substitute(body, *pairs), sq)
 
+    nonneg = VC("nonneg", (("r >= 0", r >= 0),), r * g * g / 8 >= 0, key_premise="r >= 0")
+    sa, sb, sm = z3.Reals("sq_s sq_a sq_b")
+    square_mono = VC("square_monotone", (("0 <= a", 0 <= sa), ("a <= b", sa <= sb),
+                                         ("s <= a^2", sm <= sa * sa)),
+                     sm <= sb * sb, key_premise="a <= b")
+    # The margins are the lemma's: e_base = R_base g1^2/8, e_elbow = R_elbow g2^2/8, reached
+    # from Margin.arc_chord's bound at each point's own radius (r1 about the base, r2a and r2b
+    # about the elbow at the two ends) through the reach and square_monotone step lemmas.
     e1v, e2v = z3.Reals("e_base e_elbow")
+    g1, g2, rb, re_ = z3.Reals("g1 g2 R_base R_elbow")
+    r1, r2a, r2b = z3.Reals("r1 r2a r2b")
+    arc = lambda rad, turn: rad * turn * turn / 8  # noqa: E731 - Margin.arc_chord's bound
+
+    def bound(d: Vec, rad: z3.ArithRef, turn: z3.ArithRef, big: z3.ArithRef,
+              e_: z3.ArithRef, where: str) -> tuple[tuple[str, z3.BoolRef], ...]:
+        return (
+            (f"Margin.arc_chord at {where}: |.| <= r g^2/8", sqv(d) <= arc(rad, turn) * arc(rad, turn)),
+            (f"reach at {where}", inst(reach, [(r, rad), (big_, big), (g, turn)])),
+            (f"square_monotone at {where}", inst(square_mono, [
+                (sa, arc(rad, turn)), (sb, e_), (sm, sqv(d))])),
+            (f"nonneg at {where}", inst(nonneg, [(r, rad), (g, turn)])))
+    big_ = big
     glue = (
+        ("e_base = R_base g1^2/8, e_elbow = R_elbow g2^2/8",
+         z3.And(e1v == arc(rb, g1), e2v == arc(re_, g2))),
+        ("0 <= g1, g2 <= 3.14", z3.And(0 <= g1, g1 <= G_MAX, 0 <= g2, g2 <= G_MAX)),
+        ("0 <= r1 <= R_base; 0 <= r2a, r2b <= R_elbow",
+         z3.And(0 <= r1, r1 <= rb, 0 <= r2a, r2a <= re_, 0 <= r2b, r2b <= re_)),
         ("e_base, e_elbow >= 0", z3.And(e1v >= 0, e2v >= 0)),
         ("0 <= lam <= 1", z3.And(0 <= lam, lam <= 1)),
-        ("base arc: |p - h1| <= e_base", sqv(d1) <= e1v * e1v),
-        ("elbow arc at a: |a - a'| <= e_elbow", sqv(d_a) <= e2v * e2v),
-        ("elbow arc at b: |b - b'| <= e_elbow", sqv(d_b) <= e2v * e2v),
+        *bound(d1, r1, g1, rb, e1v, "the base (p - h1)"),
+        *bound(d_a, r2a, g2, re_, e2v, "the elbow at a (a - a')"),
+        *bound(d_b, r2b, g2, re_, e2v, "the elbow at b (b - b')"),
         ("convex_norm at (a - a', b - b')", inst(convex_norm, [
             (e, e2v), (x[0], d_a[0]), (x[1], d_a[1]), (y[0], d_b[0]), (y[1], d_b[1])])),
         ("triangle at (p - h1, lam-combination of a - a', b - b')", inst(triangle, [
@@ -138,8 +164,8 @@ def _sweep_margin() -> Z3Query:
     )
     delta = e1v + e2v
     compose = VC("compose", glue, sqv(_sub(p, h)) <= delta * delta,
-                 key_premise="base arc: |p - h1| <= e_base")
-    return Z3Query((convex_norm, triangle, reach, identity, compose))
+                 key_premise="Margin.arc_chord at the base (p - h1): |.| <= r g^2/8")
+    return Z3Query((convex_norm, triangle, reach, nonneg, square_mono, identity, compose))
 
 
 def _abstract_norms(f: z3.ExprRef, sq: z3.FuncDeclRef) -> z3.ExprRef:
@@ -213,9 +239,12 @@ def margin_obligations() -> list[Obligation]:
     P, R = Verdict.PROVED, Verdict.REFUTED_AS_EXPECTED
     return [
         Obligation("Margin.cos_bound", GROUP, "DESIGN §4 (margin lemma)",
-                   "1 - cos x <= x^2/2 for every real x: sympy checks f = x^2/2 - 1 + cos x has "
-                   "f(0) = f'(0) = 0, f'' = 1 - cos x >= 0 and f even; f >= 0 then follows by the "
-                   "mean value theorem (assumed).", Method.SYMPY, P, _cos_bound),
+                   "Toward 1 - cos x <= x^2/2 for every real x: sympy checks only identities "
+                   "of f = x^2/2 - 1 + cos x: f(0) = 0, f' = x - sin x, f'(0) = 0, "
+                   "f'' = 1 - cos x, f(-x) = f(x). The rest is prose, assumed (ledger A3): "
+                   "f'' >= 0 as cos <= 1, so by the mean value theorem f' is non-decreasing, "
+                   "f' >= 0 on [0, oo) and f >= f(0) = 0 there, and f even gives x < 0.",
+                   Method.SYMPY, P, _cos_bound),
         Obligation("Margin.arc_chord", GROUP, "DESIGN §4 (margin lemma, one joint)",
                    "A point at distance r from a pivot, turning through an angle in [0, g], "
                    "g <= 3.14, stays within r g^2/8 of the chord between its end positions "
@@ -227,8 +256,15 @@ def margin_obligations() -> list[Obligation]:
                    "A link point at (theta1, theta2) in a lattice cell [c1, c1+g1] x [c2, c2+g2] "
                    "is within delta = g1^2/8 R_base + g2^2/8 R_elbow of the hull of its four "
                    "corner positions: the base arc's chord point and the elbow arcs' chord points "
-                   "combine (norm convex, triangle inequality, radius monotone; each step a VC, "
-                   "used through named instances).", Method.Z3, P, _sweep_margin),
+                   "combine (norm convex, triangle inequality, radius monotone, r g^2/8 >= 0, "
+                   "squares monotone; each step a VC, used through named instances). The compose "
+                   "VC ties e_base = R_base g1^2/8 and e_elbow = R_elbow g2^2/8 to Margin.arc_chord's "
+                   "bound r g^2/8 at each point's radius (r1 <= R_base, r2 <= R_elbow). Prose, "
+                   "not checked: that Margin.arc_chord, proved with the pivot at the origin and "
+                   "the arc symmetric about the x-axis, holds for an arc about any pivot in any "
+                   "position (rigid motions, ledger A3), and that its chord point is the one at "
+                   "weight lam (the lemma gives some weight; lam names it).",
+                   Method.Z3, P, _sweep_margin),
         Obligation("Margin.naive_hull", GROUP, "DESIGN §4 (paper's corner hull)",
                    "The hull of a link at its end configurations contains it in between: refuted "
                    "exactly (sympy) for a segment turning by pi/2, whose tip at pi/4 has a "

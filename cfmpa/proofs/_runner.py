@@ -60,7 +60,7 @@ EXPECTED_VERDICTS: dict[str, Verdict] = {
     "Margin.cos_bound": _P, "Margin.arc_chord": _P, "Lemma.sweep_margin": _P,
     "Margin.naive_hull": _R,
     "Thm1.builtdr": _P, "Thm1.termination": _P, "Thm3.builtdr": _P, "Thm3.termination": _P,
-    "Thm3.builtdr_tight": _P, "Thm3.termination_tight": _P,
+    "Thm3.builtdr_tight": _P, "Thm3.termination_tight": _P, "Thm3.box_nesting": _P,
     "Prop1.state_meaning": _P, "Prop2.endpoints": _P, "Prop3.layer_free": _P,
     "Prop4.rest_free": _P, "Prop5.optpath_is_path": _P, "Prop5.printed": _R,
     "Prop6.opt_layer_free": _P, "Prop7.opt_rest_free": _P,
