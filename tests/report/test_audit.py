@@ -37,7 +37,7 @@ from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
 from cfmpa.report._audit import _proof_sections, _verdict, contract_rows
 from cfmpa.report._obligations import load_proofs
-from cfmpa.report._provenance import git_state
+from cfmpa.report._provenance import MAX_PATHS, REPORTED_DISTRIBUTIONS, git_state
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
@@ -144,8 +144,11 @@ def test_provenance_records_the_run(report, tiny_file):
                               capture_output=True, text=True, check=False).stdout.strip()
         assert kind == "commit"
         assert p["git"]["clean"] is (p["git"]["modified"] + p["git"]["untracked"] == 0)
-    for lib in ("python", "numpy", "z3", "matplotlib"):
-        assert p["versions"][lib] and p["versions"][lib] in report["html"]
+    for lib in ("python", "numpy", "z3", "shapely", *REPORTED_DISTRIBUTIONS):
+        assert p["versions"][lib] and p["versions"][lib] != "not installed", lib
+        assert f"{lib} {p['versions'][lib]}" in report["html"], lib
+    for entry in p["git"]["paths"]:
+        assert str(escape(entry["path"])) in report["html"]
 
 
 @pytest.mark.skipif(shutil.which("git") is None, reason="git is not installed")
@@ -159,11 +162,20 @@ def test_git_state_tells_clean_from_modified_and_untracked(tmp_path):
     git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "a")
     state = git_state(tmp_path)
     assert state["available"] and state["clean"] is True and len(state["commit"]) == 40
+    assert state["paths"] == [] and state["paths_omitted"] == 0
     (tmp_path / "b.txt").write_text("b\n")
     after = git_state(tmp_path)
-    assert after | {"note": ""} == state | {"clean": False, "untracked": 1, "note": ""}
+    assert after | {"note": ""} == state | {"clean": False, "untracked": 1, "note": "",
+                                            "paths": [{"status": "??", "path": "b.txt"}]}
     (tmp_path / "a.txt").write_text("changed\n")
-    assert (git_state(tmp_path)["modified"], git_state(tmp_path)["clean"]) == (1, False)
+    now = git_state(tmp_path)
+    assert (now["modified"], now["clean"]) == (1, False)
+    assert now["paths"] == [{"status": "M", "path": "a.txt"}, {"status": "??", "path": "b.txt"}]
+    for k in range(MAX_PATHS + 3):
+        (tmp_path / f"u{k:02d}.txt").write_text("u\n")
+    many = git_state(tmp_path)
+    assert len(many["paths"]) == MAX_PATHS and many["paths_omitted"] == 5
+    assert many["untracked"] == MAX_PATHS + 4 and "the first 20 listed" in many["note"]
 
 
 def test_summary_counts_match_the_obligations(report):
@@ -375,9 +387,9 @@ def _golden(name: str, text: str) -> None:
 
 
 #: Parts of report.json whose keys belong to other modules' records (contracts, certificate,
-#: a finding's own numbers, the campaign's cases) or to the environment (versions).
+#: a finding's own numbers, the campaign's cases) or to the environment (versions, git paths).
 _OPEN = ("findings[].data", "scenarios[].variants[].contracts", "scenarios[].variants[].clearance",
-         "scenarios[].variants[].kernel",
+         "scenarios[].variants[].kernel", "provenance.git.paths",
          "scenarios[].variants[].timings_s", "selftest.rows[]", "provenance.versions",
          "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks")
 
