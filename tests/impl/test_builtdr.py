@@ -2,17 +2,19 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import factory
-from cfmpa.impl import build_dr, check_containment
-from cfmpa.spec import Variant, load_scenario, make_grid
-from cfmpa.spec._builtdr_post import dr_postcondition
+from cfmpa.impl import build_dr, check_containment, right_regions
+from cfmpa.impl._fast_builtdr import build_dr_fast
+from cfmpa.spec import EPS, Variant, load_scenario, make_grid, parse_scenario
+from cfmpa.spec._builtdr_post import BAND, dr_postcondition, expected_cells
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 VARIANTS = list(Variant)
@@ -110,3 +112,89 @@ def test_decision_frees_only_pairs_proved_apart_nan_blocks():
     nan_a = sq.copy()
     nan_a[0, 0] = np.nan
     assert blocked_against(nan_a, PolygonSet.of(far[None]), 1e-9).tolist() == [True]
+
+
+# ---- Theorem 1/3's postcondition on random small scenarios, and a random flipped cell ----
+
+@st.composite
+def small_scenarios(draw, max_cells=4000):
+    """Coarse random workcells (a few hundred to a few thousand cells): goal below start in
+    either joint (modified's s = -1) and narrow, off-centre right limits included."""
+    f = st.floats
+    dt = draw(st.sampled_from([0.15, 0.2, 0.25, 0.3]))
+    start = [draw(f(-3.0, 3.0)), draw(f(-3.0, 3.0))]
+    goal = [start[q] + draw(st.one_of(f(-1.5, -0.2), f(0.2, 1.5))) for q in range(2)]
+    limits = []
+    for _ in range(2):
+        lo = draw(f(-3.0, 1.0))
+        limits.append([lo, lo + draw(st.one_of(f(0.6, 2.0), st.just(2 * math.pi)))])
+    omega_r = [draw(f(1.0, 3.0)), draw(f(1.0, 3.0))]
+    doc = factory.doc(dt=dt, left__start=start, left__goal=goal,
+                      left__omega=[draw(f(0.5, 2.0)), draw(f(0.5, 2.0))],
+                      right__base=[draw(f(0.2, 0.8)), draw(f(-0.3, 0.3))],
+                      right__omega=omega_r, right__limits=limits,
+                      right__start_cell=[0, 0], right__goal_cell=[0, 0])
+    s = parse_scenario(doc, check_budget=False)
+    assume(200 <= s.cells <= max_cells)
+    return s
+
+
+def _check_postcondition_and_flip(s, variant, data):
+    g = make_grid(s)
+    dr = build_dr(s, variant, g)
+    report = dr_postcondition(s, variant, g, dr)
+    assert report.ok, report.mismatches
+    assert report.checked == dr.size
+    # Flip one random cell, in the direction the array allows: the spec must see it.
+    value = data.draw(st.sampled_from(sorted({int(x) for x in np.unique(dr)})))
+    cells = np.argwhere(dr == value)
+    k, i, j = (int(x) for x in cells[data.draw(st.integers(0, len(cells) - 1))])
+    dist = float(expected_cells(s, variant, g, [k], [i], [j])[0])
+    assume(abs(dist - EPS) > BAND)          # a cell in the indeterminate band is accepted either way
+    bad = dr.copy()
+    bad[k, i, j] = 1 - value
+    flipped = dr_postcondition(s, variant, g, bad)
+    assert not flipped.ok
+    assert [(m.layer, m.cell, m.got) for m in flipped.mismatches] == [(k, (i, j), 1 - value)]
+
+
+@settings(max_examples=12, deadline=None)
+@given(s=small_scenarios(), variant=st.sampled_from(VARIANTS), data=st.data())
+def test_postcondition_holds_on_random_scenarios_and_sees_a_random_flip(s, variant, data):
+    _check_postcondition_and_flip(s, variant, data)
+
+
+@pytest.mark.slow
+@settings(max_examples=300, deadline=None)
+@given(s=small_scenarios(max_cells=20000), variant=st.sampled_from(VARIANTS), data=st.data())
+def test_postcondition_holds_on_many_random_scenarios_slow(s, variant, data):
+    _check_postcondition_and_flip(s, variant, data)
+
+
+@pytest.mark.parametrize("variant", VARIANTS, ids=str)
+def test_postcondition_with_goal_below_start_and_narrow_limits(variant):
+    # A fixed case of what the random test covers: both joints run backwards (s = -1), the right
+    # arm's limits are far from [0, 2 pi].
+    s = factory.scenario(left__start=[1.6, 2.2], left__goal=[0.3, 0.8],
+                         right__limits=[[1.0, 3.0], [-1.2, 0.9]], right__omega=[1.5, 1.5],
+                         right__start_cell=[0, 0], right__goal_cell=[1, 1])
+    assert all(s.left.goal[q] < s.left.start[q] for q in range(2))
+    g = make_grid(s)
+    dr = build_dr(s, variant, g)
+    assert 0 < dr.mean() < 1
+    report = dr_postcondition(s, variant, g, dr)
+    assert report.ok, report.mismatches
+
+
+# ---- D_R nesting on every bundled scenario, with the fast kernel ----
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_dr_nests_cell_by_cell_on_bundled_scenarios(path):
+    s = load_scenario(path)
+    g = make_grid(s)
+    rr = right_regions(s, g)
+    tight, modified, original = (build_dr_fast(s, v, g, right=rr, progress=False)
+                                 for v in (Variant.TIGHT, Variant.MODIFIED, Variant.ORIGINAL))
+    assert (tight <= modified).all()
+    assert (modified <= original).all()
+    assert (modified < original).any()   # the chain is not trivially equal
