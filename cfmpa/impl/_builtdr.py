@@ -14,7 +14,7 @@ import numpy.typing as npt
 
 from ..spec import EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid
 from ._collide import PolygonSet, blocked_against, pad_polygons
-from ._regions import Polygon, convex_hull, swept_region
+from ._regions import Polygon, swept_region
 
 __all__ = [
     "LeftRegions",
