@@ -212,9 +212,14 @@ def _prop67(rest: bool) -> Z3Query:
     hyps = st.base() + _optimal_hyps(st, O) + (
         ("k >= N" if rest else "k < N", when),
         ("O holds (i, j) at step k", z3.And(pos[0] == i, pos[1] == j)))
-    layer = st.d.N if rest else k
-    return Z3Query((VC("opt_rest_free" if rest else "opt_layer_free", hyps,
-                       st.P[layer, i, j] == 0, key_premise="O = optpath, a path existing (Prop 5)"),))
+    if rest:
+        # Where R is layer N-1 (original, modified: BuiltDR copies it), layer N-1 is free too.
+        copy = z3.ForAll([i, j], st.P[st.d.N, i, j] == st.P[st.d.N - 1, i, j])
+        goal = z3.And(st.P[st.d.N, i, j] == 0, z3.Implies(copy, st.P[st.d.N - 1, i, j] == 0))
+    else:
+        goal = st.P[k, i, j] == 0
+    return Z3Query((VC("opt_rest_free" if rest else "opt_layer_free", hyps, goal,
+                       key_premise="O = optpath, a path existing (Prop 5)"),))
 
 
 def _def4_printed() -> Z3Query:
@@ -236,6 +241,37 @@ def _def4_printed() -> Z3Query:
         _SMALL(st), _BINARY(st))
     goal = st.P[k, st.goal[0], st.goal[1]] == 0
     return Z3Query((VC("after_the_list", hyps, goal),), render=_render_path(st, L, k))
+
+
+def _def4_off_grid() -> Z3Query:
+    """Definition 4 as printed constrains a step only when both its cells are grid cells: a list
+    that leaves the grid passes, even where every cell of D_R is blocked."""
+    st = _setting()
+    L = z3_path("L")
+    kk = z3.Int("og!k")
+    a, b, c = z3.Ints("og!a og!b og!c")
+    listed = lambda f: z3.ForAll([kk], z3.Implies(z3.And(0 <= kk, kk < L.length), f))  # noqa: E731
+    hyps = st.base() + (
+        ("is_path L (Definition 4 as printed)", is_path_paper(st.P, st.d, st.start, st.goal, L)),
+        ("L's cells are pairs of naturals (HOL's num)", listed(z3.And(L.xs[kk] >= 0,
+                                                                      L.ys[kk] >= 0))),
+        ("every cell of every layer blocked", z3.ForAll([a, b, c], st.P[a, b, c] == 1)),
+        ("N = m = n = 3, start (0, 0), goal (2, 2)",
+         z3.And(st.d.N == 3, st.d.m == 3, st.d.n == 3, st.start[0] == 0, st.start[1] == 0,
+                st.goal[0] == 2, st.goal[1] == 2)),
+        ("LENGTH(L) = 3", L.length == 3),
+        # A small corner, so the counterexample reads well: it is one all the same.
+        ("cells <= 9", listed(z3.And(L.xs[kk] <= 9, L.ys[kk] <= 9))))
+    goal = listed(in_grid(st.d, L.cell(kk)))
+
+    def render(m: z3.ModelRef) -> str:
+        ev = lambda e: m.eval(e, model_completion=True)  # noqa: E731
+        cells = [(int(str(ev(L.xs[q]))), int(str(ev(L.ys[q])))) for q in range(3)]
+        return (f"N = m = n = 3, every cell of every layer blocked (P = 1), start (0, 0), goal "
+                f"(2, 2): L = {cells} passes the printed is_path, since a step is constrained only "
+                "when both its cells are grid cells; it leaves the grid (under the fixed is_path nothing passes: the start is "
+                "blocked at step 0)")
+    return Z3Query((VC("off_grid", hyps, goal),), render=render)
 
 
 def _def4_fixed() -> Z3Query:
@@ -273,19 +309,30 @@ def path_obligations() -> list[Obligation]:
                    "(an optimum exists once a path does; assumed, see the ledger).", Z, P, _prop5),
         Obligation("Prop5.printed", G, "Property 5 as printed",
                    "For all startp, goalp, optpath(startp, goalp) is a path: refuted when no path "
-                   "exists (start blocked at step 0): Hilbert choice then picks a non-path.",
+                   "exists (start blocked at step 0): Hilbert choice then picks a non-path. "
+                   "is_path here is the fixed one (DESIGN §5), on purpose, an exception to "
+                   "'printed means the printed definitions': the flaw refuted is Property 5's "
+                   "missing hypothesis that a path exists, which does not depend on Definition "
+                   "4 (whose own flaws are Def4.is_path_printed and Def4.is_path_printed_off_grid).",
                    Z, R, _prop5_printed),
         Obligation("Prop6.opt_layer_free", G, "Property 6",
                    "optpath = O (a path existing), k < N and O holds (i, j) at step k imply "
                    "P[k,i,j] = 0.", Z, P, lambda: _prop67(False)),
         Obligation("Prop7.opt_rest_free", G, "Property 7",
                    "optpath = O (a path existing), k >= N and O holds (i, j) at step k imply "
-                   "P[N,i,j] = 0 (the rest layer; layer N-1 where R is layer N-1).",
+                   "P[N,i,j] = 0 (the rest layer) and, where R is layer N-1 (original, "
+                   "modified: P[N] = P[N-1] on every cell), P[N-1,i,j] = 0.",
                    Z, P, lambda: _prop67(True)),
         Obligation("Def4.is_path_printed", G, "Definition 4 as printed",
                    "Definition 4 as printed keeps the subordinate safe until the principal "
                    "arrives: refuted, a list that ends early and waits at a goal blocked in a "
                    "later layer passes it (LENGTH(L) <= k < N unchecked).", Z, R, _def4_printed),
+        Obligation("Def4.is_path_printed_off_grid", G, "Definition 4 as printed",
+                   "Definition 4 as printed keeps the path in the grid: refuted, its step "
+                   "condition applies only when L_k and L_k+1 are both grid cells (i < m, "
+                   "j < n), so with N = m = n = 3 and every cell blocked a 3-cell list from "
+                   "(0, 0) to (2, 2) through a cell outside the grid passes (cells are naturals, "
+                   "as in HOL).", Z, R, _def4_off_grid),
         Obligation("Def4.is_path_fixed_safe", G, "Definition 4 fixed (DESIGN §5)",
                    "The fixed is_path(L) implies that at every step k >= 0 the cell held is in "
                    "the grid and free in the layer in force (P[k] for k < N, the rest layer "

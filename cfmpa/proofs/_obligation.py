@@ -3,7 +3,9 @@
 An obligation names a statement of the paper (or of DESIGN) and how it is checked. Discharging
 it gives a ``Proof``: the verdict, the time, the solver's own statistics, and for a ``sat``
 answer a readable counterexample. A Z3 ``unknown`` is reported as UNKNOWN, never as proved, and
-every Z3 proof first shows its hypotheses satisfiable (else it FAILS as vacuous).
+every Z3 proof first shows its hypotheses satisfiable (else it FAILS as vacuous). Every solver
+call has a timeout; sympy and data checks, which have none of their own, run under a wall-clock
+limit (SIGALRM in the main thread, a watcher thread elsewhere) and end UNKNOWN past it.
 """
 
 from __future__ import annotations

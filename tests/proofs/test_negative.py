@@ -160,3 +160,14 @@ def test_the_fixed_is_path_closes_the_printed_gap():
     strengthened = VC(vc.name, vc.hypotheses + (("fixed is_path", fixed),), vc.goal)
     assert _answer(vc) == z3.sat
     assert _answer(strengthened) == z3.unsat
+
+
+def test_the_fixed_is_path_keeps_the_list_in_the_grid():
+    # Def4.is_path_printed_off_grid's hypotheses with the fixed is_path added: now unsat.
+    from cfmpa.proofs._obl_paths import _def4_off_grid, _setting
+    from cfmpa.spec._z3defs import is_path_fixed, z3_path
+    vc = _def4_off_grid().vcs[0]
+    st = _setting()
+    fixed = is_path_fixed(st.P, st.d, st.start, st.goal, z3_path("L"))
+    assert _answer(vc) == z3.sat
+    assert _answer(VC(vc.name, vc.hypotheses + (("fixed is_path", fixed),), vc.goal)) == z3.unsat

@@ -116,7 +116,7 @@ def test_full_run_discharges_everything_as_expected(tmp_path: Path):
     assert all(o["verdict"] == o["expected"] for o in doc["obligations"])
     refuted = {o["id"] for o in doc["obligations"] if o["verdict"] == "refuted as expected"}
     assert refuted == {"Def1.segment_printed", "Margin.naive_hull", "Prop5.printed",
-                       "Def4.is_path_printed", "Prop8.printed"}
+                       "Def4.is_path_printed", "Def4.is_path_printed_off_grid", "Prop8.printed"}
     assert all(o["counterexample"] for o in doc["obligations"] if o["id"] in refuted)
     assert [a["id"] for a in doc["assumptions"]] == [a.id for a in ASSUMPTIONS]
     assert "Summary of proof obligations" in text and "Assumptions (not proved)" in text
