@@ -14,8 +14,10 @@ and review the diff before committing.
 
 from __future__ import annotations
 
+import base64
 import copy
 import hashlib
+import html as html_lib
 import io
 import json
 import os
@@ -23,8 +25,10 @@ import re
 import shutil
 import struct
 import subprocess
+import urllib.parse
 import zlib
 from pathlib import Path
+from xml.etree import ElementTree
 
 import jsonschema
 import pytest
@@ -351,24 +355,83 @@ def test_unreadable_proofs_json_is_an_input_error(tmp_path, tiny_file):
         build_audit([str(tiny_file)], proofs_json=str(tmp_path / "bad.json"), compare_n=0)
 
 
+def test_every_embedded_picture_decodes(report):
+    from PIL import Image
+
+    uris = re.findall(r'(?:src|href)\s*=\s*"(data:[^"]*)"', report["html"])
+    wanted = {f["id"] for f in _figure_refs(report["doc"])}
+    assert len(uris) == len(wanted) > 0, "one embedded picture per figure of report.json"
+    for uri in uris:
+        head, _, body = uri.partition(",")
+        if head == "data:image/png;base64":
+            data = base64.b64decode(body, validate=True)
+            assert data[:8] == b"\x89PNG\r\n\x1a\n", head
+            with Image.open(io.BytesIO(data)) as img:
+                img.load()                    # decodes every scanline; raises if truncated
+                assert img.width > 100 and img.height > 100, img.size
+                assert len(img.getcolors(maxcolors=1 << 16) or range(1 << 16)) > 8, "blank"
+        elif head.startswith("data:image/svg+xml"):
+            text = (base64.b64decode(body).decode() if head.endswith(";base64")
+                    else urllib.parse.unquote(body))
+            assert ElementTree.fromstring(text).tag.endswith("svg")
+        else:
+            raise AssertionError(f"unexpected data URI kind {head!r}")
+
+
+def test_picture_check_catches_a_broken_picture(report):
+    # The decoding above must fail on a truncated PNG, or it checks nothing.
+    from PIL import Image
+
+    (uri,) = re.findall(r'src="(data:image/png;base64,[^"]*)"', report["html"])[:1]
+    data = base64.b64decode(uri.partition(",")[2])
+    with pytest.raises((OSError, SyntaxError)):
+        with Image.open(io.BytesIO(data[: len(data) // 2])) as img:
+            img.load()
+
+
+#: Appended to a scratch copy of the page: after load, lists every picture that did not decode.
+_IMG_PROBE = """<script>
+window.addEventListener("load", () => {
+  const imgs = Array.from(document.images);
+  const bad = imgs.filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.alt || i.src.slice(0, 40));
+  const out = document.createElement("pre");
+  out.id = "img-probe";
+  out.textContent = JSON.stringify({count: imgs.length, bad: bad});
+  document.body.appendChild(out);
+});
+</script>"""
+
+
+def _chromium(tmp_path, *args):
+    return subprocess.run(
+        [str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+         "--no-first-run", "--disable-background-networking", "--disable-component-update",
+         "--disable-sync", f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr",
+         "--v=0", *args], capture_output=True, text=True, timeout=180, check=False)
+
+
 @pytest.mark.browser
 def test_report_renders_in_headless_chromium(report, tmp_path):
     if not CHROMIUM.exists():
         pytest.skip("/usr/bin/chromium is absent (Debian package 'chromium'; .ci/run installs it)")
     shot = tmp_path / "report.png"
     url = (report["out"] / "report.html").resolve().as_uri()
-    proc = subprocess.run(
-        [str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-         "--no-first-run", "--disable-background-networking", "--disable-component-update",
-         "--disable-sync", f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr",
-         "--v=0", f"--screenshot={shot}", "--window-size=1280,4000", url],
-        capture_output=True, text=True, timeout=180, check=False)
+    proc = _chromium(tmp_path, f"--screenshot={shot}", "--window-size=1280,4000", url)
     assert proc.returncode == 0, proc.stderr[-2000:]
     # A resource that failed to load, or a script error, is logged as a console message.
     assert not re.search(r"Failed to load resource|Uncaught|net::ERR_", proc.stderr), proc.stderr
     width, height, distinct = _png_stats(shot.read_bytes())
     assert (width, height) == (1280, 4000)
     assert distinct > 50, "the screenshot is (nearly) blank"
+    # Every picture decoded in the browser: a scratch copy with a probe, read back from the DOM.
+    probe = tmp_path / "probe.html"
+    probe.write_text(report["html"].replace("</body>", _IMG_PROBE + "\n</body>"))
+    dom = _chromium(tmp_path, "--dump-dom", "--virtual-time-budget=10000", probe.as_uri())
+    assert dom.returncode == 0, dom.stderr[-2000:]
+    found = re.search(r'<pre id="img-probe">(.*?)</pre>', dom.stdout, re.S)
+    assert found, "the probe did not run: " + dom.stderr[-1000:]
+    result = json.loads(html_lib.unescape(found.group(1)))
+    assert result["count"] == len(_figure_refs(report["doc"])) and result["bad"] == [], result
 
 
 # --- helpers --------------------------------------------------------------------------------------
@@ -376,6 +439,13 @@ def test_report_renders_in_headless_chromium(report, tmp_path):
 def _results(report):
     path = Path(report["doc"]["obligations"]["source"].removeprefix("read from "))
     return {"path": path, "text": path.read_text()}
+
+
+def _figure_refs(doc):
+    """Every figure report.json refers to (findings, scenarios, campaign)."""
+    refs = [f["figure"] for f in doc["findings"] if f.get("figure")]
+    refs += [f for s in doc["scenarios"] for f in s["figures"]]
+    return refs + ([doc["compare"]["figure"]] if doc["compare"].get("figure") else [])
 
 
 def _golden(name: str, text: str) -> None:
