@@ -79,14 +79,31 @@ def test_naive_hull_of_end_configurations_is_unsound():
 def test_naive_hull_search_finds_a_protrusion_that_grows_with_the_box():
     arm = factory.scenario().left
     worst = []
-    for w in (0.04, 0.3):
+    for w in (0.04, 0.3, 0.6):
         box = ((0.3, 0.3 + w), (0.8, 0.8 + w))
         hull = naive_hull(arm, 1, box)
         ts = np.linspace(0.0, 1.0, 21)
         worst.append(max(-inside(hull, link_rectangles(arm, 0.3 + a * w, 0.8 + b * w, 1))
                          for a in ts for b in ts))
-    assert 0 < worst[0] < worst[1]
+    assert 0 < worst[0] < worst[1] < worst[2]
     assert worst[1] > 5e-3  # millimetres at a 0.3 rad sweep
+
+
+# The README's second figure, kept as a regression example: at a 0.6 rad sweep of both joints
+# the naive hull misses link 2 of the default left arm by ~28.5 mm (at theta1 mid-sweep).
+WIDE_BOX = ((0.3, 0.9), (0.8, 1.4))
+WIDE_THETA = (0.6, 0.8)
+WIDE_PROTRUSION_M = 0.028539
+
+
+def test_naive_hull_misses_the_link_by_28_mm_at_a_wide_sweep():
+    arm = factory.scenario().left
+    rect = link_rectangles(arm, *WIDE_THETA, 1)
+    protrusion = -inside(naive_hull(arm, 1, WIDE_BOX), rect)
+    assert protrusion > 25e-3
+    assert protrusion == pytest.approx(WIDE_PROTRUSION_M, rel=1e-3)
+    region = swept_region(arm, 1, WIDE_BOX, (0.3, 0.8), (0.02, 0.02))
+    assert inside(region, rect) > 0
 
 
 @pytest.mark.parametrize("scale", [1.0, 1e160, 1e300])
