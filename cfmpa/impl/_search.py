@@ -44,9 +44,16 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell) -> Sea
     the states (N, goal, d) plus a final J2 term |d|_1. The returned list drops trailing waits.
     At the capped step waits are dropped too: wait-then-move costs |p| + |d| >= |d - p| in J2.
 
-    Ties (deterministic): walking back from the goal, the last move is the smallest in MOVES order
-    among optimal ones; each state's predecessor is, among optimal ones, the one at the earlier
-    step (a DAG step before a capped one), then the one whose previous move is smallest.
+    Ties (deterministic), on the returned list L: it never waits at a step >= N before its end,
+    L_{k+1} != L_k for N <= k < len - 1 (dropping such a wait keeps a path valid and costs no
+    more), and among the optimal lists that do not, it is the least by this order. Pad L with the goal to N + 1 cells if shorter (the arm
+    holds it until the principal stops): cells L_0 .. L_T, T = max(len - 1, N), moves
+    d_k = L_{k+1} - L_k. Rank the last move d_{T-1} by its index in MOVES; rank each earlier
+    d_k by its index if it arrives before step N (k + 1 < N), by 9 + its index if it arrives at
+    step N or later. The ranks read backwards, d_{T-1} first, are lexicographically least.
+    (Internally: the least last move over the goal states; then, for each state, its optimal
+    predecessor with the state at step N itself before one at a later step, then the one with
+    the least previous move.)
     Reasons, checked in this order: start blocked in layer 0, goal blocked in the rest layer,
     unreachable.
     """

@@ -11,9 +11,11 @@ from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
 from cfmpa.impl._search import _check_size, search_opt_path
-from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                               J1, J2, SearchResult, SearchStatus, is_path, opt_path)
-from cfmpa.spec._paths_z3 import z3_opt_path
+from cfmpa.spec._paths import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED,
+                               REASON_UNREACHABLE, J1, J2, SearchResult, SearchStatus, is_path,
+                               opt_path)
+from cfmpa.spec._paths_z3 import length_bound, z3_opt_path
+from path_enumeration import optimal_lists
 
 Cell = tuple[int, int]
 
@@ -258,3 +260,91 @@ def test_refuses_grids_too_large_for_exact_cost_keys() -> None:
     _check_size(71, 316, 316)   # the default scenario is far inside the limit
     with pytest.raises(InputError, match="too large"):
         _check_size(1 << 29, 1, 1)
+
+
+# --- the tie-break rule of search_opt_path's docstring, by enumeration ---------------------------
+
+def tie_rank(path: tuple[Cell, ...], N: int) -> tuple[int, ...]:
+    """The docstring's order: pad to N + 1 cells, read the moves backwards, the last one ranked
+    by its MOVES index, each earlier d_k by its index, plus 9 if it arrives at step N or later."""
+    padded = list(path) + [path[-1]] * (N + 1 - len(path))
+    d = [(b[0] - a[0], b[1] - a[1]) for a, b in zip(padded, padded[1:])]
+    T = len(d)
+    return (MOVES.index(d[T - 1]),
+            *(MOVES.index(d[k]) + (9 if k + 1 >= N else 0) for k in range(T - 2, -1, -1)))
+
+
+def waits_after_N(path: tuple[Cell, ...], N: int) -> bool:
+    return any(path[k + 1] == path[k] for k in range(N, len(path) - 1))
+
+
+@st.composite
+def tiny_cases(draw: st.DrawFn, max_n: int = 3, max_side: int = 3
+               ) -> tuple[np.ndarray, Cell, Cell]:
+    """Grids small enough to enumerate every list up to length_bound: often free (many ties)."""
+    N = draw(st.integers(1, max_n))
+    m, n = draw(st.integers(1, max_side)), draw(st.integers(1, max_side))
+    density = draw(st.sampled_from([0.0, 0.0, 0.15, 0.3]))
+    seed = draw(st.integers(0, 2**32 - 1))
+    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
+    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    dr[0][start] = 0
+    dr[N][goal] = 0
+    return dr, start, goal
+
+
+def check_tie_rule(dr: np.ndarray, start: Cell, goal: Cell) -> int:
+    """The search returns the optimal list the documented rule picks; the number of optima."""
+    N = dr.shape[0] - 1
+    cost, optimal = optimal_lists(dr, start, goal, length_bound(dr))
+    got = search_opt_path(dr, start, goal)
+    if cost is None:
+        assert got.status is SearchStatus.NO_PATH
+        return 0
+    assert (got.J1, got.J2) == cost and got.path in optimal
+    # Every list the rule ranks has at most length_bound cells (its cells from step N on are
+    # distinct: a loop there holds a non-wait move and cutting it lowers J1), so none is missed.
+    eligible = [p for p in optimal if not waits_after_N(p, N)]
+    assert got.path == min(eligible, key=lambda p: tie_rank(p, N))
+    return len(optimal)
+
+
+@settings(max_examples=40, deadline=None)
+@given(tiny_cases())
+def test_ties_follow_the_documented_rule_on_every_optimum(case: tuple[np.ndarray, Cell, Cell]
+                                                           ) -> None:
+    ties = check_tie_rule(*case)
+    event("no path" if ties == 0 else "one optimum" if ties == 1 else "ties")
+
+
+@pytest.mark.slow
+@settings(max_examples=300, deadline=None)
+@given(tiny_cases(max_n=4))
+def test_ties_follow_the_documented_rule_many(case: tuple[np.ndarray, Cell, Cell]) -> None:
+    check_tie_rule(*case)
+
+
+def test_tie_rule_ranks_the_last_move_before_the_arrival_step() -> None:
+    # N = 1, 2 x 2 free, (1, 0) to (0, 1): three optima with (J1, J2) = (2, 4) that never wait.
+    # The diagonal arrives at step 1 = N with last move (-1, 1) (index 2); via (1, 1) the last
+    # move is (-1, 0) (index 1); via (0, 0) it is (0, 1) (index 5). The least last move wins,
+    # though that path arrives after step N.
+    dr = np.zeros((2, 2, 2), dtype=np.uint8)
+    cost, optimal = optimal_lists(dr, (1, 0), (0, 1), length_bound(dr))
+    never_wait = {p for p in optimal if all(a != b for a, b in zip(p, p[1:]))}
+    assert cost == (2, 4) and never_wait == {((1, 0), (0, 1)), ((1, 0), (1, 1), (0, 1)),
+                                             ((1, 0), (0, 0), (0, 1))}
+    assert search_opt_path(dr, (1, 0), (0, 1)).path == ((1, 0), (1, 1), (0, 1))
+
+
+def test_tie_rule_prefers_reaching_a_state_at_step_N() -> None:
+    # N = 2, 2 x 2 free, (1, 0) to (0, 1): both ((1, 0), (1, 1), (0, 1)) and the same with a
+    # wait at (1, 1) end with (-1, 0); the first reaches (1, 1) by step N, ranks (1, 5) against
+    # (1, 13, 5), and is returned.
+    dr = np.zeros((3, 2, 2), dtype=np.uint8)
+    cost, optimal = optimal_lists(dr, (1, 0), (0, 1), length_bound(dr))
+    assert cost == (2, 4) and ((1, 0), (1, 1), (1, 1), (0, 1)) in optimal
+    assert tie_rank(((1, 0), (1, 1), (0, 1)), 2) == (1, 5)
+    assert tie_rank(((1, 0), (1, 1), (1, 1), (0, 1)), 2) == (1, 13, 5)
+    assert search_opt_path(dr, (1, 0), (0, 1)).path == ((1, 0), (1, 1), (0, 1))
