@@ -136,15 +136,14 @@ def _sweep_margin() -> Z3Query:
     r1, r2a, r2b = z3.Reals("r1 r2a r2b")
     arc = lambda rad, turn: rad * turn * turn / 8  # noqa: E731 - Margin.arc_chord's bound
 
-    def bound(d: Vec, rad: z3.ArithRef, turn: z3.ArithRef, big: z3.ArithRef,
+    def bound(d: Vec, rad: z3.ArithRef, turn: z3.ArithRef, reach_max: z3.ArithRef,
               e_: z3.ArithRef, where: str) -> tuple[tuple[str, z3.BoolRef], ...]:
         return (
             (f"Margin.arc_chord at {where}: |.| <= r g^2/8", sqv(d) <= arc(rad, turn) * arc(rad, turn)),
-            (f"reach at {where}", inst(reach, [(r, rad), (big_, big), (g, turn)])),
+            (f"reach at {where}", inst(reach, [(r, rad), (big, reach_max), (g, turn)])),
             (f"square_monotone at {where}", inst(square_mono, [
                 (sa, arc(rad, turn)), (sb, e_), (sm, sqv(d))])),
             (f"nonneg at {where}", inst(nonneg, [(r, rad), (g, turn)])))
-    big_ = big
     glue = (
         ("e_base = R_base g1^2/8, e_elbow = R_elbow g2^2/8",
          z3.And(e1v == arc(rb, g1), e2v == arc(re_, g2))),
