@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["write_bytes_atomic", "write_json_atomic", "save_npy_atomic", "dumps_json"]
+__all__ = ["write_bytes_atomic", "write_json_atomic", "save_npy_atomic", "npy_bytes", "dumps_json"]
 
 
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
@@ -42,7 +42,12 @@ def write_json_atomic(path: str | os.PathLike[str], obj: Any) -> Path:
     return write_bytes_atomic(path, dumps_json(obj).encode("utf-8"))
 
 
-def save_npy_atomic(path: str | os.PathLike[str], array: np.ndarray) -> Path:
+def npy_bytes(array: np.ndarray) -> bytes:
+    """The .npy file's bytes for ``array`` (what save_npy_atomic writes)."""
     buf = io.BytesIO()
     np.save(buf, array, allow_pickle=False)
-    return write_bytes_atomic(path, buf.getvalue())
+    return buf.getvalue()
+
+
+def save_npy_atomic(path: str | os.PathLike[str], array: np.ndarray) -> Path:
+    return write_bytes_atomic(path, npy_bytes(array))

@@ -76,7 +76,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     s = load_scenario(args.scenario)
     build, search = _kernels(args.kernel)
     p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample,
-             stop=False, build=build, search=search)
+             stop=False, build=build, search=search, kernel=args.kernel)
     dr_path, plan_path = write_plan(p, args.out)
     violations = p.violations
     g, r, t = p.grid, p.search, p.timings_s

@@ -4,13 +4,15 @@ The outputs are DESIGN §9's dr.npy and plan.json. Checked, all in full: D_R's s
 and Theorem 1/3's postcondition for the plan's variant at every cell (the spec's own regions);
 the path by is_path; J1 and J2 as reported; optimality against opt_path (the spec's independent
 search); the continuous-time certificate. Also, when plan.json states them: the scenario's
-hash, the grid, and the angles of the path's cells.
+hash, the grid, the angles of the path's cells, and dr_sha256 against the dr file's bytes (a
+mismatch means the two files are not from the same run).
 Exit 0 when everything holds, 1 with a listing of what failed, 2 when an input cannot be read
 (missing file, not .npy, bad JSON, missing or mistyped keys), as ``file: error: ...``.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import sys
@@ -45,6 +47,7 @@ class PlanDoc:
     sha256: str | None
     grid: dict[str, Any] | None
     angles: tuple[tuple[float, float], ...] | None
+    dr_sha256: str | None = None
 
 
 @dataclass(frozen=True)
@@ -92,9 +95,16 @@ def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | P
         return 2
     print(f"check     {Path(dr_path)} and {Path(plan_path)} against {s.name} ({scenario_path}), "
           f"variant {doc.variant.value}")
-    report = check_outputs(s, dr, doc)
+    report = check_outputs(s, dr, doc, dr_sha256=_file_sha256(dr_path))
     print(report.text())
     return 0 if report.ok else 1
+
+
+def _file_sha256(path: str | Path) -> str | None:
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:                     # read_dr has just read it; a vanished file is not ours
+        return None
 
 
 def read_dr(path: str | Path) -> npt.NDArray[Any]:
@@ -161,6 +171,9 @@ def read_plan(path: str | Path) -> PlanDoc:
     sha = doc.get("scenario_sha256")
     if sha is not None and not isinstance(sha, str):
         raise bad("scenario_sha256", sha, "must be a string")
+    dr_sha = doc.get("dr_sha256")
+    if dr_sha is not None and not isinstance(dr_sha, str):
+        raise bad("dr_sha256", dr_sha, "must be a string")
     grid = doc.get("grid")
     if grid is not None and not isinstance(grid, dict):
         raise bad("grid", grid, "must be an object")
@@ -171,13 +184,21 @@ def read_plan(path: str | Path) -> PlanDoc:
                 for a in angles):
             raise bad("angles", _short(angles), "must be a list of [t1, t2] number pairs")
         angles = tuple((float(a[0]), float(a[1])) for a in angles)
-    return PlanDoc(variant, result, sha, grid, angles)
+    return PlanDoc(variant, result, sha, grid, angles, dr_sha)
 
 
-def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc) -> CheckReport:
-    """Every check of this module on already-read outputs (see the module docstring)."""
+def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc, *,
+                  dr_sha256: str | None = None) -> CheckReport:
+    """Every check of this module on already-read outputs (see the module docstring).
+
+    ``dr_sha256`` is the hash of the dr file's bytes, checked against plan.json's when both
+    are known."""
     g = make_grid(s)
     lines: list[CheckLine] = []
+    if doc.dr_sha256 is not None and dr_sha256 is not None:
+        lines.append(_line(doc.dr_sha256 == dr_sha256, "plan.json dr_sha256 is the dr file's "
+                           "(the two files are from one run)",
+                           (("plan's", doc.dr_sha256), ("file's", dr_sha256))))
     if doc.sha256 is not None and s.sha256:
         lines.append(_line(doc.sha256 == s.sha256, "plan.json scenario_sha256 is the scenario "
                            "file's", (("plan's", doc.sha256), ("file's", s.sha256))))

@@ -9,6 +9,7 @@ violations (they are the evidence); `cfmpa plan` then exits 1.
 
 from __future__ import annotations
 
+import hashlib
 import platform
 import time
 from collections.abc import Callable
@@ -20,10 +21,10 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from .._io import dumps_json, save_npy_atomic, write_bytes_atomic
+from .._io import dumps_json, npy_bytes, write_bytes_atomic
 from ..errors import ContractViolation
-from ..impl import build_dr_fast, search_opt_path_fast
-from ..spec import Grid, Scenario, Variant, make_grid
+from ..impl import build_dr, build_dr_fast, search_opt_path, search_opt_path_fast
+from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
 from ..spec._certificate import Certificate, certificate_json, certify, require_clear
 from ..spec._paths import SearchResult, SearchStatus
 from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
@@ -48,6 +49,7 @@ class PlanResult:
     contracts: dict[str, Any] | None
     timings_s: dict[str, float] = field(default_factory=dict)
     runs: tuple[TripleRun, ...] = ()
+    kernel: str = "custom"
 
     @property
     def free_fraction(self) -> float:
@@ -74,7 +76,8 @@ def versions() -> dict[str, str]:
 
 def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
          sample: int | None = None, stop: bool = True, grid: Grid | None = None,
-         build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast) -> PlanResult:
+         build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast,
+         kernel: str | None = None) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
 
     ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
@@ -84,13 +87,20 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     postcondition and certificate violations are recorded in ``contracts`` and the run goes on
     (a failed precondition always stops it). ``grid``, ``build`` and ``search`` replace the scenario's grid
     and the kernels (by default the fast ones, bit-identical to the reference and tested against
-    it): for the reference itself, another implementation, or a seeded fault.
+    it): for the reference itself, another implementation, or a seeded fault. ``kernel`` names
+    them in plan.json ("fast", "reference"; by default told from ``build`` and ``search``, and
+    "custom" for anything else). With the fast kernels, the first run in a process first calls
+    them on a tiny input, so that timings_s.kernel_load holds numba's compile or cache-load time
+    and build_dr / search hold the work alone (kernel_load is 0.0 once they are loaded).
     """
     v = Variant(variant)
     settings = Settings.of(contracts, seed, sample)
     g = grid or make_grid(s)
     enforce = settings.mode is not Mode.OFF
+    kernel = kernel or _kernel_name(build, search)
     t: dict[str, float] = {}
+    if kernel == "fast":
+        t["kernel_load"] = _load_fast_kernels()
     t0 = time.perf_counter()
     dr, runs = checked_build_dr(s, v, g, settings, build=_timed(build, t, "build_dr"), stop=stop)
     if enforce:
@@ -112,7 +122,40 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
                             _certificate_violation(cert) if cert and not cert.clear else None,
                             certificate_checked=True)
     return PlanResult(scenario=s, variant=v, grid=g, dr=dr, search=result, certificate=cert,
-                      contracts=record, timings_s=t, runs=tuple(runs))
+                      contracts=record, timings_s=t, runs=tuple(runs), kernel=kernel)
+
+
+def _kernel_name(build: Builder, search: Searcher) -> str:
+    if build is build_dr_fast and search is search_opt_path_fast:
+        return "fast"
+    if build is build_dr and search is search_opt_path:
+        return "reference"
+    return "custom"
+
+
+#: A workcell with a 4 x 14 x 14 grid: calling the fast kernels on it loads (or compiles) every
+#: numba specialisation a real run uses (same dtypes and layouts), in milliseconds of work.
+_WARM_UP = {
+    "name": "kernel-warm-up", "purpose": "load the fast kernels", "dt": 0.5,
+    "left": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.0, 0.0],
+             "start": [0.3, 0.8], "goal": [1.6, 2.2]},
+    "right": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.6, 0.0],
+              "limits": [[0.0, 6.283185307179586], [0.0, 6.283185307179586]],
+              "start_cell": [0, 4], "goal_cell": [7, 4]},
+}
+_loaded: list[float] = []
+
+
+def _load_fast_kernels() -> float:
+    """Seconds spent loading the fast kernels in this process by this call (0.0 if done before)."""
+    if _loaded:
+        return 0.0
+    t0 = time.perf_counter()
+    s = parse_scenario(_WARM_UP, check_budget=False)
+    dr = build_dr_fast(s, Variant.MODIFIED, make_grid(s), progress=False)
+    search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False)
+    _loaded.append(time.perf_counter() - t0)
+    return _loaded[0]
 
 
 #: The certificate's name in violations (it is not one of the paper's triples).
@@ -138,8 +181,14 @@ def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[...,
     return run
 
 
-def plan_json(p: PlanResult) -> dict[str, Any]:
-    """The plan.json document of DESIGN §9 (keys are stable: add, never rename)."""
+def plan_json(p: PlanResult, dr_bytes: bytes | None = None) -> dict[str, Any]:
+    """The plan.json document of DESIGN §9 (keys are stable: add, never rename).
+
+    ``dr_sha256`` is the sha256 of dr.npy's bytes (``dr_bytes``, by default ``npy_bytes(p.dr)``,
+    what write_plan writes), so that a dr.npy from another run is detectable. In ``clearance``,
+    ``min_m`` / ``t_s`` are the least SAMPLED distance and its instant (an upper bound on the
+    true minimum); ``lower_bound_m`` is the PROVED lower bound over every instant.
+    """
     r = p.search
     found = r.status is SearchStatus.FOUND
     g = p.grid
@@ -157,6 +206,8 @@ def plan_json(p: PlanResult) -> dict[str, Any]:
         "J2": r.J2 if found else None,
         "path_length": len(r.path),
         "free_fraction": p.free_fraction,
+        "dr_sha256": hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest(),
+        "kernel": p.kernel,
         "clearance": certificate_json(p.certificate) if p.certificate is not None else None,
         "contracts": p.contracts,
         "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
@@ -165,8 +216,10 @@ def plan_json(p: PlanResult) -> dict[str, Any]:
 
 
 def write_plan(p: PlanResult, out: str | Path) -> tuple[Path, Path]:
-    """Write DIR/dr.npy and DIR/plan.json, each atomically (temporary name, then rename)."""
+    """Write DIR/dr.npy and DIR/plan.json, each atomically (temporary name, then rename);
+    plan.json's dr_sha256 is the hash of the very bytes written to dr.npy."""
     out = Path(out)
-    dr_path = save_npy_atomic(out / "dr.npy", p.dr)
-    plan_path = write_bytes_atomic(out / "plan.json", dumps_json(plan_json(p)).encode())
+    data = npy_bytes(p.dr)
+    dr_path = write_bytes_atomic(out / "dr.npy", data)
+    plan_path = write_bytes_atomic(out / "plan.json", dumps_json(plan_json(p, data)).encode())
     return dr_path, plan_path

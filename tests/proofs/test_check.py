@@ -72,7 +72,8 @@ def test_a_wrong_cell_fails_theorem_3_with_its_values(outputs, tmp_path, capsys)
     at = lines.index(next(x for x in lines if x.startswith("FAIL  Theorem 3 post.cells")))
     assert f"layer was {k}" in lines[at + 1] and f"cell was {[i, j]}" in lines[at + 2]
     assert any(x.startswith("FAIL  Theorem 4 pre.dr.spec") for x in lines)
-    assert lines[-1].startswith("result: 2 of")
+    assert any(x.startswith("FAIL  plan.json dr_sha256") for x in lines)   # not plan's D_R
+    assert lines[-1].startswith("result: 3 of")
 
 
 def test_the_wrong_dtype_fails_the_shape_check_and_skips_the_path(outputs, tmp_path, capsys):
@@ -91,7 +92,9 @@ def test_costs_are_checked_even_when_dr_has_the_wrong_shape(outputs, tmp_path, c
     doc["J2"] += 3
     code, out, _ = _run(outputs, tmp_path, capsys, dr=dr, doc=doc)
     assert code == 1
-    assert _fails(out) == ["FAIL  Theorem 3 post.shape", "FAIL  Theorem 4 post.costs"]
+    assert _fails(out) == ["FAIL  plan.json dr_sha256 is the dr file's (the two files are "
+                           "from one run)", "FAIL  Theorem 3 post.shape",
+                           "FAIL  Theorem 4 post.costs"]
     assert f"reported J1, J2 was {[doc['J1'], doc['J2']]}" in out
     assert f"recomputed J1, J2 was {[doc['J1'], doc['J2'] - 3]}" in out
 
@@ -235,10 +238,26 @@ def test_a_bad_scenario_exits_2(outputs, tmp_path, capsys):
     assert code == 2 and "cannot be read" in capsys.readouterr().err
 
 
+def test_a_dr_file_from_another_run_fails_the_hash(outputs, tmp_path, capsys):
+    # Same shape, one cell different: dr_sha256 in plan.json names the bytes written with it.
+    code, out, _ = _run(outputs, tmp_path, capsys)
+    assert "ok    plan.json dr_sha256 is the dr file's" in out
+    dr = np.load(outputs / "ref" / "dr.npy")
+    k, i, j = (int(x) for x in np.argwhere(dr == 1)[0])
+    dr[k, i, j] = 0
+    code, out, _ = _run(outputs, tmp_path, capsys, dr=dr)
+    assert code == 1 and "FAIL  plan.json dr_sha256 is the dr file's" in out
+    doc = _plan_doc(outputs)
+    doc["dr_sha256"] = 7
+    code, _, err = _run(outputs, tmp_path, capsys, doc=doc)
+    assert code == 2 and "error: dr_sha256 must be a string" in err
+
+
 def test_extra_keys_are_allowed_and_optional_claims_may_be_absent(outputs):
     s = load_scenario(outputs / "small.toml")
     doc = _plan_doc(outputs)
-    for key in ("grid", "angles", "scenario_sha256", "clearance", "contracts"):
+    for key in ("grid", "angles", "scenario_sha256", "clearance", "contracts", "dr_sha256",
+                "kernel"):
         doc.pop(key)
     doc["my_planner"] = {"version": 3}
     p = outputs / "minimal.json"

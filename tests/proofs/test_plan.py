@@ -130,6 +130,27 @@ def test_a_contact_is_a_violation_in_every_mode(mode):
         plan(s, fault.variant, contracts=mode, search=m.search)
 
 
+def test_plan_json_names_the_kernel_and_hashes_the_dr_bytes_written(s, tmp_path):
+    import hashlib
+
+    from cfmpa.impl import build_dr_fast, search_opt_path_fast
+
+    fast = plan(s, "modified")
+    ref = plan(s, "modified", build=build_dr, search=search_opt_path)
+    custom = plan(s, "modified", build=lambda *a: build_dr(*a))
+    assert (fast.kernel, ref.kernel, custom.kernel) == ("fast", "reference", "custom")
+    assert plan(s, "modified", build=lambda *a: build_dr_fast(*a), search=search_opt_path_fast,
+                kernel="fast").kernel == "fast"
+    # the load is timed apart (once per process, then 0.0); the reference loads nothing
+    assert "kernel_load" in fast.timings_s and "kernel_load" not in ref.timings_s
+    dr_path, plan_path = write_plan(fast, tmp_path)
+    doc = json.loads(plan_path.read_text())
+    assert doc["kernel"] == "fast"
+    assert doc["dr_sha256"] == hashlib.sha256(dr_path.read_bytes()).hexdigest()
+    assert plan_json(ref)["dr_sha256"] == doc["dr_sha256"]      # bit-identical D_R
+    assert plan_json(ref)["kernel"] == "reference"
+
+
 def test_another_builder_can_be_run_under_the_contracts(s):
     seen = []
 
