@@ -57,13 +57,20 @@ class ContractViolation(CfmpaError):
     """A Hoare triple's pre- or postcondition failed at run time.
 
     The message names the triple, the condition, then one ``name was value`` line per value.
+    ``condition`` is the id and the message joined (``post.costs: the reported ...``);
+    ``condition_id`` and ``message`` are the two parts, apart.
     """
 
     exit_code = 1
 
-    def __init__(self, triple: str, condition: str, values: Mapping[str, Any] | None = None) -> None:
+    def __init__(self, triple: str, condition: str, values: Mapping[str, Any] | None = None, *,
+                 condition_id: str | None = None, message: str | None = None) -> None:
         self.triple = triple
         self.condition = condition
+        head, sep, tail = condition.partition(": ")
+        self.condition_id = condition_id if condition_id is not None else (
+            head if sep else condition)
+        self.message = message if message is not None else (tail if sep else condition)
         self.values = dict(values or {})
         lines = [f"{triple}: {condition}"]
         lines += [f"{name} was {value!r}" for name, value in self.values.items()]

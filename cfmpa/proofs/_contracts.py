@@ -328,8 +328,12 @@ def jsonable(x: Any) -> Any:
 
 
 def violation_json(v: ContractViolation) -> dict[str, Any]:
-    """A violation as plan.json records it: triple, condition, and its values."""
-    return {"triple": v.triple, "condition": v.condition, "values": jsonable(v.values)}
+    """A violation as plan.json records it: triple, condition, and its values.
+
+    ``condition`` joins the id and the message (kept as it was); ``condition_id`` (``post.costs``,
+    ``certificate.contact``) and ``message`` are the two apart."""
+    return {"triple": v.triple, "condition": v.condition, "condition_id": v.condition_id,
+            "message": v.message, "values": jsonable(v.values)}
 
 
 def contracts_json(settings: Settings, runs: Sequence[TripleRun],

@@ -236,13 +236,15 @@ def require_clear(cert: Certificate, *, name: str = "continuous-time certificate
                            "right angles_rad": list(c.right_angles_rad),
                            "path segment": c.segment,
                            "cells": [list(x) for x in c.cells]})
-        raise CertificateViolation(name, "the arms' link rectangles touch during the motion",
-                                   values)
+        text = "the arms' link rectangles touch during the motion"
+        raise CertificateViolation(name, text, values, condition_id="certificate.contact",
+                                   message=text)
     first = cert.undecided[0] if cert.undecided else None
-    raise CertificateViolation(name, "some time intervals could be neither proved clear nor "
-                               "shown in contact", {"undecided intervals": len(cert.undecided),
-                                                    "first interval_s": first,
-                                                    "min sampled distance_m": cert.min_clearance_m})
+    text = "some time intervals could be neither proved clear nor shown in contact"
+    raise CertificateViolation(name, text, condition_id="certificate.undecided", message=text,
+                               values={"undecided intervals": len(cert.undecided),
+                                       "first interval_s": first,
+                                       "min sampled distance_m": cert.min_clearance_m})
 
 
 def _check_path(path: Sequence[Sequence[int]], grid: Grid) -> IntArray:

@@ -114,7 +114,8 @@ class Triple:
         if failure.count > 1:
             values["instances failing"] = failure.count
         return ContractViolation(self.label,
-                                 f"{failure.condition}: {failure.message}", values)
+                                 f"{failure.condition}: {failure.message}", values,
+                                 condition_id=failure.condition, message=failure.message)
 
     def __str__(self) -> str:
         def block(conds: tuple[Condition, ...]) -> list[str]:

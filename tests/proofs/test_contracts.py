@@ -67,6 +67,15 @@ def test_a_violation_names_the_triple_the_condition_and_each_value():
     assert isinstance(err, ContractViolation)
     assert str(err).splitlines() == ["Theorem 3 [BuiltDR, modified]: post.cells: a cell is free",
                                      "layer was 3", "cell was [4, 5]", "instances failing was 7"]
+    assert (err.condition_id, err.message) == ("post.cells", "a cell is free")
+    from cfmpa.proofs._contracts import violation_json
+
+    doc = violation_json(err)
+    assert (doc["condition"], doc["condition_id"], doc["message"]) == (
+        "post.cells: a cell is free", "post.cells", "a cell is free")
+    # made by hand, without the parts: they are read off the joined text
+    bare = ContractViolation("T", "pre.x: y: z")
+    assert (bare.condition_id, bare.message) == ("pre.x", "y: z")
 
 
 # --- preconditions ------------------------------------------------------------------------------

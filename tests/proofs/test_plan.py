@@ -99,6 +99,9 @@ def test_a_postcondition_violation_stops_the_run_unless_recording(s):
     p = plan(s, "modified", contracts="sampled", search=lying, stop=False)
     rec = plan_json(p)["contracts"]
     assert [v["condition"].split(":")[0] for v in rec["violations"]] == ["post.costs"]
+    v = rec["violations"][0]                        # the id and the message, also apart
+    assert v["condition_id"] == "post.costs" and v["message"] == "the reported costs are not the path's"
+    assert v["condition"] == f"{v['condition_id']}: {v['message']}"
     assert rec["violations"][0]["triple"] == "Theorem 4 [searchoptpath over D'_R]"
     assert rec["violations"][0]["values"]["reported J1, J2"] == [p.search.J1, p.search.J2]
     dumps_json(plan_json(p))                        # the record is valid, deterministic JSON
@@ -118,6 +121,7 @@ def test_a_contact_is_a_violation_in_every_mode(mode):
     assert CertificateViolation in [type(v) for v in p.violations]
     rec = plan_json(p)["contracts"]
     assert rec["violations"][-1]["triple"] == CERTIFICATE
+    assert rec["violations"][-1]["condition_id"] == "certificate.contact"
     values = rec["violations"][-1]["values"]
     assert values["distance_m"] == 0.0 and values["path segment"] == "resting at the last cell"
     assert values["cells"] == [list(p.search.path[-1])] * 2
