@@ -110,7 +110,8 @@ def _clearance_line(c: Certificate) -> str:
     sampled = (f"sampled minimum {c.min_clearance_m * 1000:.6g} mm at t={c.t_min_s:.4f} s "
                f"({c.intervals} intervals)")
     if c.clear:
-        return f"clearance clear: proved >= {c.lower_bound_m * 1000:.6g} mm at every instant; {sampled}"
+        return (f"clearance clear: proved >= {c.lower_bound_m * 1000:.6g} mm at every instant; "
+                f"{sampled}")
     if c.contact_detail is not None:
         d = c.contact_detail
         return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, left link {d.links[0]} and "

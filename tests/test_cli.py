@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -19,8 +20,10 @@ ROOT = Path(__file__).resolve().parents[1]
 def tiny_file(tmp_path):
     text = (ROOT / "scenarios" / "default.toml").read_text()
     p = tmp_path / "tiny.toml"
+    # The default workcell at dt = 0.25 s (grid 7 x 27 x 27), with cells between which a path
+    # exists under every variant.
     p.write_text(text.replace("dt = 0.02", "dt = 0.25").replace("start_cell = [40, 100]",
-                 "start_cell = [3, 8]").replace("goal_cell = [150, 60]", "goal_cell = [12, 5]"))
+                 "start_cell = [2, 8]").replace("goal_cell = [150, 60]", "goal_cell = [13, 5]"))
     return p
 
 
@@ -62,36 +65,94 @@ def test_console_script_runs_without_traceback(tmp_path):
     assert "Traceback" not in proc.stderr and "error:" in proc.stderr
 
 
-def _without_timings(path: Path) -> str:
-    import json
-
-    doc = json.loads(path.read_text())
-    doc.pop("timings_s")
-    return json.dumps(doc, sort_keys=True)
+def _without_timings(path: Path) -> bytes:
+    """plan.json's raw bytes with only the timings_s block cut out (keys are sorted, indent 2)."""
+    lines = path.read_bytes().splitlines(keepends=True)
+    at = lines.index(b'  "timings_s": {\n')
+    end = next(k for k in range(at, len(lines)) if lines[k].startswith(b"  }"))
+    assert b'"timings_s"' not in b"".join(lines[:at] + lines[end + 1:])
+    return b"".join(lines[:at] + lines[end + 1:])
 
 
 def test_plan_writes_stable_json_and_a_summary(tiny_file, tmp_path, capsys):
     outs = [tmp_path / "a", tmp_path / "b"]
+    texts = []
     for out in outs:
         assert main(["plan", str(tiny_file), "--variant", "modified", "--out", str(out),
                      "--contracts", "off"]) == 0
-    text = capsys.readouterr().out
-    for word in ("variant", "grid", "free", "status", "time"):
-        assert word in text
+        texts.append(capsys.readouterr().out)
+    # byte-identical apart from timings_s, compared on the raw bytes (not re-serialised)
     a, b = (_without_timings(o / "plan.json") for o in outs)
     assert a == b
+    assert (outs[0] / "dr.npy").read_bytes() == (outs[1] / "dr.npy").read_bytes()
     import json
 
     doc = json.loads((outs[0] / "plan.json").read_text())
     for key in ("scenario", "scenario_sha256", "variant", "grid", "status", "reason", "path",
-                "angles", "J1", "J2", "clearance", "contracts", "timings_s", "versions"):
+                "angles", "J1", "J2", "clearance", "contracts", "timings_s", "versions",
+                "dr_sha256", "kernel"):
         assert key in doc
     assert set(doc["grid"]) >= {"N", "m", "n", "dt", "lo", "h"}
     assert np.load(outs[0] / "dr.npy").shape == (doc["grid"]["N"] + 1, doc["grid"]["m"],
                                                  doc["grid"]["n"])
-    if doc["status"] == "found":
-        assert doc["path"][0] == [3, 8] and doc["path"][-1] == [12, 5]
-        assert len(doc["angles"]) == len(doc["path"])
+    assert doc["status"] == "found"
+    assert doc["path"][0] == [2, 8] and doc["path"][-1] == [13, 5]
+    assert len(doc["angles"]) == len(doc["path"])
+    # the summary: variant, grid, free fraction, status, J1, J2, length, both clearance figures,
+    # and the times of every stage
+    text = texts[0]
+    g = doc["grid"]
+    assert "variant   modified" in text and f"N={g['N']} m={g['m']} n={g['n']}" in text
+    assert f"free      {doc['free_fraction']:.4%} of cells" in text
+    assert (f"status    found: J1={doc['J1']} J2={doc['J2']} length={len(doc['path'])} cells"
+            in text)
+    c = doc["clearance"]
+    assert (f"proved >= {c['lower_bound_m'] * 1000:.6g} mm at every instant; sampled minimum "
+            f"{c['min_m'] * 1000:.6g} mm at t={c['t_s']:.4f} s" in text)
+    time_line = next(x for x in text.splitlines() if x.startswith("time "))
+    for stage in ("build_dr", "search", "certificate"):
+        assert re.search(rf"{stage} \d+\.\d{{3}} s", time_line), stage
+
+
+def test_the_atomic_writer_leaves_the_old_file_and_no_temporary_when_interrupted(
+        tmp_path, monkeypatch):
+    from cfmpa import _io
+
+    target = tmp_path / "plan.json"
+    target.write_bytes(b"old")
+
+    def boom(*args):
+        raise OSError(28, "No space left on device")
+
+    for name in ("replace", "fsync"):
+        with monkeypatch.context() as m:
+            m.setattr(_io.os, name, boom)
+            with pytest.raises(OSError, match="No space"):
+                _io.write_bytes_atomic(target, b"new and complete")
+        assert target.read_bytes() == b"old", name
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["plan.json"], name
+    _io.write_bytes_atomic(target, b"new")           # and without the fault it is replaced
+    assert target.read_bytes() == b"new"
+
+
+def test_plan_interrupted_at_the_rename_exits_2_and_keeps_the_old_files(tiny_file, tmp_path,
+                                                                         monkeypatch, capsys):
+    from cfmpa import _io
+
+    out = tmp_path / "out"
+    assert main(["plan", str(tiny_file), "--out", str(out), "--contracts", "off"]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    capsys.readouterr()
+
+    def boom(src, dst):
+        raise OSError(5, "Input/output error", str(dst))
+
+    monkeypatch.setattr(_io.os, "replace", boom)
+    assert main(["plan", str(tiny_file), "--variant", "tight", "--out", str(out),
+                 "--contracts", "off"]) == 2
+    err = capsys.readouterr().err
+    assert "Input/output error" in err and "Traceback" not in err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
 
 
 def test_plan_into_an_unwritable_place_exits_2(tiny_file, tmp_path, capsys):

@@ -85,9 +85,10 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     In every mode, off included, a certificate that is not clear (a contact, or an interval left
     undecided) is a violation. A violation raises ContractViolation; with ``stop=False``
     postcondition and certificate violations are recorded in ``contracts`` and the run goes on
-    (a failed precondition always stops it). ``grid``, ``build`` and ``search`` replace the scenario's grid
-    and the kernels (by default the fast ones, bit-identical to the reference and tested against
-    it): for the reference itself, another implementation, or a seeded fault. ``kernel`` names
+    (a failed precondition always stops it). ``grid``, ``build`` and ``search`` replace the
+    scenario's grid and the kernels (by default the fast ones, bit-identical to the reference
+    and tested against it): for the reference itself, another implementation, or a seeded
+    fault. ``kernel`` names
     them in plan.json ("fast", "reference"; by default told from ``build`` and ``search``, and
     "custom" for anything else). With the fast kernels, the first run in a process first calls
     them on a tiny input, so that timings_s.kernel_load holds numba's compile or cache-load time

@@ -54,7 +54,12 @@ def test_sampled_records_seed_sample_and_what_was_checked(s):
     occupied = {(min(k, N), c) for k, c in enumerate(path)} | {(N, path[-1])}
     assert on_path[0]["count"] == len(occupied) == len(path)
     optimal = [c for (_, cond, _), c in checks.items() if cond == "post.optimal"]
-    assert optimal[0]["ok"] is None
+    assert optimal[0]["ok"] is None and optimal[0]["coverage"] == "none"
+    # a sample is recorded as one: pre.dr.spec does not claim more than the cells drawn
+    spec = [c for (_, cond, _), c in checks.items() if cond == "pre.dr.spec"]
+    assert spec[0]["coverage"] == "sample" and spec[0]["scope"].startswith("on a sample only")
+    assert "300 random cells" in spec[0]["scope"] and "not checked" in spec[0]["scope"]
+    assert sampled[0]["coverage"] == on_path[0]["coverage"] == "sample"
     assert rec["checked"] == sum(c["count"] for c in checks.values())
     assert rec["certificate_enforced"] is True and {"contracts_builtdr",
                                                      "contracts_search"} <= set(p.timings_s)
@@ -65,7 +70,7 @@ def test_full_checks_every_cell_and_optimality(s):
     checks = _checks(plan_json(p)["contracts"])
     cells = [c for (_, cond, _), c in checks.items() if cond == "post.cells"]
     assert [c["count"] for c in cells] == [p.dr.size]
-    assert all(c["ok"] is True for c in checks.values())
+    assert all(c["ok"] is True and c["coverage"] == "all" for c in checks.values())
     assert any(cond == "post.optimal" and c["count"] == 1 for (_, cond, _), c in checks.items())
 
 
@@ -100,7 +105,8 @@ def test_a_postcondition_violation_stops_the_run_unless_recording(s):
     rec = plan_json(p)["contracts"]
     assert [v["condition"].split(":")[0] for v in rec["violations"]] == ["post.costs"]
     v = rec["violations"][0]                        # the id and the message, also apart
-    assert v["condition_id"] == "post.costs" and v["message"] == "the reported costs are not the path's"
+    assert v["condition_id"] == "post.costs"
+    assert v["message"] == "the reported costs are not the path's"
     assert v["condition"] == f"{v['condition_id']}: {v['message']}"
     assert rec["violations"][0]["triple"] == "Theorem 4 [searchoptpath over D'_R]"
     assert rec["violations"][0]["values"]["reported J1, J2"] == [p.search.J1, p.search.J2]
