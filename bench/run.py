@@ -26,7 +26,6 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 WORKER = Path(__file__).resolve().parent / "_worker.py"
-PLAN_FAST = [sys.executable, str(Path(__file__).resolve().parent / "_plan_fast.py")]
 DEFAULT_CELLS = {"start_cell": (40, 100), "goal_cell": (150, 60)}   # default.toml, dt = 0.02
 VARIANTS = ("original", "modified", "tight")
 GIB = 1024.0
@@ -42,14 +41,15 @@ class Config:
     sample: int = 2000                     # per-cell shapely loop
     dwithin_stride: int = 8                # vectorised dwithin: every 8th layer, extrapolated
     scaling_dts: tuple[float, ...] = (0.04, 0.02, 0.01)
-    contracts_dt: float = 0.04             # full contracts on the default grid take minutes
+    contracts_runs_full: int = 3           # full contracts on the default grid: minutes a run
+    contracts_budget_full_s: float = 900.0
     one_degree: dict[str, Any] = field(default_factory=dict)
 
     @classmethod
     def of(cls, quick: bool, runs: int | None) -> Config:
         if quick:
             return cls(quick=True, runs=runs or 1, warmup=0, budget_s=20.0, dt=0.16, sample=100,
-                       dwithin_stride=1, scaling_dts=(0.32, 0.16, 0.08), contracts_dt=0.32,
+                       dwithin_stride=1, scaling_dts=(0.32, 0.16, 0.08), contracts_runs_full=1,
                        one_degree=one_degree(10))
         return cls(quick=False, runs=runs or 5, one_degree=one_degree(1))
 
@@ -202,6 +202,13 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
                "contracts": "sampled"},
               {"kind": "plan_fast", "scenario": cfg.one_degree, "variant": "modified",
                "contracts": "sampled"}]
+    # Contract overhead on the default grid itself, in process (imports and interpreter start
+    # excluded, so the ratio is the checks' own cost); full gets fewer runs and no warm-up.
+    items += [{"kind": "plan_fast", "scenario": base, "variant": "modified", "contracts": mode}
+              for mode in ("off", "sampled")]
+    items += [{"kind": "plan_fast", "scenario": base, "variant": "modified", "contracts": "full",
+               "runs": cfg.contracts_runs_full, "warmup": 0,
+               "budget_s": cfg.contracts_budget_full_s}]
     out = iter(in_workers(cfg, items))
 
     res["builtdr"] = {v: {impl: next(out) for impl in ("reference", "fast", "fast_regions_given")}
@@ -212,6 +219,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
     res["scaling"] = [{"dt": dt, "cells": (b := next(out))["info"]["cells"], "builtdr_fast": b,
                        "search_fast": next(out)} for dt in cfg.scaling_dts]
     plan_fast, one_fast = next(out), next(out)
+    in_process = {mode: next(out) for mode in ("off", "sampled", "full")}
 
     have_cli = cli_has("plan")
     no_cli = skipped("no `cfmpa plan` in this checkout (.venv/bin/cfmpa missing or no plan)")
@@ -221,22 +229,17 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
         "cli_sampled": cli_run(cfg, ["plan", str(default_toml), "--variant", "modified", "--out",
                                      str(tmp / "plan"), "--contracts", "sampled"])
         if have_cli else no_cli,
-        "fast_process_sampled": cli_run(cfg, [str(default_toml), "modified", str(tmp / "pf"),
-                                              "sampled"], PLAN_FAST),
         "fast_in_process_sampled": plan_fast,
-        "note": "cli: `cfmpa plan` as this checkout wires it; fast_process: the same steps with "
-                "build_dr_fast and search_opt_path_fast in a fresh process (bench/_plan_fast.py, "
-                "imports included); fast_in_process: plan() with them, files written, imports "
-                "excluded",
+        "note": "cli: `cfmpa plan` in a fresh process (fast kernels, imports and the kernels' "
+                "cache load included); fast_in_process: plan() with the same kernels, files "
+                "written, imports excluded",
     }
     res["prove"] = (cli_run(cfg, ["prove"]) if cli_has("prove")
                     else skipped("no `cfmpa prove` in this checkout yet"))
-    res["contracts"] = contracts_section(cfg, tmp, have_cli)
+    res["contracts"] = contracts_section(cfg, tmp, have_cli, base, in_process)
     res["one_degree"] = {
         "grid": one_fast["info"]["grid"], "cells": one_fast["info"]["cells"],
         "plan_fast_in_process_sampled": one_fast,
-        "plan_fast_process_sampled": cli_run(cfg, [str(one_toml), "modified", str(tmp / "pf1"),
-                                                   "sampled"], PLAN_FAST),
         "plan_cli_sampled": cli_run(cfg, ["plan", str(one_toml), "--variant", "modified",
                                           "--out", str(tmp / "one"), "--contracts", "sampled"])
         if have_cli else no_cli,
@@ -276,20 +279,30 @@ def shapely_section(res: dict[str, Any], variant: str, loop: dict[str, Any],
     }
 
 
-def contracts_section(cfg: Config, tmp: Path, have_cli: bool) -> dict[str, Any]:
+def contracts_section(cfg: Config, tmp: Path, have_cli: bool, base: dict[str, Any],
+                      in_process: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """`--contracts off|sampled|full` on the default grid: in process (the checks' own cost) and,
+    for off and sampled, as `cfmpa plan` processes (what a user waits for)."""
+    out: dict[str, Any] = {"scenario": base, "variant": "modified",
+                           "note": "in_process: plan() after a warm-up (full: no warm-up, fewer "
+                                   "runs, minutes each); cli: whole `cfmpa plan` processes",
+                           "in_process": in_process}
+    modes = ("off", "sampled", "full")
+    if all("median_s" in in_process[m] for m in modes):
+        off = in_process["off"]["median_s"]
+        out["ratios"] = {"sampled_over_off": in_process["sampled"]["median_s"] / off,
+                         "full_over_off": in_process["full"]["median_s"] / off}
     if not have_cli:
-        return skipped("no `cfmpa plan` in this checkout")
-    spec = default_at(cfg.contracts_dt)
-    toml = scenario_file(spec, tmp)
-    out: dict[str, Any] = {"scenario": spec, "note": "`cfmpa plan --contracts MODE`, variant "
-                           "modified, on the default workcell at this dt (full on the default "
-                           "grid takes minutes per run)"}
-    for mode in ("off", "sampled", "full"):
-        out[mode] = cli_run(cfg, ["plan", str(toml), "--variant", "modified", "--out",
-                                  str(tmp / f"contracts-{mode}"), "--contracts", mode])
-    if all("median_s" in out[m] for m in ("off", "sampled", "full")):
-        out["ratios"] = {"sampled_over_off": out["sampled"]["median_s"] / out["off"]["median_s"],
-                         "full_over_off": out["full"]["median_s"] / out["off"]["median_s"]}
+        out["cli"] = skipped("no `cfmpa plan` in this checkout")
+        return out
+    toml = scenario_file(base, tmp)
+    out["cli"] = {mode: cli_run(cfg, ["plan", str(toml), "--variant", "modified", "--out",
+                                      str(tmp / f"contracts-{mode}"), "--contracts", mode])
+                  for mode in ("off", "sampled")}
+    cli = out["cli"]
+    if all("median_s" in cli[m] for m in ("off", "sampled")):
+        out["cli_ratios"] = {"sampled_over_off": cli["sampled"]["median_s"]
+                             / cli["off"]["median_s"]}
     return out
 
 
@@ -306,8 +319,6 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
     sh = res["shapely"]["ratios"]
     cli = res["plan"]["cli_sampled"]
     one = res["one_degree"]
-    fast_plan = res["plan"]["fast_process_sampled"]
-    one_fast = one["plan_fast_process_sampled"]
     rows = [
         row("BuiltDR fast, slowest variant (s)",
             max(res["builtdr"][v]["fast"]["median_s"] for v in VARIANTS), 0.5,
@@ -318,15 +329,12 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
             False, note="both given the same regions"),
         row("search fast, slowest variant (s)",
             max(res["search"][v]["fast"]["median_s"] for v in VARIANTS), 1.0),
-        row("cfmpa plan end to end, sampled (s)", med(cli), 3.0, note="the CLI as wired"),
-        row("plan, fast kernels, fresh process, sampled (s)", med(fast_plan), 3.0,
-            note="what `cfmpa plan` does once wired to them"),
-        row("1-degree plan, fast kernels, fresh process (s)", med(one_fast), 5.0),
-        row("1-degree plan, fast kernels, fresh process (peak MiB)", one_fast.get("peak_rss_mb"),
-            GIB),
-        row("1-degree cfmpa plan (s)", med(one["plan_cli_sampled"]), 5.0, note="the CLI as wired"),
+        row("cfmpa plan end to end, sampled (s)", med(cli), 3.0,
+            note="fresh process, certificate included"),
+        row("1-degree cfmpa plan (s)", med(one["plan_cli_sampled"]), 5.0,
+            note="fresh process, certificate included"),
         row("1-degree cfmpa plan (peak MiB)", one["plan_cli_sampled"].get("peak_rss_mb"), GIB,
-            note="the CLI as wired"),
+            note="fresh process"),
     ]
     if cfg.quick:
         for r in rows:
@@ -377,21 +385,18 @@ def table(res: dict[str, Any]) -> str:
     for s in res["scaling"]:
         add(f"scaling dt={s['dt']} BuiltDR fast ({s['cells']} cells)", s["builtdr_fast"])
         add(f"scaling dt={s['dt']} search fast", s["search_fast"])
-    add("cfmpa plan, sampled (CLI as wired)", res["plan"]["cli_sampled"])
-    add("plan, fast kernels, sampled (fresh process)", res["plan"]["fast_process_sampled"])
-    add("plan, fast kernels, sampled (in process)", res["plan"]["fast_in_process_sampled"])
+    add("cfmpa plan, sampled (fresh process)", res["plan"]["cli_sampled"])
+    add("plan(), sampled (in process)", res["plan"]["fast_in_process_sampled"])
     add("make prove (cfmpa prove)", res["prove"])
     c = res["contracts"]
     for mode in ("off", "sampled", "full"):
-        if mode in c:
-            add(f"cfmpa plan --contracts {mode} (dt={c['scenario']['overrides']['dt']})", c[mode])
-        elif mode == "off":
-            add("cfmpa plan --contracts", c)
+        add(f"plan(), contracts {mode} (in process)", c["in_process"][mode])
+    for mode, d in c["cli"].items() if "skipped" not in c["cli"] else ():
+        add(f"cfmpa plan --contracts {mode} (fresh process)", d)
     one = res["one_degree"]
     grid = "x".join(str(x) for x in one["grid"])
-    add(f"plan {grid}, fast kernels, sampled (fresh process)", one["plan_fast_process_sampled"])
-    add(f"plan {grid}, fast kernels, sampled (in process)", one["plan_fast_in_process_sampled"])
-    add(f"cfmpa plan {grid}, sampled (CLI as wired)", one["plan_cli_sampled"])
+    add(f"plan() {grid}, sampled (in process)", one["plan_fast_in_process_sampled"])
+    add(f"cfmpa plan {grid}, sampled (fresh process)", one["plan_cli_sampled"])
     lines.append("")
     r = sh["ratios"]
     lines.append(f"per-cell shapely loop: {sh['per_cell_loop']['rate_cells_per_s']:.0f} cells/s, "
@@ -405,8 +410,11 @@ def table(res: dict[str, Any]) -> str:
                  f"{r['loop_over_ours_with_right_regions']:.0f}x, vectorised intersects "
                  f"{r['intersects_over_ours_with_right_regions']:.1f}x")
     if "ratios" in c:
-        lines.append(f"contracts: sampled/off {c['ratios']['sampled_over_off']:.2f}x, "
-                     f"full/off {c['ratios']['full_over_off']:.2f}x")
+        lines.append(f"contracts, in process: sampled/off {c['ratios']['sampled_over_off']:.2f}x, "
+                     f"full/off {c['ratios']['full_over_off']:.1f}x")
+    if "cli_ratios" in c:
+        lines.append(f"contracts, fresh processes: sampled/off "
+                     f"{c['cli_ratios']['sampled_over_off']:.2f}x")
     lines.append("")
     lines.append("targets:")
     for t in res["targets"]:
