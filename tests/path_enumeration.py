@@ -15,10 +15,12 @@ def optimal_lists(dr: np.ndarray, start: Cell, goal: Cell, max_len: int
     """The least (J1, J2) over lists of at most ``max_len`` cells that is_path accepts, and every
     such list reaching it with its trailing waits dropped; (None, set()) if none is valid.
 
-    Depth first over in-grid move sequences. A prefix is cut only when no extension can be an
-    optimal path: a cell of the list blocked at its own step (is_path checks every step k < len),
-    or partial costs already above the best found (J1 and the J2 terms so far only grow, so an
-    extension costs at least as much, lexicographically).
+    Depth first over in-grid move sequences. A prefix is cut only when no extension within
+    ``max_len`` can be an optimal path: a cell of the list blocked at its own step (is_path
+    checks every step k < len), the goal more moves away than cells are left, or partial costs
+    already above the best found (J1 and the J2 terms so far only grow, so an extension costs at
+    least as much, lexicographically). Nothing is searched when is_path's own clauses rule out
+    every list: the start blocked in layer 0 or the goal blocked in the rest layer.
     """
     N, m, n = dr.shape[0] - 1, dr.shape[1], dr.shape[2]
     free = (np.asarray(dr) == 0).tolist()
@@ -35,9 +37,9 @@ def optimal_lists(dr: np.ndarray, start: Cell, goal: Cell, max_len: int
                 found.clear()
             if cost == best[0]:
                 found.add(_drop_trailing_waits(path))
-        if len(path) == max_len:
-            return
         i, j = path[-1]
+        if len(path) == max_len or max(abs(goal[0] - i), abs(goal[1] - j)) > max_len - len(path):
+            return
         layer = free[layer_of_step(len(path), N)]
         for di, dj in MOVES:
             c = (i + di, j + dj)
@@ -47,7 +49,7 @@ def optimal_lists(dr: np.ndarray, start: Cell, goal: Cell, max_len: int
                       (di, dj))
                 path.pop()
 
-    if free[0][start[0]][start[1]]:
+    if free[0][start[0]][start[1]] and free[N][goal[0]][goal[1]]:
         visit([start], 0, 0, (0, 0))
     return best[0], found
 

@@ -2,8 +2,10 @@
 
 ``is_path`` is the fixed definition: the subordinate holds the goal after its list ends, so every
 step up to ``max(len, N)`` and the rest layer are checked. ``is_path_paper`` is the paper's
-Definition 4 word for word, kept only to show its flaw. ``opt_path`` is Definition 5 made
-executable by a plain Dijkstra; it is the spec's independent oracle for searchoptpath.
+Definition 4 word for word, kept only to show its flaw. ``opt_path`` computes Definition 5's
+optimum by a plain Dijkstra over capped states (not by ranging over every list); it is the
+spec's independent oracle for searchoptpath. ``is_opt_path`` is Definition 5's condition on
+one list, decided with that optimum.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ __all__ = [
     "J1",
     "J2",
     "check_search_inputs",
+    "is_opt_path",
     "is_path",
     "is_path_paper",
     "layer_of_step",
@@ -172,8 +175,17 @@ def is_path_paper(path: Sequence[Cell], dr: npt.NDArray[np.integer], start: Cell
     """The paper's Definition 4 (is_path_def) read literally; NOT the definition the project uses.
 
     Its flaw: only steps k < LENGTH(L) are checked, so a path that arrives early and waits at a
-    goal the principal later sweeps passes. Read literally it also never checks the last cell
-    (the clause for L_k needs an L_{k+1}) nor any pair with a cell outside the grid.
+    goal the principal later sweeps passes. Read literally it also never checks any pair with a
+    cell outside the grid, nor the last cell: the clause for k = LENGTH(L) - 1 needs
+    L_{k+1} = L_{LENGTH(L)}, and this function takes that element to be no grid cell.
+
+    That is a chosen reading. In HOL4 an element past the end is not absent but unspecified:
+    with L_k = EL k L, L_{LENGTH(L)} = HD [], one fixed unknown pair, the same for every list.
+    Were it a grid cell, the clause would also ask the goal to be one move from it and free at
+    step LENGTH(L) - 1 (layer N - 1 from N on), and no list at all would reach a goal not next
+    to it. The flaw holds under every reading that lets some list reach the goal: the early-arrival
+    path's goal is free at its own last step, and steps LENGTH(L) .. N - 1, where it is swept,
+    are checked under none.
     """
     N, m, n = dr.shape[0] - 1, dr.shape[1], dr.shape[2]
     cells = [(int(c[0]), int(c[1])) for c in path]
@@ -183,7 +195,7 @@ def is_path_paper(path: Sequence[Cell], dr: npt.NDArray[np.integer], start: Cell
     # forall i j k i' j'. i < m /\ i' < m /\ j < n /\ j' < n /\ k < LENGTH L ==>
     #   L_k = (i, j) /\ L_{k+1} = (i', j') ==> adjacent /\ (k < N ==> P_{k,i,j} = 0)
     #                                          /\ (k >= N ==> P_{N-1,i,j} = 0)
-    # For k = LENGTH L - 1 there is no L_{k+1}, so the antecedent is never met there.
+    # At k = LENGTH L - 1, L_{k+1} is taken to be no grid cell (see above): antecedent never met.
     for k in range(len(cells) - 1):
         (i, j), (i2, j2) = cells[k], cells[k + 1]
         if not (0 <= i < m and 0 <= i2 < m and 0 <= j < n and 0 <= j2 < n):
@@ -212,11 +224,15 @@ def J2(path: Sequence[Cell]) -> int:
 
 
 def opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell) -> SearchResult:
-    """Definition 5 made executable: the least (J1, J2), lexicographically, over all valid paths.
+    """The least (J1, J2), lexicographically, over all valid paths (Definition 5's optimum), and
+    one path reaching it; or no path, and why.
 
-    Plain Dijkstra with tuple costs over states (step capped at N, cell, previous move): layers
-    at steps >= N are all R, so states there with equal (cell, previous move) have the same
-    futures. Only (status, reason, J1, J2) are specified; which optimal path it returns is not.
+    Not Definition 5 read literally (an epsilon-choice over every list that is_path accepts):
+    a plain Dijkstra with tuple costs over states (step capped at N, cell, previous move). The
+    two agree because layers at steps >= N are all R, so states there with equal (cell,
+    previous move) have the same futures at the same costs; the tests check the agreement
+    against every list up to length_bound cells (grids up to 3 x 3, N <= 3) and against Z3's
+    Optimize. Only (status, reason, J1, J2) are specified; which optimal path it returns is not.
     """
     N, m, n, start, goal = check_search_inputs(dr, start, goal)
     free = (np.asarray(dr) == 0).tolist()
@@ -249,6 +265,19 @@ def opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell) -> SearchResu
                 cost = (c1 + abs(di) + abs(dj), c2 + abs(di - pi) + abs(dj - pj))
                 _relax(best, parent, heap, (s2, i2, j2, di, dj), cost, state)
     return SearchResult.no_path(REASON_UNREACHABLE)
+
+
+def is_opt_path(path: Sequence[Cell], dr: npt.NDArray[np.integer], start: Cell,
+                goal: Cell) -> bool:
+    """Definition 5's condition on one list: valid, and no valid list has a smaller (J1, J2).
+
+    Decided as is_path(path) and (J1, J2)(path) = opt_path's optimum, so it is exact as far as
+    opt_path is (see there); any of the optimal lists passes, not only the one opt_path returns.
+    """
+    if not is_path(path, dr, start, goal):
+        return False
+    best = opt_path(dr, start, goal)
+    return best.status is SearchStatus.FOUND and (J1(path), J2(path)) == (best.J1, best.J2)
 
 
 def _relax(best: dict[State, tuple[int, int]], parent: dict[State, State | None],

@@ -310,7 +310,7 @@ def check_tie_rule(dr: np.ndarray, start: Cell, goal: Cell) -> int:
     return len(optimal)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=80, deadline=None)
 @given(tiny_cases())
 def test_ties_follow_the_documented_rule_on_every_optimum(case: tuple[np.ndarray, Cell, Cell]
                                                            ) -> None:
@@ -319,7 +319,7 @@ def test_ties_follow_the_documented_rule_on_every_optimum(case: tuple[np.ndarray
 
 
 @pytest.mark.slow
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=600, deadline=None)
 @given(tiny_cases(max_n=4))
 def test_ties_follow_the_documented_rule_many(case: tuple[np.ndarray, Cell, Cell]) -> None:
     check_tie_rule(*case)

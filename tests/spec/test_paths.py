@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 
 import numpy as np
 import pytest
@@ -12,9 +11,12 @@ from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
 from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                               J1, J2, SearchResult, SearchStatus, is_path, is_path_paper, opt_path,
-                               path_violations)
+                               J1, J2, SearchResult, SearchStatus, is_opt_path, is_path,
+                               is_path_paper, opt_path, path_violations)
 from cfmpa.spec._paths_z3 import dr_free, length_bound, path_vars, z3_is_path, z3_J1, z3_J2
+from path_enumeration import optimal_lists
+
+Cell = tuple[int, int]
 
 
 def free_dr(N: int, m: int, n: int) -> np.ndarray:
@@ -184,46 +186,76 @@ def test_opt_path_rejects_bad_inputs() -> None:
         opt_path(np.zeros((1, 3, 3), dtype=np.uint8), (0, 0), (0, 0))
 
 
-def _all_paths_min(dr: np.ndarray, start: tuple[int, int], goal: tuple[int, int],
-                   max_len: int) -> tuple[int, int] | None:
-    """Least (J1, J2) over every in-grid move sequence of at most max_len cells that is_path accepts."""
-    m, n = dr.shape[1:]
-    best = None
-    frontier = [[start]]
-    for _ in range(max_len):
-        grown = []
-        for path in frontier:
-            if is_path(path, dr, start, goal):
-                cost = (J1(path), J2(path))
-                best = cost if best is None or cost < best else best
-            i, j = path[-1]
-            for di, dj in itertools.product((-1, 0, 1), repeat=2):
-                if 0 <= i + di < m and 0 <= j + dj < n:
-                    grown.append(path + [(i + di, j + dj)])
-        frontier = grown
-    return best
+@st.composite
+def enumerable_cases(draw: st.DrawFn, max_n: int = 3) -> tuple[np.ndarray, Cell, Cell]:
+    """Grids up to 3 x 3 (N <= max_n), small enough to enumerate every list up to the bound."""
+    N = draw(st.integers(1, max_n))
+    m, n = draw(st.integers(1, 3)), draw(st.integers(1, 3))
+    density = draw(st.sampled_from([0.0, 0.15, 0.3, 0.5]))
+    seed = draw(st.integers(0, 2**32 - 1))
+    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
+    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
+    if draw(st.booleans()):
+        dr[0][start] = 0     # free ends, so that most cases reach the search proper
+        dr[N][goal] = 0
+    return dr, start, goal
 
 
-@settings(max_examples=40, deadline=None)
-@given(st.data())
-def test_opt_path_is_the_minimum_over_all_short_paths(data: st.DataObject) -> None:
-    # Definition 5 by enumeration: every path of up to length_bound + 1 cells; the extra cell
-    # also checks, on these cases, that longer paths never beat the bound.
-    N = data.draw(st.integers(1, 2))
-    m, n = data.draw(st.sampled_from([(1, 1), (1, 2), (2, 1), (1, 3), (2, 2)]))
-    dr = np.array(data.draw(st.lists(st.integers(0, 1), min_size=(N + 1) * m * n,
-                                     max_size=(N + 1) * m * n)), dtype=np.uint8)
-    dr = dr.reshape(N + 1, m, n)
-    start = (data.draw(st.integers(0, m - 1)), data.draw(st.integers(0, n - 1)))
-    goal = (data.draw(st.integers(0, m - 1)), data.draw(st.integers(0, n - 1)))
-    want = _all_paths_min(dr, start, goal, length_bound(dr) + 1)
+def check_opt_path_by_enumeration(dr: np.ndarray, start: Cell, goal: Cell, extra: int) -> str:
+    """opt_path's optimum is the least (J1, J2) over every list of at most length_bound + extra
+    cells that is_path accepts (the extra cells check, here, that longer lists never beat the
+    bound), and is_opt_path accepts exactly the lists reaching it."""
+    want, optimal = optimal_lists(dr, start, goal, length_bound(dr) + extra)
     got = opt_path(dr, start, goal)
     if want is None:
         assert got.status == SearchStatus.NO_PATH
-    else:
-        assert got.status == SearchStatus.FOUND and (got.J1, got.J2) == want
-        assert is_path(got.path, dr, start, goal)
-        assert (J1(got.path), J2(got.path)) == want
+        assert not is_opt_path([start, goal], dr, start, goal)
+        return f"no path: {got.reason}"
+    assert got.status == SearchStatus.FOUND and (got.J1, got.J2) == want
+    assert is_path(got.path, dr, start, goal) and (J1(got.path), J2(got.path)) == want
+    assert is_opt_path(got.path, dr, start, goal)
+    assert all(is_opt_path(p, dr, start, goal) for p in optimal)
+    # Valid lists that cost more: the optimum, then a step off the goal and back (J1 + 2).
+    m, n = dr.shape[1:]
+    rejected = 0
+    for di, dj in ((0, 1), (1, 0), (0, -1), (-1, 0)):
+        off = (goal[0] + di, goal[1] + dj)
+        detour = [*got.path, off, goal]
+        if 0 <= off[0] < m and 0 <= off[1] < n and is_path(detour, dr, start, goal):
+            assert J1(detour) == want[0] + 2 and not is_opt_path(detour, dr, start, goal)
+            rejected += 1
+    return "found, a costlier list rejected" if rejected else "found"
+
+
+@settings(max_examples=100, deadline=None)
+@given(enumerable_cases())
+def test_opt_path_is_the_minimum_over_all_short_paths(
+        case: tuple[np.ndarray, Cell, Cell]) -> None:
+    event(check_opt_path_by_enumeration(*case, extra=1))
+
+
+@pytest.mark.slow
+@settings(max_examples=400, deadline=None)
+@given(enumerable_cases(max_n=4))
+def test_opt_path_is_the_minimum_over_all_short_paths_many(
+        case: tuple[np.ndarray, Cell, Cell]) -> None:
+    check_opt_path_by_enumeration(*case, extra=2)
+
+
+def test_is_opt_path_on_hand_lists() -> None:
+    dr = free_dr(2, 1, 3)
+    dr[1, 0, 1] = 1          # (0, 1) is swept at step 1
+    best = opt_path(dr, (0, 0), (0, 2))
+    assert (best.J1, best.J2) == (2, 2)
+    assert is_opt_path([(0, 0), (0, 0), (0, 1), (0, 2)], dr, (0, 0), (0, 2))   # waits it out
+    assert not is_opt_path([(0, 0), (0, 1), (0, 2)], dr, (0, 0), (0, 2))      # blocked: invalid
+    stop_start = [(0, 0), (0, 0), (0, 1), (0, 1), (0, 2)]                      # valid, (2, 4)
+    assert is_path(stop_start, dr, (0, 0), (0, 2))
+    assert not is_opt_path(stop_start, dr, (0, 0), (0, 2))
+    walled = free_dr(2, 1, 3)
+    walled[:, 0, 1] = 1
+    assert not is_opt_path([(0, 0), (0, 1), (0, 2)], walled, (0, 0), (0, 2))  # no path at all
 
 
 # --- the Z3 encoding that Optimize minimises, against the executable definitions ----------------
