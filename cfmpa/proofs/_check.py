@@ -89,22 +89,24 @@ def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | P
     try:
         s = load_scenario(scenario_path)
         dr = read_dr(dr_path)
+        dr_sha = _file_sha256(dr_path)
         doc = read_plan(plan_path)
     except InputError as exc:
         print(exc.render(), file=sys.stderr)
         return 2
     print(f"check     {Path(dr_path)} and {Path(plan_path)} against {s.name} ({scenario_path}), "
           f"variant {doc.variant.value}")
-    report = check_outputs(s, dr, doc, dr_sha256=_file_sha256(dr_path))
+    report = check_outputs(s, dr, doc, dr_sha256=dr_sha)
     print(report.text())
     return 0 if report.ok else 1
 
 
-def _file_sha256(path: str | Path) -> str | None:
+def _file_sha256(path: str | Path) -> str:
     try:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    except OSError:                     # read_dr has just read it; a vanished file is not ours
-        return None
+    except OSError as exc:
+        raise InputError("dr", MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=str(path)) from None
 
 
 def read_dr(path: str | Path) -> npt.NDArray[Any]:
