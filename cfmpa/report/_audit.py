@@ -346,7 +346,7 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
     made.append(F.variants_figure(
         f"fig-{slug}-variants", s, g, {v: p.dr for v, p in ok.items()},
         {v: left_regions(s, v, g).links[layer] for v in ok}, layer))
-    series, minima, same = {}, {}, {}
+    series, minima, same, bounds = {}, {}, {}, {}
     for v, p in ok.items():
         if p.search.status is not SearchStatus.FOUND:
             continue
@@ -357,10 +357,13 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
         series[v] = sample_clearance(s, g, p.search.path)
         if p.certificate is not None:
             minima[v] = (p.certificate.t_min_s, p.certificate.min_clearance_m)
+            # The proved figure is a bound only when every interval was proved clear.
+            if p.certificate.clear and getattr(p.certificate, "lower_bound_m", None):
+                bounds[v] = p.certificate.lower_bound_m
     if series:
         missing = [v for v in ok if v not in series]
         made.append(F.clearance_figure(f"fig-{slug}-clearance", s, g, series, minima, missing,
-                                       same))
+                                       same, bounds))
     for f in made:
         figures[f.id] = f
     return [{"id": f.id, "caption": f.caption} for f in made]

@@ -495,6 +495,49 @@ def _png_stats(data: bytes) -> tuple[int, int, int]:
     return width, height, len(set(zlib.decompress(idat)))
 
 
+#: report.json's fields documented as varying between builds from the same inputs (see the
+#: docstring of cfmpa.report._audit): times anywhere, and the provenance's date and git state.
+_VARYING_KEYS = ("seconds", "timings_s", "mean_seconds")
+
+
+def _without_varying(x, path=""):
+    if isinstance(x, dict):
+        return {k: _without_varying(v, f"{path}.{k}") for k, v in x.items()
+                if k not in _VARYING_KEYS and f"{path}.{k}" not in (".provenance.date_utc",
+                                                                   ".provenance.git")}
+    if isinstance(x, list):
+        return [_without_varying(v, path) for v in x]
+    return x
+
+
+def test_varying_fields_are_only_the_documented_ones(report):
+    doc = report["doc"]
+    stripped = _without_varying(doc)
+    assert "date_utc" not in stripped["provenance"] and "git" not in stripped["provenance"]
+    assert stripped["scenarios"][0]["variants"][0]["variant"] == "original"
+    assert all("timings_s" not in v for v in stripped["scenarios"][0]["variants"])
+    # Nothing else is dropped: the same key set apart from the varying ones.
+    assert len(_keys(stripped)) > 0.9 * len(_keys(doc))
+
+
+@pytest.mark.slow
+def test_report_json_is_deterministic(report, tiny_file, results_json, tmp_path):
+    """A second build from the same inputs gives the same report.json but for the documented
+    varying fields (about 30 s: the findings replan three bundled scenarios)."""
+    again = build_audit([str(tiny_file)], argv=report["argv"], proofs_json=str(results_json),
+                        compare_n=4, compare_seed=3, expected_ids=EXPECTED)
+    write_report(again, tmp_path)
+    second = json.loads((tmp_path / "report.json").read_text())
+    first = report["doc"]
+    assert first["provenance"]["date_utc"] and second["provenance"]["date_utc"]
+    a, b = _without_varying(first), _without_varying(second)
+    diff = [k for k in a if a[k] != b[k]]
+    assert not diff, diff
+    # The pictures are the same bytes too (PNG without date metadata).
+    assert {k: f.png for k, f in again.figures.items()} == {
+        k: f.png for k, f in report["result"].figures.items()}
+
+
 @pytest.mark.slow
 def test_full_audit_of_the_bundled_scenarios(tmp_path, capsys):
     """`cfmpa audit` as `make prove` ends: every scenario, fresh obligations, 100 workcells."""
