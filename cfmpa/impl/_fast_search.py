@@ -14,6 +14,8 @@ are computed, and the tie-break is a property of the labels, not of the order of
   among them, and a DAG label against an equal static one, is exactly the reference's rule.
 - It stops at the first bucket holding a goal state, and finishes with the least key + |d|_1
   over the goal states of that bucket, the least move on ties, as the reference does.
+
+So the tie-break is the one ``search_opt_path``'s docstring states on the returned path.
 """
 
 from __future__ import annotations
