@@ -305,7 +305,7 @@ def _aggregate(recs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
         # Nothing examined here: either another check stands for it (pre.dr.spec is BuiltDR's
         # post.cells) or there was nothing to examine (no path): never a green "0 held".
         checked = [r for r in recs if r["ok"] is not None]
-        state = "delegated" if all(r["scope"].startswith("by ") for r in checked) else "n/a"
+        state = "delegated" if all("post.cells" in r["scope"] for r in checked) else "n/a"
     else:
         state = "held"
     return {"count": count, "ok": ok, "state": state,

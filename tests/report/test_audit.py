@@ -40,6 +40,7 @@ from cfmpa.proofs import expected_ids, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
 from cfmpa.report._audit import _proof_sections, _verdict, contract_rows
+from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
 from cfmpa.report._provenance import MAX_PATHS, REPORTED_DISTRIBUTIONS, git_state
 
@@ -230,7 +231,8 @@ def test_contract_table_shows_a_failed_first_record_as_failed():
                   ("post", "post.optimal", "not checked in sampled mode", 0, None))
     held = _record(("post", "post.cells", "4096 random cells of 9000 (seed 0)", 4096, True),
                    ("post", "post.cells", "the 13 cells the path occupies", 13, True),
-                   ("pre", "pre.dr.spec", "by Theorem 3's post.cells check: 4096 random", 0, True))
+                   ("pre", "pre.dr.spec", "on a sample only: Theorem 3's post.cells at 4096 "
+                    "random cells of 9000", 0, True))
     rows = {r["condition"]: r for r in contract_rows({"modified": rec, "tight": held})}
     cells = rows["post.cells"]["variants"]
     assert (cells["modified"]["count"], cells["modified"]["ok"], cells["modified"]["state"]) == (
@@ -278,6 +280,18 @@ def test_additive_plan_keys_validate_and_render(report):
     text = render_html(AuditResult(audit, report["result"].figures))
     assert "ab" * 32 in text and "builtdr: fast" in text
     assert "message: a new field" in text and "cell was [0, 1, 2]" in text
+
+
+def test_workcell_instants_spread_over_the_principals_motion():
+    # Default: Tf = 1.4 s, the subordinate arrives at 3 s, least clearance at t = 0.
+    times = workcell_instants(1.4, 3.0, 0.02, 0.0)
+    assert times == pytest.approx([0.0, 1.4 / 3, 2.8 / 3, 1.4, 3.0])
+    assert sum(t <= 1.4 for t in times) == 4 and times[-1] == 3.0
+    # A least-clearance instant near an inner instant replaces it; one far away is added.
+    assert workcell_instants(1.6, 2.2, 0.04, 0.565) == pytest.approx([0, 0.565, 3.2 / 3, 1.6, 2.2])
+    assert len(workcell_instants(1.6, 2.2, 0.04, 2.0)) == 6
+    # A path that ends before Tf: no instant after Tf.
+    assert max(workcell_instants(1.6, 1.0, 0.04, None)) == 1.6
 
 
 def test_findings_text_matches_golden(report):
