@@ -4,17 +4,24 @@ from ._grid import (EPS, Grid, Variant, exact_n, exact_tf, joint_points, left_an
                     make_grid, rest_is_goal, right_box)
 from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
 from ._kinematics import arm_corners, joints, link_corners
-from ._paths import (J1, J2, PathViolation, SearchResult, SearchStatus, is_path, is_path_paper,
-                     opt_path, path_violations)
+from ._paths import (J1, J2, PathViolation, SearchResult, SearchStatus, is_opt_path, is_path,
+                     is_path_paper, opt_path, path_violations)
 from ._polygon import polygon_distance, polygon_distances
 from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
                         load_scenario, max_cells, parse_scenario)
 from ._triples import TRIPLES, Triple, builtdr_triple, search_triple
 
 __all__ = [
-    "ANGLE_TOLERANCE", "Certificate", "ContactDetail", "certificate_json", "certify", "require_clear", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm", "Scenario",
-    "Variant", "arm_corners", "exact_n", "joints", "link_corners", "exact_tf", "joint_points", "left_angles", "left_box", "load_scenario",
-    "make_grid", "max_cells", "parse_scenario", "polygon_distance", "polygon_distances", "rest_is_goal", "right_box",
-    "J1", "J2", "PathViolation", "SearchResult", "SearchStatus", "is_path", "is_path_paper", "opt_path",
-    "path_violations", "TRIPLES", "Triple", "builtdr_triple", "search_triple",
+    # scenario, grids and motion (DESIGN §2-§3)
+    "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm",
+    "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
+    "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_is_goal", "right_box",
+    # geometry
+    "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
+    # paths (DESIGN §5)
+    "J1", "J2", "PathViolation", "SearchResult", "SearchStatus", "is_opt_path", "is_path",
+    "is_path_paper", "opt_path", "path_violations",
+    # triples and the certificate (DESIGN §7)
+    "TRIPLES", "Triple", "builtdr_triple", "search_triple",
+    "Certificate", "ContactDetail", "certificate_json", "certify", "require_clear",
 ]
