@@ -311,7 +311,7 @@ def cspace_figure(fid: str, s: Scenario, g: Grid, dr: npt.NDArray[np.uint8],
             ax.plot(rest[:, 0], rest[:, 1], color=RIGHT_COLOR, lw=1.0, alpha=0.35, ls="--",
                     zorder=3)
             ax.plot(done[:, 0], done[:, 1], color=RIGHT_COLOR, lw=1.6, zorder=3)
-            waiting = step == last or (step > 0 and cells[step].tolist() == cells[step - 1].tolist())
+            waiting = step == last or (step > 0 and bool((cells[step] == cells[step - 1]).all()))
             ax.plot(*ang[step], marker="o", ms=7, mfc="#ff2020", mec="white", mew=1.0, ls="",
                     zorder=6)
             if k == g.N:

@@ -407,7 +407,8 @@ def test_picture_check_catches_a_broken_picture(report):
 _IMG_PROBE = """<script>
 window.addEventListener("load", () => {
   const imgs = Array.from(document.images);
-  const bad = imgs.filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.alt || i.src.slice(0, 40));
+  const bad = imgs.filter(i => !(i.complete && i.naturalWidth > 0))
+                  .map(i => i.alt || i.src.slice(0, 40));
   const out = document.createElement("pre");
   out.id = "img-probe";
   out.textContent = JSON.stringify({count: imgs.length, bad: bad});
