@@ -138,6 +138,9 @@ def cmd_prove(args: argparse.Namespace) -> int:
     """Discharge every obligation; with --audit, also write the audit report."""
     from .proofs import run_prove
 
+    if args.only and args.audit is not None:
+        # A report a reviewer trusts is of a whole run: a selection would show the rest missing.
+        raise InputError("--audit", args.audit, "needs every obligation; run it without --only")
     code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only)
     if args.audit is None:
         return code

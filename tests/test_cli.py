@@ -193,3 +193,12 @@ def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_pa
         plan_doc = json.loads((out / "plan.json").read_text())
         assert plan_doc["clearance"]["clear"] is False and (out / "dr.npy").exists()
         assert plan_doc["contracts"]["violations"][-1]["triple"] == "continuous-time certificate"
+
+
+def test_prove_refuses_an_audit_of_a_partial_run(tmp_path, capsys):
+    # --only with --audit would write a report of a selection: refused before any work.
+    code = main(["prove", "--only", "Prop8", "--out", str(tmp_path / "p"), "--audit",
+                 str(tmp_path / "a")])
+    err = capsys.readouterr().err
+    assert code == 2 and "--audit needs every obligation" in err and "Traceback" not in err
+    assert not (tmp_path / "p").exists() and not (tmp_path / "a").exists()

@@ -18,13 +18,13 @@ from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proo
                           Verdict, Z3Query, discharge)
 from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
                       collect_obligations, expected_ids, is_bundled, pinned_verdict,
-                      render_report, run_obligations, scenarios_note, selected)
+                      render_report, run_obligations, run_record, scenarios_note, selected)
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
     "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "discharge", "expected_ids",
-    "is_bundled", "pinned_verdict", "render_report", "run_obligations", "run_prove",
+    "is_bundled", "pinned_verdict", "render_report", "run_obligations", "run_prove", "run_record",
     "scenarios_note", "selected",
 ]
 
@@ -50,7 +50,8 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
                              "Prop8.printed, a prefix such as Prop8, or a glob such as 'Thm*')")
     obligations = collect_obligations(sdir, picks)
     expected = [i for i in every if selected(i, picks)]
-    run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir))
+    run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir),
+                          record=run_record(sdir))
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
 

@@ -10,7 +10,9 @@ sha256, and results.json says which obligations are new, changed or the same sin
 
 from __future__ import annotations
 
+import datetime as _dt
 import fnmatch
+import hashlib
 import json
 import os
 import tempfile
@@ -24,6 +26,7 @@ import sympy
 import z3
 
 from .. import __version__
+from .._git import git_state, repo_root
 from ._ledger import ASSUMPTIONS, Assumption
 from ._obl_builtdr import builtdr_obligations
 from ._obl_geometry import geometry_obligations
@@ -163,6 +166,7 @@ class ProveRun:
     verdict_mismatch: tuple[str, ...] = ()   # verdict or Obligation.expected != the pinned one
     duplicate_ids: tuple[str, ...] = ()      # produced more than once
     scenarios_note: str = ""
+    record: dict[str, Any] = field(default_factory=dict)   # results.json's "run" (run_record)
 
     @property
     def ok(self) -> bool:
@@ -171,8 +175,19 @@ class ProveRun:
                 and not self.duplicate_ids)
 
 
+def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
+    """What these results are of: the date, the checkout's commit and cleanliness, and the
+    sha256 of every scenario file read, so a report can tell results of another tree."""
+    git = git_state(repo_root())
+    return {"date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+            "git": {"commit": git["commit"], "clean": git["clean"]},
+            "scenarios": {f.name: hashlib.sha256(f.read_bytes()).hexdigest()
+                          for f in scenario_files(scenarios_dir)}}
+
+
 def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
-                    expected: Sequence[str], *, note: str = "") -> ProveRun:
+                    expected: Sequence[str], *, note: str = "",
+                    record: dict[str, Any] | None = None) -> ProveRun:
     """Discharge each obligation, save its query and the results, compare with the last run;
     every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``."""
     out = Path(out_dir)
@@ -200,7 +215,7 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                    missing_ids=tuple(i for i in exp if i not in ids),
                    unexpected_ids=tuple(i for i in dict.fromkeys(ids) if i not in exp),
                    seconds=seconds, verdict_mismatch=tuple(mismatch), duplicate_ids=tuple(dups),
-                   scenarios_note=note)
+                   scenarios_note=note, record=dict(record or {}))
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run
 
@@ -273,7 +288,7 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
     carried = [dict(v, change="not run") for k, v in previous.items() if k not in ran]
     doc = {
         "tool": "cfmpa prove", "version": __version__, "z3": z3.get_version_string(),
-        "sympy": sympy.__version__, "ok": run.ok,
+        "sympy": sympy.__version__, "ok": run.ok, "run": run.record,
         "summary": {g: _counts(ps) for g, ps in _groups(run.proofs).items()},
         "totals": _counts(run.proofs),
         "missing_ids": list(run.missing_ids), "unexpected_ids": list(run.unexpected_ids),

@@ -143,6 +143,7 @@ def _proof_sections(proofs: ProofData) -> dict[str, Any]:
             "missing_ids": list(proofs.missing_ids), "unexpected_ids": list(proofs.unexpected_ids),
             "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
                                 and not proofs.unexpected_ids) if proofs.available else None,
+            "run": proofs.run, "not_run": list(proofs.not_run),
         },
         "assumptions": {"available": proofs.ledger_available,
                         "source": proofs.source if proofs.ledger_available else
@@ -403,6 +404,7 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
                               if ob["unexpected_ids"] else "")))
     else:
         items.append(_item("obligations as expected", None, ob["source"]))
+    items.append(_proofs_of_this_tree(ob, doc["provenance"]))
     fnd = [f for f in doc["findings"] if f["available"]]
     missing = [f["id"] for f in doc["findings"] if not f["available"]]
     not_rep = [f["id"] for f in fnd if not f["reproduced"]]
@@ -439,6 +441,32 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     else:
         items.append(_item("campaign checks", None, cmp_["note"]))
     return {"ok": all(i["ok"] is not False for i in items), "items": items}
+
+
+def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, Any]:
+    """Whether the obligation results are of the tree and scenario files this report describes:
+    a results.json from another commit, other scenario bytes, or carried-over rows fail it."""
+    check = "proof results are of this tree"
+    if not ob["available"]:
+        return _item(check, None, ob["source"])
+    if ob["run"] is None:
+        if ob["source"].startswith("read from"):
+            return _item(check, None, "results.json records no run (commit, scenario hashes)")
+        return _item(check, True, "discharged afresh for this report")
+    run, problems = ob["run"], []
+    mine, theirs = prov["git"].get("commit"), (run.get("git") or {}).get("commit")
+    if mine != theirs:
+        problems.append(f"proved at commit {theirs}, report at {mine}")
+    hashes = run.get("scenarios") or {}
+    for s in prov["scenarios"]:
+        name = Path(s["path"]).name
+        if name in hashes and hashes[name] != s["sha256"]:
+            problems.append(f"{name} changed since the prove run")
+    if ob["not_run"]:
+        problems.append(f"{len(ob['not_run'])} results carried over from an earlier run "
+                        f"(e.g. {ob['not_run'][0]})")
+    return _item(check, not problems, "; ".join(problems) or
+                 f"commit {theirs}, proved {run.get('date_utc')}, scenario hashes match")
 
 
 def _item(check: str, ok: bool | None, detail: str) -> dict[str, Any]:

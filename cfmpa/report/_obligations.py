@@ -86,6 +86,8 @@ class ProofData:
     ledger_available: bool
     missing_ids: tuple[str, ...] = ()      # expected by the prove machinery, not in the data
     unexpected_ids: tuple[str, ...] = ()   # in the data, not expected
+    run: dict[str, Any] | None = None      # results.json's "run" record (None: fresh, or absent)
+    not_run: tuple[str, ...] = ()          # ids results.json carried over from an earlier run
 
 
 def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
@@ -166,10 +168,12 @@ def _from_file(path: Path, expected: Sequence[str]) -> ProofData:
     ledger_doc = doc.get("assumptions")
     ledger = _ledger_entries(ledger_doc) if isinstance(ledger_doc, list) else ()
     missing, unexpected = check_ids([r.id for r in rows], expected)
+    run = doc.get("run") if isinstance(doc.get("run"), dict) else None
     return ProofData(available=True, source=f"read from {path}",
                      note="the results the prove run recorded, not re-run for this report",
                      rows=rows, ledger=ledger, ledger_available=isinstance(ledger_doc, list),
-                     missing_ids=missing, unexpected_ids=unexpected)
+                     missing_ids=missing, unexpected_ids=unexpected, run=run,
+                     not_run=tuple(r.id for r in rows if r.change == "not run"))
 
 
 def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:

@@ -7,6 +7,7 @@ import hashlib
 import io
 import json
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -193,3 +194,17 @@ def test_another_scenarios_folder_says_what_it_expects(tmp_path: Path):
     assert rc == 0
     assert (f"scenarios: {tmp_path} is not the bundled folder" in out.getvalue()
             and "Scenario.mine.{time_grid,cspace_grid,margin_side,containment}" in out.getvalue())
+
+
+def test_results_json_records_what_it_is_of(tmp_path: Path):
+    # The commit and every scenario file's hash, so a report can refuse results of another tree.
+    rc = run_prove(out_dir=tmp_path, scenarios_dir=REPO / "scenarios", only=["Def1"],
+                   stream=io.StringIO())
+    assert rc == 0
+    run = json.loads((tmp_path / "results.json").read_text())["run"]
+    head = subprocess.run(["git", "-C", str(REPO), "rev-parse", "HEAD"], capture_output=True,
+                          text=True).stdout.strip()
+    assert run["git"]["commit"] == (head or None)
+    files = sorted((REPO / "scenarios").glob("*.toml"))
+    assert run["scenarios"] == {f.name: hashlib.sha256(f.read_bytes()).hexdigest() for f in files}
+    assert run["date_utc"].endswith("+00:00")

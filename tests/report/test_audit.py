@@ -350,6 +350,47 @@ def test_ids_of_a_doctored_results_json_are_checked_not_copied(report, tmp_path)
     assert set(partial.missing_ids) == set(expected_ids(ROOT / "scenarios")) - set(EXPECTED)
 
 
+def _check(audit, name):
+    return next(i for i in audit["verdict"]["items"] if i["check"] == name)
+
+
+def test_results_of_another_tree_fail_the_audit(report, tmp_path):
+    # The fixture's results are of this checkout: commit and scenario bytes match.
+    here = _check(report["doc"], "proof results are of this tree")
+    assert here["ok"] is True, here
+    doc = json.loads(_results(report)["text"])
+    assert doc["run"]["git"]["commit"] == report["doc"]["provenance"]["git"]["commit"]
+    assert doc["run"]["scenarios"]["default.toml"] == hashlib.sha256(
+        (ROOT / "scenarios" / "default.toml").read_bytes()).hexdigest()
+
+    def audited(d):
+        bad = tmp_path / "results.json"
+        bad.write_text(json.dumps(d))
+        audit = copy.deepcopy(report["result"].doc)
+        audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
+        audit["verdict"] = _verdict(audit)
+        return audit
+
+    other = copy.deepcopy(doc)
+    other["run"]["git"]["commit"] = "0" * 40
+    audit = audited(other)
+    assert audit["verdict"]["ok"] is False
+    assert "proved at commit " + "0" * 40 in _check(audit, "proof results are of this tree")["detail"]
+    # The report's scenario (tiny.toml) under another's bytes.
+    name = Path(report["doc"]["provenance"]["scenarios"][0]["path"]).name
+    changed = copy.deepcopy(doc)
+    changed["run"]["scenarios"][name] = "f" * 64
+    assert "changed since the prove run" in _check(audited(changed),
+                                                   "proof results are of this tree")["detail"]
+    carried = copy.deepcopy(doc)
+    carried["obligations"][0]["change"] = "not run"
+    assert _check(audited(carried), "proof results are of this tree")["ok"] is False
+    # An older results.json with no record: cannot tell, said so, not counted as a failure.
+    old = {k: v for k, v in doc.items() if k != "run"}
+    unknown = _check(audited(old), "proof results are of this tree")
+    assert unknown["ok"] is None and "records no run" in unknown["detail"]
+
+
 def test_missing_parts_are_labelled_not_available(report):
     audit = copy.deepcopy(report["result"].doc)
     audit["compare"] = {"available": False, "note": "not run for this report (compare_n = 0)"}
