@@ -234,7 +234,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
                 "cache load included); fast_in_process: plan() with the same kernels, files "
                 "written, imports excluded",
     }
-    res["prove"] = (cli_run(cfg, ["prove"]) if cli_has("prove")
+    res["prove"] = (cli_run(cfg, ["prove", "--out", str(tmp / "proofs")]) if cli_has("prove")
                     else skipped("no `cfmpa prove` in this checkout yet"))
     res["contracts"] = contracts_section(cfg, tmp, have_cli, base, in_process)
     res["one_degree"] = {
