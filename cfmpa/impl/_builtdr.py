@@ -74,9 +74,12 @@ def left_regions(s: Scenario, variant: Variant | str, grid: Grid | None = None) 
 def _rotate(poly: npt.NDArray[np.float64], angles: npt.NDArray[np.float64],
             base: tuple[float, float]) -> npt.NDArray[np.float64]:
     """Rotate polygons (…, V, 2) about the origin by each angle, then translate to base."""
-    c, s = np.cos(angles), np.sin(angles)
-    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (m, 2, 2)
-    return np.einsum("mab,...vb->m...va", rot, poly) + np.asarray(base)
+    # Written out rather than as an einsum: the same two products and one sum per coordinate
+    # (so the same doubles), several times faster on the right arm's m x n polygons.
+    shape = (len(angles),) + (1,) * (poly.ndim - 1)
+    c, s = np.cos(angles).reshape(shape), np.sin(angles).reshape(shape)
+    x, y = poly[..., 0][None], poly[..., 1][None]
+    return np.stack([c * x + (-s) * y, s * x + c * y], axis=-1) + np.asarray(base)
 
 
 def right_regions(s: Scenario, grid: Grid | None = None) -> RightRegions:

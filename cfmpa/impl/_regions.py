@@ -79,18 +79,20 @@ def convex_hull(points: npt.ArrayLike) -> Polygon:
 
 def _hull_indices(pts: np.ndarray) -> list[int]:
     """Indices into sorted, distinct pts of their hull's vertices, counter-clockwise."""
+    # Python floats, not numpy scalars: the same IEEE double operations, far less overhead.
+    xs, ys = pts[:, 0].tolist(), pts[:, 1].tolist()
 
-    def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+    def cross(o: int, a: int, b: int) -> float:
+        return (xs[a] - xs[o]) * (ys[b] - ys[o]) - (ys[a] - ys[o]) * (xs[b] - xs[o])
 
     lower: list[int] = []
-    for i in range(len(pts)):
-        while len(lower) >= 2 and cross(pts[lower[-2]], pts[lower[-1]], pts[i]) <= 0:
+    for i in range(len(xs)):
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], i) <= 0:
             lower.pop()
         lower.append(i)
     upper: list[int] = []
-    for i in range(len(pts) - 1, -1, -1):
-        while len(upper) >= 2 and cross(pts[upper[-2]], pts[upper[-1]], pts[i]) <= 0:
+    for i in range(len(xs) - 1, -1, -1):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], i) <= 0:
             upper.pop()
         upper.append(i)
     return lower[:-1] + upper[:-1]
