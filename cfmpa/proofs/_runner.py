@@ -32,7 +32,7 @@ from ._obl_builtdr import builtdr_obligations
 from ._obl_geometry import geometry_obligations
 from ._obl_margin import margin_obligations
 from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
-from ._obl_scenario import CHECKS, scenario_files, scenario_ids, scenario_obligations
+from ._obl_scenario import CHECKS, scenario_files, scenario_obligations
 from ._obligation import Method, Obligation, Proof, Verdict, discharge
 
 __all__ = [

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from .._git import MAX_PATHS, git_state
+from .._git import git_state
 
 __all__ = ["REPORTED_DISTRIBUTIONS", "git_state", "library_versions", "provenance"]
 

@@ -6,7 +6,6 @@ The floats in a scenario are dyadic rationals; N and m are computed from their e
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from enum import Enum
 from fractions import Fraction

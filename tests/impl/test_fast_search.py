@@ -20,6 +20,7 @@ from cfmpa.impl._search import search_opt_path
 from cfmpa.spec import Variant, load_scenario
 from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                                SearchStatus, is_path)
+from dr_strategies import random_dr
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 SMALL = [p for p in SCENARIOS if p.stem != "default"]
@@ -35,17 +36,10 @@ def assert_same(dr, start, goal):
     return ref
 
 
-@st.composite
-def random_drs(draw):
+def random_drs() -> st.SearchStrategy:
     """D_R arrays with few to many blocked cells (none at all gives the most ties)."""
-    N = draw(st.integers(1, 7))
-    m, n = draw(st.integers(1, 9)), draw(st.integers(1, 9))
-    density = draw(st.sampled_from([0.0, 0.1, 0.25, 0.4, 0.6]))
-    seed = draw(st.integers(0, 2**32 - 1))
-    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
-    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    return dr, start, goal
+    return random_dr(max_n=7, max_side=9, density=st.sampled_from([0.0, 0.1, 0.25, 0.4, 0.6]),
+                     free_ends=False)
 
 
 @settings(max_examples=300, deadline=None)

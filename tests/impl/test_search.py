@@ -15,6 +15,7 @@ from cfmpa.spec._paths import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED,
                                REASON_UNREACHABLE, J1, J2, SearchResult, SearchStatus, is_path,
                                opt_path)
 from cfmpa.spec._paths_z3 import length_bound, z3_opt_path
+from dr_strategies import random_dr
 from path_enumeration import optimal_lists
 
 Cell = tuple[int, int]
@@ -59,23 +60,10 @@ def plain_dijkstra(dr: np.ndarray, start: Cell, goal: Cell) -> tuple[str, object
     return ("found", answer) if answer is not None else ("no_path", REASON_UNREACHABLE)
 
 
-@st.composite
-def dr_cases(draw: st.DrawFn, max_n: int = 6, max_side: int = 8
-             ) -> tuple[np.ndarray, Cell, Cell]:
-    """A random D_R (random sizes and obstacle density), start and goal."""
-    N = draw(st.integers(1, max_n))
-    m = draw(st.integers(1, max_side))
-    n = draw(st.integers(1, max_side))
-    density = draw(st.floats(0.0, 0.6))
-    seed = draw(st.integers(0, 2**32 - 1))
-    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
-    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    if draw(st.booleans()):
-        # Mostly free ends, so that most cases reach the search proper.
-        dr[0][start] = 0
-        dr[N][goal] = 0
-    return dr, start, goal
+def dr_cases(max_n: int = 6, max_side: int = 8) -> st.SearchStrategy:
+    """A random D_R (random sizes and obstacle density), start and goal; mostly free ends."""
+    return random_dr(max_n=max_n, max_side=max_side, density=st.floats(0.0, 0.6),
+                     free_ends=None)
 
 
 def check_against_oracles(dr: np.ndarray, start: Cell, goal: Cell) -> SearchResult:
@@ -134,21 +122,11 @@ def check_against_z3(dr: np.ndarray, start: Cell, goal: Cell) -> SearchResult:
     return got
 
 
-@st.composite
-def z3_cases(draw: st.DrawFn) -> tuple[np.ndarray, Cell, Cell]:
+def z3_cases() -> st.SearchStrategy:
     """A tiny random D_R for Z3 (N <= 4, m, n <= 4), any start and goal, with densities up to
     0.8 so that a good share of cases have no path (unreachable, or an end blocked)."""
-    N = draw(st.integers(1, 4))
-    m, n = draw(st.integers(1, 4)), draw(st.integers(1, 4))
-    density = draw(st.sampled_from([0.0, 0.2, 0.4, 0.6, 0.8]))
-    seed = draw(st.integers(0, 2**32 - 1))
-    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
-    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    if draw(st.booleans()):
-        dr[0][start] = 0     # free ends, so that "no path" is often "unreachable"
-        dr[N][goal] = 0
-    return dr, start, goal
+    return random_dr(max_n=4, max_side=4, density=st.sampled_from([0.0, 0.2, 0.4, 0.6, 0.8]),
+                     free_ends=None)
 
 
 @settings(max_examples=50, deadline=None)
@@ -278,20 +256,10 @@ def waits_after_N(path: tuple[Cell, ...], N: int) -> bool:
     return any(path[k + 1] == path[k] for k in range(N, len(path) - 1))
 
 
-@st.composite
-def tiny_cases(draw: st.DrawFn, max_n: int = 3, max_side: int = 3
-               ) -> tuple[np.ndarray, Cell, Cell]:
+def tiny_cases(max_n: int = 3, max_side: int = 3) -> st.SearchStrategy:
     """Grids small enough to enumerate every list up to length_bound: often free (many ties)."""
-    N = draw(st.integers(1, max_n))
-    m, n = draw(st.integers(1, max_side)), draw(st.integers(1, max_side))
-    density = draw(st.sampled_from([0.0, 0.0, 0.15, 0.3]))
-    seed = draw(st.integers(0, 2**32 - 1))
-    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
-    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    dr[0][start] = 0
-    dr[N][goal] = 0
-    return dr, start, goal
+    return random_dr(max_n=max_n, max_side=max_side,
+                     density=st.sampled_from([0.0, 0.0, 0.15, 0.3]), free_ends=True)
 
 
 def check_tie_rule(dr: np.ndarray, start: Cell, goal: Cell) -> int:

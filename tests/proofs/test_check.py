@@ -123,12 +123,17 @@ def test_misreported_costs_and_a_jump_fail_their_checks(outputs, tmp_path, capsy
     assert "FAIL  Theorem 4 post.costs" not in out
 
 
-def test_a_valid_but_worse_path_fails_optimality_only(outputs, tmp_path, capsys):
+def _worse_path(outputs):
+    """A valid path that is not optimal: the self-check's seeded fault, run on the good D_R."""
     s = load_scenario(outputs / "small.toml")
     fault = next(f for f in FAULTS if f.name == "non-optimal path")
     dr = np.load(outputs / "ref" / "dr.npy")
-    worse = fault.make(s, fault.variant, make_grid(s)).search(dr, s.right.start_cell,
-                                                              s.right.goal_cell)
+    return fault.make(s, fault.variant, make_grid(s)).search(dr, s.right.start_cell,
+                                                             s.right.goal_cell)
+
+
+def test_a_valid_but_worse_path_fails_optimality_only(outputs, tmp_path, capsys):
+    worse = _worse_path(outputs)
     doc = _plan_doc(outputs)
     doc.update(path=[list(c) for c in worse.path], J1=worse.J1, J2=worse.J2)
     doc.pop("angles")
@@ -142,11 +147,7 @@ def test_a_worse_path_reported_with_the_optimal_costs_fails_costs_and_optimality
         outputs, tmp_path, capsys):
     # The numbers claimed are the optimum's: only recomputing the path's own costs shows that
     # the path is not the least.
-    s = load_scenario(outputs / "small.toml")
-    fault = next(f for f in FAULTS if f.name == "non-optimal path")
-    dr = np.load(outputs / "ref" / "dr.npy")
-    worse = fault.make(s, fault.variant, make_grid(s)).search(dr, s.right.start_cell,
-                                                              s.right.goal_cell)
+    worse = _worse_path(outputs)
     doc = _plan_doc(outputs)
     best = [doc["J1"], doc["J2"]]
     doc.update(path=[list(c) for c in worse.path])

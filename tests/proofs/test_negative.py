@@ -29,14 +29,22 @@ SYNTACTIC = {(ident, f"BuiltDR.{v}.main") for ident, v in (
 
 
 def _answer(vc: VC, goal: z3.BoolRef | None = None) -> z3.CheckSatResult:
-    ctx = z3.Context()
-    s = z3.Solver(ctx=ctx)
-    s.set("timeout", 20_000)
-    s.add([h.translate(ctx) for _, h in vc.hypotheses])
-    s.add(z3.Not((vc.goal if goal is None else goal).translate(ctx)))
-    # Pins under which Z3 finds the counter-model (e.g. a convex set it cannot invent).
-    s.add([c.translate(ctx) == v.translate(ctx) for c, v in vc.counter_witness])
-    return s.check()
+    # Quantified queries: Z3 may give up (unknown) on one search path and find the model on
+    # another, so an unknown is retried under other seeds; only sat passes a negative test.
+    answer = z3.unknown
+    for seed in range(3):
+        ctx = z3.Context()
+        s = z3.Solver(ctx=ctx)
+        s.set("timeout", 20_000)
+        s.set("random_seed", seed)
+        s.add([h.translate(ctx) for _, h in vc.hypotheses])
+        s.add(z3.Not((vc.goal if goal is None else goal).translate(ctx)))
+        # Pins under which Z3 finds the counter-model (e.g. a convex set it cannot invent).
+        s.add([c.translate(ctx) == v.translate(ctx) for c, v in vc.counter_witness])
+        answer = s.check()
+        if answer != z3.unknown:
+            return answer
+    return answer
 
 
 KEYED = [(i, vc) for i, vc in ALL_VCS if (i, vc.name) not in NO_HYPOTHESES | SYNTACTIC]

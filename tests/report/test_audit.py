@@ -42,7 +42,8 @@ from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write
 from cfmpa.report._audit import _proof_sections, _verdict, contract_rows
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
-from cfmpa.report._provenance import MAX_PATHS, REPORTED_DISTRIBUTIONS, git_state
+from cfmpa._git import MAX_PATHS, git_state
+from cfmpa.report._provenance import REPORTED_DISTRIBUTIONS
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"

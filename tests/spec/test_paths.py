@@ -14,6 +14,7 @@ from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON
                                J1, J2, SearchResult, SearchStatus, is_opt_path, is_path,
                                is_path_paper, opt_path, path_violations)
 from cfmpa.spec._paths_z3 import dr_free, length_bound, path_vars, z3_is_path, z3_J1, z3_J2
+from dr_strategies import random_dr
 from path_enumeration import optimal_lists
 
 Cell = tuple[int, int]
@@ -186,20 +187,10 @@ def test_opt_path_rejects_bad_inputs() -> None:
         opt_path(np.zeros((1, 3, 3), dtype=np.uint8), (0, 0), (0, 0))
 
 
-@st.composite
-def enumerable_cases(draw: st.DrawFn, max_n: int = 3) -> tuple[np.ndarray, Cell, Cell]:
+def enumerable_cases(max_n: int = 3) -> st.SearchStrategy:
     """Grids up to 3 x 3 (N <= max_n), small enough to enumerate every list up to the bound."""
-    N = draw(st.integers(1, max_n))
-    m, n = draw(st.integers(1, 3)), draw(st.integers(1, 3))
-    density = draw(st.sampled_from([0.0, 0.15, 0.3, 0.5]))
-    seed = draw(st.integers(0, 2**32 - 1))
-    dr = (np.random.default_rng(seed).random((N + 1, m, n)) < density).astype(np.uint8)
-    start = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    goal = (draw(st.integers(0, m - 1)), draw(st.integers(0, n - 1)))
-    if draw(st.booleans()):
-        dr[0][start] = 0     # free ends, so that most cases reach the search proper
-        dr[N][goal] = 0
-    return dr, start, goal
+    return random_dr(max_n=max_n, max_side=3, density=st.sampled_from([0.0, 0.15, 0.3, 0.5]),
+                     free_ends=None)
 
 
 def check_opt_path_by_enumeration(dr: np.ndarray, start: Cell, goal: Cell, extra: int) -> str:
