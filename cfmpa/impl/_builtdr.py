@@ -7,6 +7,7 @@ over i and j are vectorised; the loop over k and the links is written out.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -127,6 +128,7 @@ class ContainmentReport:
     layers: int
     worst_slack_m: float
     detail: str
+    regions_sha256: str = ""   # of every polygon checked, so a replay can tell changed regions
 
 
 #: Float slack allowed when checking that one computed polygon lies within another (metres).
@@ -155,7 +157,13 @@ def check_containment(s: Scenario, grid: Grid | None = None) -> ContainmentRepor
                 if sl < worst:
                     worst, where = sl, f"layer {k} link {link + 1}: {inner} within {outer}"
     ok = worst >= -CONTAINMENT_TOL
+    digest = hashlib.sha256()
+    for v in Variant:
+        for pair in regs[v].links:
+            for poly in pair:
+                digest.update(poly.tobytes())
     layer_word = "rest layer" if where.startswith(f"layer {g.N} ") else "layer"
     detail = (f"{g.N} layers and the rest layer, both links; least slack {worst:.3e} m at {where}"
               f" ({layer_word})")
-    return ContainmentReport(ok=ok, layers=g.N + 1, worst_slack_m=float(worst), detail=detail)
+    return ContainmentReport(ok=ok, layers=g.N + 1, worst_slack_m=float(worst), detail=detail,
+                             regions_sha256=digest.hexdigest())

@@ -18,7 +18,6 @@ superfluous ones (0.020 reads as 0.02, the same number).
 
 from __future__ import annotations
 
-import hashlib
 import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -127,7 +126,8 @@ def _margin_side(s: Scenario, d: _Decimal) -> CheckOutcome:
     from ..impl import link_reach, sweep_margin   # the impl's own margin and its snap slack
     from ..impl._regions import SNAP
     g = make_grid(s)
-    left = (s.left.omega[0] * s.dt, s.left.omega[1] * s.dt)   # impl._left_spacing
+    from ..impl._builtdr import _left_spacing     # the spacing the left regions use
+    left = _left_spacing(s)
     right = g.h
     parts, ok = [], True
     for side, arm, sp in (("left", s.left, left), ("right", s.right, right)):
@@ -155,17 +155,11 @@ def _margin_side(s: Scenario, d: _Decimal) -> CheckOutcome:
 
 
 def _containment(s: Scenario, d: _Decimal) -> CheckOutcome:
-    from ..impl import check_containment, left_regions   # only the data checks need impl
-    from ..spec import Variant
+    from ..impl import check_containment   # only the data checks need impl
     rep = check_containment(s)
-    # A digest of the polygons checked, so that a change in the regions shows as "changed".
-    h = hashlib.sha256()
-    for v in Variant:
-        for pair in left_regions(s, v).links:
-            for poly in pair:
-                h.update(poly.tobytes())
+    # The digest of the polygons checked, so that a change in the regions shows as "changed".
     detail = (f"{rep.layers} layers (rest included): {rep.detail}; "
-              f"worst slack {rep.worst_slack_m:.3e} m; polygons sha256 {h.hexdigest()[:16]}")
+              f"worst slack {rep.worst_slack_m:.3e} m; polygons sha256 {rep.regions_sha256[:16]}")
     return CheckOutcome(rep.ok, detail, None if rep.ok else detail)
 
 

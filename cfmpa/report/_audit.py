@@ -359,7 +359,7 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
         if p.certificate is not None:
             minima[v] = (p.certificate.t_min_s, p.certificate.min_clearance_m)
             # The proved figure is a bound only when every interval was proved clear.
-            if p.certificate.clear and getattr(p.certificate, "lower_bound_m", None):
+            if p.certificate.clear:
                 bounds[v] = p.certificate.lower_bound_m
     if series:
         missing = [v for v in ok if v not in series]
