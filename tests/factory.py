@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import json
 from typing import Any
 
 from cfmpa.spec import Scenario, parse_scenario
@@ -37,3 +38,11 @@ def doc(**changes: Any) -> dict[str, Any]:
 def scenario(**changes: Any) -> Scenario:
     """A validated tiny scenario (grid 27 x 27, 6 layers) with ``changes`` applied."""
     return parse_scenario(doc(**changes), check_budget=False)
+
+
+def toml(doc: dict[str, Any]) -> str:
+    """A scenario document (top-level keys, then [left] and [right]) as TOML text."""
+    lines = [f"{k} = {json.dumps(doc[k])}" for k in ("name", "purpose", "dt")]
+    for side in ("left", "right"):
+        lines += [f"[{side}]"] + [f"{k} = {json.dumps(v)}" for k, v in doc[side].items()]
+    return "\n".join(lines) + "\n"

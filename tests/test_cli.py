@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import factory
 from cfmpa.cli import main
 from cfmpa.spec import load_scenario, make_grid
 
@@ -174,11 +175,8 @@ def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_pa
 
     fault = next(f for f in FAULTS if "early" in f.name)
     doc = WORKCELLS[fault.workcell]
-    lines = [f"{k} = {json.dumps(doc[k])}" for k in ("name", "purpose", "dt")]
-    for side in ("left", "right"):
-        lines += [f"[{side}]"] + [f"{k} = {json.dumps(v)}" for k, v in doc[side].items()]
     toml = tmp_path / "early.toml"
-    toml.write_text("\n".join(lines) + "\n")
+    toml.write_text(factory.toml(doc))
     s = load_scenario(toml)
     bad = fault.make(s, fault.variant, make_grid(s)).search
     monkeypatch.setattr(cli, "_kernels", lambda name: (build_dr_fast, bad))

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import factory
 from cfmpa.proofs._check import check_outputs, read_plan, run_check
 from cfmpa.proofs._plan import plan, write_plan
 from cfmpa.proofs._selftest import FAULTS, WORKCELLS
@@ -16,19 +17,11 @@ from cfmpa.spec import load_scenario, make_grid
 from cfmpa.spec._paths import J1, J2
 
 
-def _toml(doc: dict) -> str:
-    lines = [f"{k} = {json.dumps(doc[k])}" for k in ("name", "purpose", "dt")]
-    for side in ("left", "right"):
-        lines.append(f"[{side}]")
-        lines += [f"{k} = {json.dumps(v)}" for k, v in doc[side].items()]
-    return "\n".join(lines) + "\n"
-
-
 @pytest.fixture(scope="module")
 def outputs(tmp_path_factory):
     """A scenario file and the reference planner's outputs for it (variant modified)."""
     d = tmp_path_factory.mktemp("check")
-    (d / "small.toml").write_text(_toml(WORKCELLS["small"]))
+    (d / "small.toml").write_text(factory.toml(WORKCELLS["small"]))
     s = load_scenario(d / "small.toml")
     write_plan(plan(s, "modified", contracts="off"), d / "ref")
     return d
@@ -184,7 +177,7 @@ def test_a_claimed_grid_or_hash_that_differs_fails(outputs, tmp_path, capsys):
 def test_a_contact_fails_the_certificate(outputs, tmp_path, capsys):
     # The early-arrival fault's path waits at its goal while the principal sweeps through it.
     fault = next(f for f in FAULTS if "early" in f.name)
-    (tmp_path / "early.toml").write_text(_toml(WORKCELLS[fault.workcell]))
+    (tmp_path / "early.toml").write_text(factory.toml(WORKCELLS[fault.workcell]))
     s = load_scenario(tmp_path / "early.toml")
     p = plan(s, fault.variant, contracts="off", stop=False,
              search=fault.make(s, fault.variant, make_grid(s)).search)

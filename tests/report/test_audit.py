@@ -411,38 +411,42 @@ def test_unreadable_proofs_json_is_an_input_error(tmp_path, tiny_file):
         build_audit([str(tiny_file)], proofs_json=str(tmp_path / "bad.json"), compare_n=0)
 
 
-def test_every_embedded_picture_decodes(report):
+def _check_data_uri(uri: str) -> None:
+    """Raise unless ``uri`` is a decodable, non-blank PNG or a parseable SVG."""
     from PIL import Image
 
+    head, _, body = uri.partition(",")
+    if head == "data:image/png;base64":
+        data = base64.b64decode(body, validate=True)
+        assert data[:8] == b"\x89PNG\r\n\x1a\n", head
+        with Image.open(io.BytesIO(data)) as img:
+            img.load()                    # decodes every scanline; raises if truncated
+            assert img.width > 100 and img.height > 100, img.size
+            assert len(img.getcolors(maxcolors=1 << 16) or range(1 << 16)) > 8, "blank"
+    elif head.startswith("data:image/svg+xml"):
+        text = (base64.b64decode(body).decode() if head.endswith(";base64")
+                else urllib.parse.unquote(body))
+        assert ElementTree.fromstring(text).tag.endswith("svg")
+    else:
+        raise AssertionError(f"unexpected data URI kind {head!r}")
+
+
+def test_every_embedded_picture_decodes(report):
     uris = re.findall(r'(?:src|href)\s*=\s*"(data:[^"]*)"', report["html"])
     wanted = {f["id"] for f in _figure_refs(report["doc"])}
     assert len(uris) == len(wanted) > 0, "one embedded picture per figure of report.json"
     for uri in uris:
-        head, _, body = uri.partition(",")
-        if head == "data:image/png;base64":
-            data = base64.b64decode(body, validate=True)
-            assert data[:8] == b"\x89PNG\r\n\x1a\n", head
-            with Image.open(io.BytesIO(data)) as img:
-                img.load()                    # decodes every scanline; raises if truncated
-                assert img.width > 100 and img.height > 100, img.size
-                assert len(img.getcolors(maxcolors=1 << 16) or range(1 << 16)) > 8, "blank"
-        elif head.startswith("data:image/svg+xml"):
-            text = (base64.b64decode(body).decode() if head.endswith(";base64")
-                    else urllib.parse.unquote(body))
-            assert ElementTree.fromstring(text).tag.endswith("svg")
-        else:
-            raise AssertionError(f"unexpected data URI kind {head!r}")
+        _check_data_uri(uri)
 
 
 def test_picture_check_catches_a_broken_picture(report):
-    # The decoding above must fail on a truncated PNG, or it checks nothing.
-    from PIL import Image
-
+    # The check above must fail on a truncated PNG, or it checks nothing.
     (uri,) = re.findall(r'src="(data:image/png;base64,[^"]*)"', report["html"])[:1]
-    data = base64.b64decode(uri.partition(",")[2])
+    head, _, body = uri.partition(",")
+    data = base64.b64decode(body)
+    cut = head + "," + base64.b64encode(data[: len(data) // 2]).decode()
     with pytest.raises((OSError, SyntaxError)):
-        with Image.open(io.BytesIO(data[: len(data) // 2])) as img:
-            img.load()
+        _check_data_uri(cut)
 
 
 #: Appended to a scratch copy of the page: after load, lists every picture that did not decode.

@@ -201,7 +201,9 @@ def check_opt_path_by_enumeration(dr: np.ndarray, start: Cell, goal: Cell, extra
     got = opt_path(dr, start, goal)
     if want is None:
         assert got.status == SearchStatus.NO_PATH
-        assert not is_opt_path([start, goal], dr, start, goal)
+        N = dr.shape[0] - 1
+        assert got.reason == (REASON_START_BLOCKED if dr[0][start] else
+                              REASON_GOAL_BLOCKED if dr[N][goal] else REASON_UNREACHABLE)
         return f"no path: {got.reason}"
     assert got.status == SearchStatus.FOUND and (got.J1, got.J2) == want
     assert is_path(got.path, dr, start, goal) and (J1(got.path), J2(got.path)) == want
