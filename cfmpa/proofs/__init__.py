@@ -17,13 +17,14 @@ from ._obl_scenario import scenario_files
 from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proof, VCResult,
                           Verdict, Z3Query, discharge)
 from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
-                      collect_obligations, expected_ids, is_bundled, pinned_verdict,
+                      collect_obligations, compare_ids, expected_ids, is_bundled, pinned_verdict,
                       render_report, run_obligations, run_record, scenarios_note, selected)
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
-    "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "discharge", "expected_ids",
+    "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "discharge",
+    "expected_ids",
     "is_bundled", "pinned_verdict", "render_report", "run_obligations", "run_prove", "run_record",
     "scenarios_note", "selected",
 ]

@@ -175,6 +175,19 @@ class ProveRun:
                 and not self.duplicate_ids)
 
 
+def compare_ids(ids: Sequence[str], expected: Sequence[str]
+                ) -> tuple[tuple[str, ...], tuple[str, ...], dict[str, int]]:
+    """(missing, unexpected, repeated): expected ids absent from ``ids`` (in expected order),
+    ids not expected (first-seen order, once each), and each id produced more than once with
+    its count. The prove run and the audit report judge a set of results by this one rule."""
+    want = set(expected)
+    seen: dict[str, int] = {}
+    for i in ids:
+        seen[i] = seen.get(i, 0) + 1
+    return (tuple(i for i in expected if i not in seen), tuple(i for i in seen if i not in want),
+            {i: n for i, n in seen.items() if n > 1})
+
+
 def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
     """What these results are of: the date, the checkout's commit and cleanliness, and the
     sha256 of every scenario file read, so a report can tell results of another tree."""
@@ -209,12 +222,12 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
         pin = pinned_verdict(p.id)
         if pin is not None and (p.verdict is not pin or p.expected is not pin):
             mismatch.append(p.id)
-    dups = sorted({i for i in ids if ids.count(i) > 1})
+    missing, unexpected, repeated = compare_ids(ids, exp)
     run = ProveRun(proofs=proofs, obligations=tuple(obligations), changes=changes,
                    removed=tuple(sorted(set(previous) - set(exp) - set(ids))),
-                   missing_ids=tuple(i for i in exp if i not in ids),
-                   unexpected_ids=tuple(i for i in dict.fromkeys(ids) if i not in exp),
-                   seconds=seconds, verdict_mismatch=tuple(mismatch), duplicate_ids=tuple(dups),
+                   missing_ids=missing, unexpected_ids=unexpected,
+                   seconds=seconds, verdict_mismatch=tuple(mismatch),
+                   duplicate_ids=tuple(sorted(repeated)),
                    scenarios_note=note, record=dict(record or {}))
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run

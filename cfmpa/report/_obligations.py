@@ -107,18 +107,13 @@ def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
 
 def check_ids(ids: Sequence[str], expected: Sequence[str]) -> tuple[tuple[str, ...],
                                                                      tuple[str, ...]]:
-    """(missing, unexpected): expected ids absent from ``ids``, and ids not expected or repeated
-    (a repeated id is listed as ``"<id> (twice)"``, or the count)."""
-    have = set(ids)
-    want = set(expected)
-    missing = tuple(i for i in expected if i not in have)
-    seen: dict[str, int] = {}
-    for i in ids:
-        seen[i] = seen.get(i, 0) + 1
-    unexpected = tuple(i for i in seen if i not in want)
-    repeated = tuple(f"{i} ({'twice' if n == 2 else f'{n} times'})" for i, n in seen.items()
-                     if n > 1)
-    return missing, unexpected + repeated
+    """(missing, unexpected): by the prove run's own rule (``proofs.compare_ids``), with each
+    repeated id listed among the unexpected as ``"<id> (twice)"``, or its count."""
+    from ..proofs import compare_ids
+
+    missing, unexpected, repeated = compare_ids(ids, expected)
+    return missing, unexpected + tuple(f"{i} ({'twice' if n == 2 else f'{n} times'})"
+                                       for i, n in repeated.items())
 
 
 def summary_table(rows: Iterable[ObligationRow]) -> dict[str, Any]:
