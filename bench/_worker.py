@@ -102,7 +102,7 @@ def item_search(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any]]:
 def item_plan_fast(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any]]:
     """plan() as `cfmpa plan` runs it (fast kernels, the item's contract mode, the certificate),
     files written; imports and the interpreter's start are outside the time."""
-    from cfmpa.proofs._plan import plan, write_plan
+    from cfmpa.runs import plan, write_plan
     from cfmpa.spec import make_grid
 
     s = load(it["scenario"])

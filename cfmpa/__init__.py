@@ -1,6 +1,8 @@
 """cfmpa: an executable specification and checker for a dual-arm collision-free planner.
 
-Layers point one way: ``spec`` <- ``impl``; ``proofs`` uses both; ``cli`` sits on top.
+Layers point one way: ``spec`` <- ``impl`` <- ``proofs`` and ``runs`` <- ``report`` <- ``cli``;
+``errors``, ``files``, ``gitstate`` and ``scenarios`` are leaves every layer may use
+(docs/model.md §1).
 """
 
 __version__ = "0.1.0"

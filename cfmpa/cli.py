@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from . import __version__
 from .errors import CfmpaError, InputError
+from .scenarios import resolve
 
 if TYPE_CHECKING:
     from .spec import Certificate
@@ -31,23 +32,15 @@ def _variant(value: str) -> str:
             f"--variant must be one of {', '.join(v.value for v in Variant)}, got {value!r}") from None
 
 
-def _kernels(name: str):  # type: ignore[no-untyped-def]
-    """(build, search): the fast kernels (bit-identical, checked against) or the reference."""
-    from . import impl
-
-    if name == "reference":
-        return impl.build_dr, impl.search_opt_path
-    return impl.build_dr_fast, impl.search_opt_path_fast
-
-
 def cmd_dr(args: argparse.Namespace) -> int:
     """Build D_R for one scenario and variant; write DIR/dr.npy."""
-    from ._io import save_npy_atomic
+    from .files import save_npy_atomic
+    from .impl import kernels
     from .spec import load_scenario, make_grid
 
-    s = load_scenario(args.scenario)
+    s = load_scenario(resolve(args.scenario))
     g = make_grid(s)
-    build, _ = _kernels(args.kernel)
+    build, _ = kernels(args.kernel)
     t0 = time.perf_counter()
     dr = build(s, args.variant, g)
     seconds = time.perf_counter() - t0
@@ -70,11 +63,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
     (a contact or an undecided interval is a violation in every --contracts mode, off included);
     the files are written all the same, as the evidence, and the summary says so.
     """
-    from .proofs._plan import plan, write_plan
+    from .impl import kernels
+    from .runs import plan, write_plan
     from .spec import load_scenario
 
-    s = load_scenario(args.scenario)
-    build, search = _kernels(args.kernel)
+    s = load_scenario(resolve(args.scenario))
+    build, search = kernels(args.kernel)
     p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample,
              stop=False, build=build, search=search, kernel=args.kernel)
     dr_path, plan_path = write_plan(p, args.out)
@@ -90,10 +84,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         print(f"status    {r.status}: {r.reason}")
     if p.certificate is not None:
         print(_clearance_line(p.certificate))
-    if p.contracts is not None:
-        n_bad = len(p.contracts.get("violations", []))
-        print(f"contracts {p.contracts.get('mode')}: {p.contracts.get('checked')} checks, "
-              f"{n_bad} violations")
+    print(f"contracts {p.settings.mode.value}: {p.checked} checks, {len(violations)} violations")
     print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()))
     print(f"wrote     {dr_path}, {plan_path}")
     for v in violations:
@@ -122,14 +113,14 @@ def _clearance_line(c: Certificate) -> str:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Check another planner's dr.npy and plan.json against the spec."""
-    from .proofs import run_check
+    from .runs import run_check
 
-    return run_check(args.scenario, args.dr, args.plan)
+    return run_check(resolve(args.scenario), args.dr, args.plan)
 
 
 def cmd_selftest(args: argparse.Namespace) -> int:
     """Seed faults and show which contract check catches each."""
-    from .proofs import run_selftest
+    from .runs import run_selftest
 
     return run_selftest()
 
@@ -147,7 +138,7 @@ def cmd_prove(args: argparse.Namespace) -> int:
     from .report import run_audit
 
     print()
-    audit = run_audit(None, args.audit, argv=["cfmpa", *sys.argv[1:]],
+    audit = run_audit(None, args.audit, argv=["cfmpa", *args.argv],
                       proofs_json=str(Path(args.out) / "results.json"),
                       scenarios_dir=args.scenarios)
     return code or audit
@@ -157,8 +148,23 @@ def cmd_audit(args: argparse.Namespace) -> int:
     """Write the audit report (HTML and its JSON twin)."""
     from .report import run_audit
 
-    return run_audit(args.scenarios or None, args.out, argv=["cfmpa", *sys.argv[1:]],
+    files = [str(resolve(a)) for a in args.scenarios] or None
+    return run_audit(files, args.out, argv=["cfmpa", *args.argv],
                      proofs_json=args.proofs, compare_n=args.compare_n)
+
+
+def cmd_scenarios(args: argparse.Namespace) -> int:
+    """List the bundled scenarios: name, grid size and purpose."""
+    from .scenarios import BUNDLED_DIR, bundled_names
+    from .spec import load_scenario, make_grid
+
+    print(f"bundled scenarios in {BUNDLED_DIR} (give the name or a path to any command)")
+    for name in bundled_names():
+        s = load_scenario(BUNDLED_DIR / f"{name}.toml")
+        g = make_grid(s)
+        print(f"{name:<16} dt={s.dt:g} s  grid N={g.N} m={g.m} n={g.n}")
+        print(f"{'':<16} {s.purpose}")
+    return 0
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
@@ -184,7 +190,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     d = sub.add_parser("dr", help="build the collision-state database D_R (BuiltDR)")
-    d.add_argument("scenario", help="scenario TOML file")
+    d.add_argument("scenario", help="scenario: a bundled name (cfmpa scenarios) or a TOML file")
     d.add_argument("--variant", type=_variant, default="modified",
                    help="original | modified | tight (default: modified)")
     d.add_argument("--out", required=True, help="output folder (dr.npy is written there)")
@@ -193,7 +199,7 @@ def _parser() -> argparse.ArgumentParser:
     d.set_defaults(func=cmd_dr)
 
     pl = sub.add_parser("plan", help="plan the subordinate's path; write dr.npy and plan.json")
-    pl.add_argument("scenario", help="scenario TOML file")
+    pl.add_argument("scenario", help="scenario: a bundled name (cfmpa scenarios) or a TOML file")
     pl.add_argument("--variant", type=_variant, default="modified",
                     help="original | modified | tight (default: modified)")
     pl.add_argument("--out", required=True, help="output folder")
@@ -207,9 +213,9 @@ def _parser() -> argparse.ArgumentParser:
     pl.set_defaults(func=cmd_plan)
 
     c = sub.add_parser("check", help="check another planner's dr.npy and plan.json")
-    c.add_argument("scenario", help="scenario TOML file the outputs are for")
+    c.add_argument("scenario", help="scenario the outputs are for: a bundled name or a TOML file")
     c.add_argument("--dr", required=True, help="dr.npy (uint8, shape (N + 1, m, n))")
-    c.add_argument("--plan", required=True, help="plan.json (DESIGN §9)")
+    c.add_argument("--plan", required=True, help="plan.json (docs/model.md §9)")
     c.set_defaults(func=cmd_check)
 
     st = sub.add_parser("selftest", help="seed faults; show which check catches each")
@@ -217,7 +223,8 @@ def _parser() -> argparse.ArgumentParser:
 
     pr = sub.add_parser("prove", help="discharge every obligation (make prove)")
     pr.add_argument("--out", default="build/proofs", help="results folder (default build/proofs)")
-    pr.add_argument("--scenarios", default="scenarios", help="scenario folder (default scenarios)")
+    pr.add_argument("--scenarios", default=None,
+                    help="scenario folder to prove (default: the bundled scenarios)")
     pr.add_argument("--only", action="append", default=None,
                     help="an obligation id, prefix or glob (repeatable)")
     pr.add_argument("--audit", metavar="DIR", default=None,
@@ -225,13 +232,16 @@ def _parser() -> argparse.ArgumentParser:
     pr.set_defaults(func=cmd_prove)
 
     au = sub.add_parser("audit", help="write report.html and report.json")
-    au.add_argument("scenarios", nargs="*", help="scenario files (default: all bundled)")
+    au.add_argument("scenarios", nargs="*", help="scenario names or files (default: all bundled)")
     au.add_argument("--out", required=True, help="output folder")
     au.add_argument("--proofs", default=None,
                     help="results.json of a prove run to report (default: prove afresh)")
     au.add_argument("--compare-n", type=_positive, default=100,
                     help="workcells in the campaign (0 skips it; default 100)")
     au.set_defaults(func=cmd_audit)
+
+    sc = sub.add_parser("scenarios", help="list the bundled scenarios and their purposes")
+    sc.set_defaults(func=cmd_scenarios)
 
     co = sub.add_parser("compare", help="original vs modified vs tight on random workcells")
     co.add_argument("--n", type=_positive, default=100, help="workcells (default 100)")
@@ -245,6 +255,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code (errors become messages, never tracebacks)."""
     parser = _parser()
     args = parser.parse_args(argv)
+    # The provenance records what this call was given, not the process's sys.argv.
+    args.argv = list(sys.argv[1:] if argv is None else argv)
     try:
         return int(args.func(args))
     except InputError as exc:

@@ -117,7 +117,7 @@ def test_plan_writes_stable_json_and_a_summary(tiny_file, tmp_path, capsys):
 
 def test_the_atomic_writer_leaves_the_old_file_and_no_temporary_when_interrupted(
         tmp_path, monkeypatch):
-    from cfmpa import _io
+    from cfmpa import files as _io
 
     target = tmp_path / "plan.json"
     target.write_bytes(b"old")
@@ -138,7 +138,7 @@ def test_the_atomic_writer_leaves_the_old_file_and_no_temporary_when_interrupted
 
 def test_plan_interrupted_at_the_rename_exits_2_and_keeps_the_old_files(tiny_file, tmp_path,
                                                                          monkeypatch, capsys):
-    from cfmpa import _io
+    from cfmpa import files as _io
 
     out = tmp_path / "out"
     assert main(["plan", str(tiny_file), "--out", str(out), "--contracts", "off"]) == 0
@@ -169,9 +169,9 @@ def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_pa
     # contact. --contracts off waives the triples, not the certificate.
     import json
 
-    import cfmpa.cli as cli
+    import cfmpa.impl as impl
     from cfmpa.impl import build_dr_fast
-    from cfmpa.proofs._selftest import FAULTS, WORKCELLS
+    from cfmpa.runs._selftest import FAULTS, WORKCELLS
 
     fault = next(f for f in FAULTS if "early" in f.name)
     doc = WORKCELLS[fault.workcell]
@@ -179,7 +179,7 @@ def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_pa
     toml.write_text(factory.toml(doc))
     s = load_scenario(toml)
     bad = fault.make(s, fault.variant, make_grid(s)).search
-    monkeypatch.setattr(cli, "_kernels", lambda name: (build_dr_fast, bad))
+    monkeypatch.setattr(impl, "kernels", lambda name: (build_dr_fast, bad))
     for mode in ("off", "sampled"):
         out = tmp_path / mode
         assert main(["plan", str(toml), "--variant", fault.variant.value, "--out", str(out),

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 import factory
 from cfmpa.impl import link_rectangles, naive_hull, swept_region
-from cfmpa.impl._builtdr import _slack
+from cfmpa.impl import containment_slack as _slack
 
 TOL = 1e-12
 ARM = factory.scenario().left

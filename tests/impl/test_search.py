@@ -1,4 +1,4 @@
-"""search_opt_path is exact: checked against two Dijkstras and against Z3's Optimize (DESIGN §5)."""
+"""search_opt_path is exact: checked against two Dijkstras and against Z3's Optimize (docs/model.md §5)."""
 
 from __future__ import annotations
 

@@ -69,7 +69,7 @@ def _vc(ident: str, name: str) -> VC:
 
 
 def test_closed_goals_are_not_true_for_a_trivial_reason():
-    from cfmpa.spec._z3defs import is_convex, segment_member
+    from cfmpa.spec.z3defs import is_convex, segment_member
     x = (z3.Real("x.x"), z3.Real("x.y"))
     y = (z3.Real("y.x"), z3.Real("y.y"))
     one, zero = z3.RealVal(1), z3.RealVal(0)
@@ -113,7 +113,7 @@ def test_tight_search_needs_its_own_rest_layer():
     # principal at rest: the safety it promises from step N on is no longer implied.
     from cfmpa.proofs._obl_paths import _search_post, _setting, search_top_level
     from cfmpa.proofs._while import verification_conditions
-    from cfmpa.spec._z3defs import REGION, blocked_exact, in_grid, inter, z3_path
+    from cfmpa.spec.z3defs import REGION, blocked_exact, in_grid, inter, z3_path
     st = _setting()
     found, R = z3.Bool("found"), z3_path("R")
     ints = z3.IntSort()
@@ -161,7 +161,7 @@ def test_a_buggy_builtdr_fails_its_obligation():
 def test_the_fixed_is_path_closes_the_printed_gap():
     # The refuted Def4.is_path_printed hypotheses with the fixed is_path added: now unsat.
     from cfmpa.proofs._obl_paths import _def4_printed, _setting
-    from cfmpa.spec._z3defs import is_path_fixed, z3_path
+    from cfmpa.spec.z3defs import is_path_fixed, z3_path
     vc = _def4_printed().vcs[0]
     st = _setting()
     fixed = is_path_fixed(st.P, st.d, st.start, st.goal, z3_path("L"))
@@ -173,7 +173,7 @@ def test_the_fixed_is_path_closes_the_printed_gap():
 def test_the_fixed_is_path_keeps_the_list_in_the_grid():
     # Def4.is_path_printed_off_grid's hypotheses with the fixed is_path added: now unsat.
     from cfmpa.proofs._obl_paths import _def4_off_grid, _setting
-    from cfmpa.spec._z3defs import is_path_fixed, z3_path
+    from cfmpa.spec.z3defs import is_path_fixed, z3_path
     vc = _def4_off_grid().vcs[0]
     st = _setting()
     fixed = is_path_fixed(st.P, st.d, st.start, st.goal, z3_path("L"))

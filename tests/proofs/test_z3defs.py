@@ -8,7 +8,7 @@ import z3
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cfmpa.spec._z3defs import Z3Dims, Z3PathVar, is_path_fixed, is_path_paper
+from cfmpa.spec.z3defs import Z3Dims, Z3PathVar, is_path_fixed, is_path_paper
 
 paths = pytest.importorskip("cfmpa.spec._paths")
 

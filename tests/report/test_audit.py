@@ -34,7 +34,7 @@ import jsonschema
 import pytest
 from markupsafe import escape
 
-from cfmpa._io import dumps_json
+from cfmpa.files import dumps_json
 from cfmpa.errors import InputError
 from cfmpa.proofs import expected_ids, run_prove
 from cfmpa.proofs._runner import selected
@@ -42,12 +42,12 @@ from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write
 from cfmpa.report._audit import _proof_sections, _verdict, contract_rows
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
-from cfmpa._git import MAX_PATHS, git_state
+from cfmpa.gitstate import MAX_PATHS, git_state
 from cfmpa.report._provenance import REPORTED_DISTRIBUTIONS
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
-SCHEMA = ROOT / "cfmpa" / "report" / "schema.json"
+SCHEMA = ROOT / "report" / "schema.json"
 CHROMIUM = Path("/usr/bin/chromium")
 #: A subset of obligations that discharges in a few seconds, across several groups and verdicts.
 OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival"]

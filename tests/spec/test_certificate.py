@@ -287,7 +287,7 @@ def test_certificate_json_shape():
     assert len(out["contact"]["links"]) == 2
     assert json.loads(json.dumps(out)) == out
     clear = certificate_json(certify(s, g, [(0, 1), (0, 1)]))
-    assert {"min_m", "t_s", "lower_bound_m"} <= set(clear)   # DESIGN §9's keys, and the proof's
+    assert {"min_m", "t_s", "lower_bound_m"} <= set(clear)   # docs/model.md §9's keys, and the proof's
     assert clear["clear"] is True and clear["contact"] is None and clear["undecided"] == []
     assert clear["min_m"] > 0.0 and clear["lower_bound_m"] > 0.0
 

@@ -1,4 +1,4 @@
-"""Paths, costs and Definition 5's oracle (DESIGN §5) on hand-built D_R arrays."""
+"""Paths, costs and Definition 5's oracle (docs/model.md §5) on hand-built D_R arrays."""
 
 from __future__ import annotations
 

@@ -258,7 +258,7 @@ def test_extreme_floats_are_refused_by_name_or_give_a_sane_grid(key, xs):
                for q in range(2))
 
 
-# ---- The principal's PTP motion and the variants' boxes (DESIGN §2, §4) ----
+# ---- The principal's PTP motion and the variants' boxes (docs/model.md §2, §4) ----
 
 _angle = st.floats(-3.2, 3.2)
 

@@ -1,0 +1,177 @@
+"""BuiltDR, the reference (the paper's Algorithm 1, step 3), for the three variants of docs/model.md §4.
+
+Read next to the paper: for every layer k, cell (i, j): P[k, i, j] = 0 iff the principal's region
+S_LArm[k] and the subordinate's region S_RArm[i][j] are apart (distance > eps), else 1. The loops
+over i and j are vectorised; the loop over k and the links is written out.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ..spec import EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid
+from ._collide import PolygonSet, blocked_against, pad_polygons
+from ._regions import Polygon, swept_region
+
+__all__ = [
+    "LeftRegions",
+    "RightRegions",
+    "left_regions",
+    "right_regions",
+    "build_dr",
+    "ContainmentReport",
+    "check_containment",
+    "containment_slack",
+    "left_spacing",
+]
+
+DR = npt.NDArray[np.uint8]  # (N + 1, m, n)
+
+
+@dataclass(frozen=True)
+class LeftRegions:
+    """The principal's region per layer: ``links[k] = (link 1, link 2)``, k = 0..N (N: rest)."""
+
+    variant: Variant
+    links: tuple[tuple[Polygon, Polygon], ...]
+
+
+@dataclass(frozen=True)
+class RightRegions:
+    """The subordinate's regions: link 1 per i (m, V, 2); link 2 per (i, j) (m, n, V, 2)."""
+
+    link1: npt.NDArray[np.float64]
+    link2: npt.NDArray[np.float64]
+
+
+def left_spacing(s: Scenario) -> tuple[float, float]:
+    """The lattice spacing of the principal's regions, omega_q dt per joint, in every variant."""
+    # One lattice for all variants (anchored at theta_L(k dt), spacing omega dt) makes the
+    # variants' lattices nest, so tight within modified within original holds point for point.
+    return (s.left.omega[0] * s.dt, s.left.omega[1] * s.dt)
+
+
+def left_regions(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,
+                 margin_scale: float = 1.0) -> LeftRegions:
+    """S_LArm[k] for k = 0..N-1 and the rest layer (index N), per docs/model.md §4."""
+    v = Variant(variant)
+    g = grid or make_grid(s)
+    spacing = left_spacing(s)
+    out = []
+    for k in range(g.N):
+        box = left_box(s, v, k)
+        anchor = left_angles(s, k * s.dt)
+        out.append(tuple(swept_region(s.left, link, box, anchor, spacing, margin_scale=margin_scale)
+                          for link in (0, 1)))
+    if v is Variant.TIGHT:
+        goal = tuple(s.left.goal)
+        rest = tuple(swept_region(s.left, link, ((goal[0], goal[0]), (goal[1], goal[1])), goal,
+                                  spacing, margin_scale=margin_scale) for link in (0, 1))
+        out.append(rest)
+    else:
+        out.append(out[-1])
+    return LeftRegions(variant=v, links=tuple(out))  # type: ignore[arg-type]
+
+
+def _rotate(poly: npt.NDArray[np.float64], angles: npt.NDArray[np.float64],
+            base: tuple[float, float]) -> npt.NDArray[np.float64]:
+    """Rotate polygons (…, V, 2) about the origin by each angle, then translate to base."""
+    # Written out rather than as an einsum: the same two products and one sum per coordinate
+    # (so the same doubles), several times faster on the right arm's m x n polygons.
+    shape = (len(angles),) + (1,) * (poly.ndim - 1)
+    c, s = np.cos(angles).reshape(shape), np.sin(angles).reshape(shape)
+    x, y = poly[..., 0][None], poly[..., 1][None]
+    return np.stack([c * x + (-s) * y, s * x + c * y], axis=-1) + np.asarray(base)
+
+
+def right_regions(s: Scenario, grid: Grid | None = None, *, margin_scale: float = 1.0
+                  ) -> RightRegions:
+    """S_RArm[i][j] for every cell: the box [t_i -+ h1] x [t_j -+ h2] swept by each link.
+
+    Computed at t_i = 0 with the base at the origin, then rotated by t_i about the base: turning
+    theta1 rotates every configuration's rectangle rigidly, so this is the same construction.
+    """
+    g = grid or make_grid(s)
+    arm = s.right
+    origin = type(arm)(**{**arm.__dict__, "base": (0.0, 0.0)})
+    h1, h2 = g.h
+    t_i = np.asarray(g.angle(0, np.arange(g.m)), dtype=float)
+    t_j = np.asarray(g.angle(1, np.arange(g.n)), dtype=float)
+    l1 = swept_region(origin, 0, ((-h1, h1), (0.0, 0.0)), (0.0, 0.0), (h1, h2),
+                      margin_scale=margin_scale)
+    l2 = pad_polygons([swept_region(origin, 1, ((-h1, h1), (tj - h2, tj + h2)), (0.0, tj), (h1, h2),
+                                    margin_scale=margin_scale) for tj in t_j])
+    return RightRegions(link1=_rotate(l1, t_i, arm.base), link2=_rotate(l2, t_i, arm.base))
+
+
+def build_dr(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,
+             eps: float = EPS, right: RightRegions | None = None, margin_scale: float = 1.0) -> DR:
+    """D_R for ``variant``: uint8 (N + 1, m, n), layers 0..N-1 then the rest layer; 1 = blocked."""
+    g = grid or make_grid(s)
+    rr = right or right_regions(s, g, margin_scale=margin_scale)
+    left = left_regions(s, variant, g, margin_scale=margin_scale)
+    m, n = g.m, g.n
+    set1 = PolygonSet.of(rr.link1)
+    set2 = PolygonSet.of(rr.link2.reshape(m * n, *rr.link2.shape[2:]))
+    P = np.zeros(g.shape, dtype=np.uint8)
+    for k, (a1, a2) in enumerate(left.links):            # For all k = 0 to N (N: rest layer)
+        blocked = np.zeros((m, n), dtype=bool)
+        for a in (a1, a2):                                # S_LArm[k] = link 1 ∪ link 2
+            blocked |= blocked_against(a, set1, eps)[:, None]
+            blocked |= blocked_against(a, set2, eps).reshape(m, n)
+        P[k] = blocked                                    # if S_LArm ∩ S_RArm = Φ then 0 else 1
+    return P
+
+
+@dataclass(frozen=True)
+class ContainmentReport:
+    """tight within modified within original, per layer and rest layer, on computed polygons."""
+
+    ok: bool
+    layers: int
+    worst_slack_m: float
+    detail: str
+    regions_sha256: str = ""   # of every polygon checked, so a replay can tell changed regions
+
+
+#: Float slack allowed when checking that one computed polygon lies within another (metres).
+CONTAINMENT_TOL = 1e-12
+
+
+def containment_slack(inner: Polygon, outer: Polygon) -> float:
+    """Least distance by which inner's vertices lie inside outer's edge lines (< 0: outside)."""
+    edges = np.roll(outer, -1, axis=0) - outer
+    normals = np.stack([edges[:, 1], -edges[:, 0]], -1)           # outward for CCW
+    normals /= np.hypot(normals[:, 0], normals[:, 1])[:, None]
+    out = np.einsum("ed,ved->ve", normals, inner[:, None, :] - outer[None, :, :])
+    return float(-out.max())
+
+
+def check_containment(s: Scenario, grid: Grid | None = None) -> ContainmentReport:
+    """Check region_tight within region_modified within region_original at every layer and R."""
+    g = grid or make_grid(s)
+    regs = {v: left_regions(s, v, g) for v in Variant}
+    worst = np.inf
+    where = ""
+    for k in range(g.N + 1):
+        for link in (0, 1):
+            for inner, outer in ((Variant.TIGHT, Variant.MODIFIED), (Variant.MODIFIED, Variant.ORIGINAL)):
+                sl = containment_slack(regs[inner].links[k][link],
+                                       regs[outer].links[k][link])
+                if sl < worst:
+                    worst, where = sl, f"layer {k} link {link + 1}: {inner} within {outer}"
+    ok = worst >= -CONTAINMENT_TOL
+    digest = hashlib.sha256()
+    for v in Variant:
+        for pair in regs[v].links:
+            for poly in pair:
+                digest.update(poly.tobytes())
+    layer_word = "rest layer" if where.startswith(f"layer {g.N} ") else "layer"
+    detail = (f"{g.N} layers and the rest layer, both links; least slack {worst:.3e} m at {where}"
+              f" ({layer_word})")
+    return ContainmentReport(ok=ok, layers=g.N + 1, worst_slack_m=float(worst), detail=detail,
+                             regions_sha256=digest.hexdigest())

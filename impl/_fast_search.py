@@ -1,0 +1,185 @@
+"""searchoptpath, fast: the reference's states, costs and tie-break, in compiled loops.
+
+Same answer as ``search_opt_path``: the same (J1, J2), status, reason and path. The states
+(step capped at N, cell, previous move), the int64 keys J1 * 2**SHIFT + J2, the input checks, the
+size check and the walk back (``_unwind``) are the reference's own. What differs is how labels
+are computed, and the tie-break is a property of the labels, not of the order of work:
+
+- DAG steps 1..N: the same min over the 9 previous moves with the least move index kept on ties
+  (the reference's two-stage min keeps the lexicographically least (p1, p2), which is the least
+  index 3 p1 + p2); only the cells within s moves of the start are visited at step s.
+- The capped step N: Dial's buckets over J1, as in the reference, with waits left out. Every
+  static predecessor of a state (c, d) has J1 = J1(c, d) - |d|_1, so all of them are expanded
+  together, before (c, d) is; keeping the least key and, on equal keys, the least previous move
+  among them, and a DAG label against an equal static one, is exactly the reference's rule.
+- It stops at the first bucket holding a goal state, and finishes with the least key + |d|_1
+  over the goal states of that bucket, the least move on ties, as the reference does.
+
+So the tie-break is the one ``search_opt_path``'s docstring states on the returned path.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+
+from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
+                           Cell, SearchResult, check_search_inputs)
+from ._progress import progress_bar
+from ._search import INF, J2_MASK, SHIFT, WAIT, _check_size, _unwind
+
+__all__ = ["search_opt_path_fast"]
+
+_DI = np.array([d[0] for d in MOVES], dtype=np.int64)
+_DJ = np.array([d[1] for d in MOVES], dtype=np.int64)
+_NORM = np.abs(_DI) + np.abs(_DJ)                                            # |d|_1
+_GAP = np.abs(_DI[:, None] - _DI[None, :]) + np.abs(_DJ[:, None] - _DJ[None, :])  # |d - p|_1
+
+
+def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
+                         progress: bool | None = None) -> SearchResult:
+    """The same result as ``search_opt_path`` (least (J1, J2), its path, or why none)."""
+    N, m, n, start, goal = check_search_inputs(dr, start, goal)
+    free = np.ascontiguousarray(np.asarray(dr) == 0)
+    if not free[0, start[0], start[1]]:
+        return SearchResult.no_path(REASON_START_BLOCKED)
+    if not free[N, goal[0], goal[1]]:
+        return SearchResult.no_path(REASON_GOAL_BLOCKED)
+    _check_size(N, m, n)
+    dag_pred = np.zeros((N, 9, m, n), dtype=np.int8)   # read only at reachable states
+    keys = np.full((9, m, n), INF, dtype=np.int64)
+    spare = np.full((9, m, n), INF, dtype=np.int64)
+    keys[WAIT, start[0], start[1]] = 0                 # step 0: at start, "arrived" by waiting
+    with progress_bar("search", N + 1, int(free.size), progress) as bar:
+        for s in range(1, N + 1):
+            _dag_step(free[s], keys, spare, dag_pred[s - 1], start[0], start[1], s,
+                      _DI, _DJ, _NORM, _GAP, SHIFT, INF)
+            keys, spare = spare, keys
+            bar.advance()
+        M = m * n
+        pred = np.full(9 * M, -1, dtype=np.int8)
+        from_static = np.zeros(9 * M, dtype=np.bool_)
+        goal_flat = goal[0] * n + goal[1]
+        key, last = _static_phase(free[N].reshape(M), n, keys.reshape(9 * M), pred, from_static,
+                                  goal_flat, _DI, _DJ, _NORM, _GAP, SHIFT, INF, WAIT)
+        bar.advance()
+    if key < 0:
+        return SearchResult.no_path(REASON_UNREACHABLE)
+    path = _unwind(goal, int(last), start, pred, from_static, dag_pred.reshape(N, 3, 3, m, n))
+    return SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+
+
+# ---------------------------------------------------------------- compiled kernels (numba) ----
+
+@njit(cache=True)
+def _dag_step(free, keys, out, pred, si, sj, s, DI, DJ, NORM, GAP, shift, inf
+              ):  # pragma: no cover - compiled; its results are tested against search_opt_path
+    """Step s: out[d, c] = min over p of keys[p, c - d] + |d - p|_1 + (|d|_1 << shift), the least
+    p on ties into pred[d, c]; inf where c is blocked or no finite label reaches it."""
+    m, n = free.shape
+    i0, i1 = max(0, si - s), min(m - 1, si + s)   # cells within s moves of the start
+    j0, j1 = max(0, sj - s), min(n - 1, sj + s)
+    for i in range(i0, i1 + 1):
+        for j in range(j0, j1 + 1):
+            if not free[i, j]:
+                for d in range(9):
+                    out[d, i, j] = inf
+                continue
+            for d in range(9):
+                pi, pj = i - DI[d], j - DJ[d]
+                best, arg = inf, -1
+                if 0 <= pi < m and 0 <= pj < n:
+                    for p in range(9):
+                        k = keys[p, pi, pj]
+                        if k < inf:
+                            v = k + GAP[p, d]
+                            if v < best:
+                                best, arg = v, p
+                if arg >= 0:
+                    out[d, i, j] = best + (NORM[d] << shift)
+                    pred[d, i, j] = arg
+                else:
+                    out[d, i, j] = inf
+
+
+@njit(cache=True)
+def _grow(buf, count, value):  # pragma: no cover - compiled
+    """Append value to buf[:count], doubling buf when full; returns the (maybe new) buffer."""
+    if count == buf.shape[0]:
+        bigger = np.empty(2 * buf.shape[0], dtype=buf.dtype)
+        bigger[:count] = buf[:count]
+        buf = bigger
+    buf[count] = value
+    return buf
+
+
+@njit(cache=True)
+def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shift, inf, wait
+                  ):  # pragma: no cover - compiled; its results are tested against search_opt_path
+    """Dial's buckets over J1 at the capped step N; returns (finish key, last move), or (-1, -1)
+    when the goal is unreachable. State u = move * M + cell; keys start as the DAG's labels."""
+    M = free.shape[0]
+    m = M // n
+    done = np.zeros(keys.shape[0], dtype=np.bool_)
+    initial = np.flatnonzero(keys < inf)
+    order = np.argsort(keys[initial] >> shift, kind="mergesort")
+    initial = initial[order]
+    init_j1 = (keys >> shift)[initial]                 # as sorted; a key may drop later
+    nxt = 0                                            # next unread state of ``initial``
+    # Moves cost J1 1 or 2, so the open buckets are b, b + 1, b + 2: a ring of three.
+    ring = [np.empty(1024, dtype=np.int64) for _ in range(3)]
+    size = np.zeros(3, dtype=np.int64)
+    frontier = np.empty(1024, dtype=np.int64)
+    b = 0 if initial.shape[0] == 0 else init_j1[0]
+    while nxt < initial.shape[0] or size.sum() > 0:
+        if size.sum() == 0 and init_j1[nxt] > b:
+            b = init_j1[nxt]                           # skip empty buckets
+        slot = b % 3
+        count = 0
+        while nxt < initial.shape[0] and init_j1[nxt] == b:
+            u = initial[nxt]
+            nxt += 1
+            if not done[u] and keys[u] >> shift == b:
+                done[u] = True
+                frontier = _grow(frontier, count, u)
+                count += 1
+        for r in range(size[slot]):
+            u = ring[slot][r]
+            if not done[u] and keys[u] >> shift == b:
+                done[u] = True
+                frontier = _grow(frontier, count, u)
+                count += 1
+        size[slot] = 0
+        best, last = inf, -1
+        for d in range(9):                             # the least move on equal finishes
+            u = d * M + goal
+            if done[u] and keys[u] + NORM[d] < best:
+                best, last = keys[u] + NORM[d], d
+        if last >= 0:
+            return best, last
+        for f in range(count):
+            u = frontier[f]
+            p, c = u // M, u % M
+            i, j = c // n, c % n
+            for d in range(9):
+                if d == wait:
+                    continue
+                ti, tj = i + DI[d], j + DJ[d]
+                if ti < 0 or ti >= m or tj < 0 or tj >= n or not free[ti * n + tj]:
+                    continue
+                v = d * M + ti * n + tj
+                if done[v]:
+                    continue
+                cand = keys[u] + (NORM[d] << shift) + GAP[p, d]
+                if cand < keys[v]:
+                    keys[v] = cand
+                    pred[v] = p
+                    from_static[v] = True
+                    target = (b + NORM[d]) % 3
+                    ring[target] = _grow(ring[target], size[target], v)
+                    size[target] += 1
+                elif cand == keys[v] and from_static[v] and p < pred[v]:
+                    pred[v] = p                         # equal keys: the least previous move
+        b += 1
+    return -1, -1

@@ -1,0 +1,370 @@
+"""`make prove`: collect the obligations, discharge them, compare with the last run, report.
+
+The run passes only if every verdict is the one pinned in EXPECTED_VERDICTS (and agrees with
+``Obligation.expected``) and the set of obligation ids equals the expected list, without
+repeats: the fixed ids below plus one per check (CHECKS) and scenario, by name for the bundled
+folder's scenarios (so a deleted file is a missing id) and per file found for any other folder
+(said in the report). Nothing can be dropped silently. Every obligation's query is saved under
+the output directory with its sha256, and results.json says which obligations are new, changed or the same since last time.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import fnmatch
+import hashlib
+import json
+import os
+import tempfile
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import sympy
+import z3
+
+from .. import __version__
+from ..gitstate import git_state, repo_root
+from ..scenarios import BUNDLED_DIR
+from ._ledger import ASSUMPTIONS, Assumption
+from ._obl_builtdr import builtdr_obligations
+from ._obl_geometry import geometry_obligations
+from ._obl_margin import margin_obligations
+from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
+from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
+from ._obligation import Method, Obligation, Proof, Verdict, discharge
+
+__all__ = [
+    "BUNDLED_DIR",
+    "BUNDLED_SCENARIOS",
+    "EXPECTED_VERDICTS",
+    "FIXED_IDS",
+    "ProveRun",
+    "collect_obligations",
+    "expected_ids",
+    "is_bundled",
+    "pinned_verdict",
+    "render_report",
+    "run_obligations",
+    "scenarios_note",
+    "selected",
+]
+
+_P, _R = Verdict.PROVED, Verdict.REFUTED_AS_EXPECTED
+
+#: Every fixed obligation id and the verdict it must get: the one place the expectation is
+#: pinned. Kept by hand, on purpose: an obligation that disappears from the code, or whose
+#: ``Obligation.expected`` drifts from this, makes the run fail.
+EXPECTED_VERDICTS: dict[str, Verdict] = {
+    "Def1.segment": _P, "Def1.segment_printed": _R, "Def2.is_convex": _P,
+    "Def3.convex_hull": _P, "Lemma1.convex_monotone": _P, "Lemma2.convex_union": _P,
+    "Sep.separating_axis": _P, "Sep.distance_monotone": _P,
+    "Margin.cos_bound": _P, "Margin.arc_chord": _P, "Lemma.sweep_margin": _P,
+    "Margin.naive_hull": _R,
+    "Thm1.builtdr": _P, "Thm1.termination": _P, "Thm3.builtdr": _P, "Thm3.termination": _P,
+    "Thm3.builtdr_tight": _P, "Thm3.termination_tight": _P, "Thm3.box_nesting": _P,
+    "Prop1.state_meaning": _P, "Prop2.endpoints": _P, "Prop3.layer_free": _P,
+    "Prop4.rest_free": _P, "Prop5.optpath_is_path": _P, "Prop5.printed": _R,
+    "Prop6.opt_layer_free": _P, "Prop7.opt_rest_free": _P,
+    "Def4.is_path_printed": _R, "Def4.is_path_printed_off_grid": _R,
+    "Def4.is_path_fixed_safe": _P,
+    "Thm2.searchoptpath": _P, "Thm4.searchoptpath": _P, "Thm4.searchoptpath_tight": _P,
+    "Prop8.printed": _R, "Prop8.intersection_monotone": _P, "Prop8.subset_monotone": _P,
+    "Prop8.valid_transfer": _P, "Prop8.path_exists": _P, "Prop8.optimal_cost": _P,
+    "Prop8.prestrength_thm4": _P,
+}
+
+#: The obligations every run must produce, besides the per-scenario ones.
+FIXED_IDS: tuple[str, ...] = tuple(EXPECTED_VERDICTS)
+
+#: The bundled scenario files (stems) of ``BUNDLED_DIR``: their checks are expected by name, so
+#: a deleted file is a missing id, not a quietly shorter run. Every scenario check must prove.
+BUNDLED_SCENARIOS: tuple[str, ...] = ("default", "early-arrival", "limited-joints",
+                                      "narrow-gap", "original-fails")
+
+
+def is_bundled(scenarios_dir: str | Path) -> bool:
+    """Whether ``scenarios_dir`` is the repository's own scenarios folder."""
+    try:
+        return Path(scenarios_dir).resolve() == BUNDLED_DIR.resolve()
+    except OSError:
+        return False
+
+
+def pinned_verdict(ident: str) -> Verdict | None:
+    """The verdict ``ident`` must get: from EXPECTED_VERDICTS, PROVED for a scenario check, None
+    for an id this module does not know (it is then an unexpected id)."""
+    if ident in EXPECTED_VERDICTS:
+        return EXPECTED_VERDICTS[ident]
+    parts = ident.split(".")
+    if len(parts) >= 3 and parts[0] == "Scenario" and parts[-1] in CHECKS:
+        return Verdict.PROVED
+    return None
+
+
+_COLUMNS = ("total", "proved (Z3)", "proved (sympy)", "checked on data", "refuted as expected",
+            "unknown", "failed")
+
+
+def collect_obligations(scenarios_dir: str | Path = BUNDLED_DIR,
+                        only: Iterable[str] | None = None) -> tuple[Obligation, ...]:
+    """Every obligation (cheap: queries are built when discharged), optionally filtered."""
+    obs = (geometry_obligations() + margin_obligations() + builtdr_obligations()
+           + path_obligations() + theorem_obligations() + prop8_obligations()
+           + scenario_obligations(scenarios_dir))
+    return tuple(o for o in obs if selected(o.id, only))
+
+
+def expected_ids(scenarios_dir: str | Path = BUNDLED_DIR) -> tuple[str, ...]:
+    """The ids a full run must produce: FIXED_IDS, then len(CHECKS) per scenario: for the bundled
+    folder the pinned BUNDLED_SCENARIOS (whatever files are there), for any other folder one
+    set per file found in it (``scenarios_note`` says so)."""
+    if is_bundled(scenarios_dir):
+        stems = list(BUNDLED_SCENARIOS)
+    else:
+        stems = [f.stem for f in scenario_files(scenarios_dir)]
+    return FIXED_IDS + tuple(scenario_check_id(s, c) for s in stems for c in CHECKS)
+
+
+def scenarios_note(scenarios_dir: str | Path) -> str:
+    """What the run expects from the scenario folder, in words (printed at the top)."""
+    if is_bundled(scenarios_dir):
+        return (f"scenarios: the bundled folder; expecting {len(CHECKS)} checks for each of "
+                + ", ".join(BUNDLED_SCENARIOS))
+    files = scenario_files(scenarios_dir)
+    return (f"scenarios: {scenarios_dir} is not the bundled folder ({BUNDLED_DIR}); expecting "
+            f"from its {len(files)} file(s) the ids "
+            + (", ".join(scenario_check_id(f.stem, "{" + ",".join(CHECKS) + "}") for f in files)
+               or "(none)")
+            + "; the bundled scenarios' checks are not run")
+
+
+def selected(ident: str, only: Iterable[str] | None) -> bool:
+    """Whether ``ident`` is picked by ``only``: an exact id, a prefix ending at a dot (``Prop8``
+    picks ``Prop8.printed``), or a glob (``Thm*``). None picks everything."""
+    if only is None:
+        return True
+    for pat in only:
+        if ident == pat or ident.startswith(pat.rstrip(".") + ".") or fnmatch.fnmatchcase(ident, pat):
+            return True
+    return False
+
+
+@dataclass(frozen=True)
+class ProveRun:
+    """One run: the proofs, how each compares with the previous run, and the id check."""
+
+    proofs: tuple[Proof, ...]
+    obligations: tuple[Obligation, ...]
+    changes: dict[str, str]            # id -> new | changed | same
+    removed: tuple[str, ...]           # in the previous results, expected no longer
+    missing_ids: tuple[str, ...]       # expected but not produced
+    unexpected_ids: tuple[str, ...]    # produced but not expected
+    seconds: float
+    assumptions: tuple[Assumption, ...] = field(default=ASSUMPTIONS)
+    verdict_mismatch: tuple[str, ...] = ()   # verdict or Obligation.expected != the pinned one
+    duplicate_ids: tuple[str, ...] = ()      # produced more than once
+    scenarios_note: str = ""
+    record: dict[str, Any] = field(default_factory=dict)   # results.json's "run" (run_record)
+
+    @property
+    def ok(self) -> bool:
+        return (all(p.as_expected for p in self.proofs) and not self.missing_ids
+                and not self.unexpected_ids and not self.verdict_mismatch
+                and not self.duplicate_ids)
+
+
+def compare_ids(ids: Sequence[str], expected: Sequence[str]
+                ) -> tuple[tuple[str, ...], tuple[str, ...], dict[str, int]]:
+    """(missing, unexpected, repeated): expected ids absent from ``ids`` (in expected order),
+    ids not expected (first-seen order, once each), and each id produced more than once with
+    its count. The prove run and the audit report judge a set of results by this one rule."""
+    want = set(expected)
+    seen: dict[str, int] = {}
+    for i in ids:
+        seen[i] = seen.get(i, 0) + 1
+    return (tuple(i for i in expected if i not in seen), tuple(i for i in seen if i not in want),
+            {i: n for i, n in seen.items() if n > 1})
+
+
+def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
+    """What these results are of: the date, the checkout's commit and cleanliness, and the
+    sha256 of every scenario file read, so a report can tell results of another tree."""
+    git = git_state(repo_root())
+    return {"date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+            "git": {"commit": git["commit"], "clean": git["clean"]},
+            "scenarios": {f.name: hashlib.sha256(f.read_bytes()).hexdigest()
+                          for f in scenario_files(scenarios_dir)}}
+
+
+def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
+                    expected: Sequence[str], *, note: str = "",
+                    record: dict[str, Any] | None = None) -> ProveRun:
+    """Discharge each obligation, save its query and the results, compare with the last run;
+    every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    previous = _load_previous(out / "results.json")
+    t0 = time.perf_counter()
+    proofs = tuple(discharge(o) for o in obligations)
+    seconds = time.perf_counter() - t0
+    changes = {}
+    for p in proofs:
+        old = previous.get(p.id)
+        changes[p.id] = "new" if old is None else ("same" if old.get("sha256") == p.sha256
+                                                  else "changed")
+        _write_atomic(out / _query_file(p), p.smtlib)
+    ids = [p.id for p in proofs]
+    exp = list(expected)
+    mismatch = []
+    for p in proofs:
+        pin = pinned_verdict(p.id)
+        if pin is not None and (p.verdict is not pin or p.expected is not pin):
+            mismatch.append(p.id)
+    missing, unexpected, repeated = compare_ids(ids, exp)
+    run = ProveRun(proofs=proofs, obligations=tuple(obligations), changes=changes,
+                   removed=tuple(sorted(set(previous) - set(exp) - set(ids))),
+                   missing_ids=missing, unexpected_ids=unexpected,
+                   seconds=seconds, verdict_mismatch=tuple(mismatch),
+                   duplicate_ids=tuple(sorted(repeated)),
+                   scenarios_note=note, record=dict(record or {}))
+    _write_atomic(out / "results.json", _results_json(run, previous))
+    return run
+
+
+def _query_file(p: Proof) -> str:
+    return f"{p.id}.smt2" if p.method is Method.Z3 else f"{p.id}.txt"
+
+
+def _load_previous(path: Path) -> dict[str, dict[str, Any]]:
+    try:
+        doc = json.loads(path.read_text())
+        return {o["id"]: o for o in doc.get("obligations", []) if isinstance(o, dict) and "id" in o}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    """Write to a temporary name in the same directory, then rename over the target."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _counts(proofs: Iterable[Proof]) -> dict[str, int]:
+    c = dict.fromkeys(_COLUMNS, 0)
+    for p in proofs:
+        c["total"] += 1
+        if p.verdict is Verdict.PROVED:
+            key = {Method.Z3: "proved (Z3)", Method.SYMPY: "proved (sympy)",
+                   Method.DATA: "checked on data"}[p.method]
+            c[key] += 1
+        elif p.verdict is Verdict.REFUTED_AS_EXPECTED:
+            c["refuted as expected"] += 1
+        elif p.verdict is Verdict.UNKNOWN:
+            c["unknown"] += 1
+        else:
+            c["failed"] += 1
+    return c
+
+
+def _groups(proofs: Sequence[Proof]) -> dict[str, list[Proof]]:
+    out: dict[str, list[Proof]] = {}
+    for p in proofs:
+        out.setdefault(p.group, []).append(p)
+    return out
+
+
+def _proof_json(p: Proof, ob: Obligation, change: str) -> dict[str, Any]:
+    return {
+        "id": p.id, "group": p.group, "paper_ref": ob.paper_ref, "statement": ob.statement,
+        "method": p.method.value, "expected": p.expected.value, "verdict": p.verdict.value,
+        "as_expected": p.as_expected, "seconds": round(p.seconds, 3), "sha256": p.sha256,
+        "file": _query_file(p), "change": change, "statistics": p.statistics,
+        "counterexample": p.counterexample, "reason": p.reason,
+        "reason_unknown": p.reason_unknown,
+        "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer} for v in p.vcs],
+    }
+
+
+def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
+    by_id = {o.id: o for o in run.obligations}
+    entries = [_proof_json(p, by_id[p.id], run.changes[p.id]) for p in run.proofs]
+    ran = {p.id for p in run.proofs}
+    # Obligations not selected this time keep their last recorded result.
+    carried = [dict(v, change="not run") for k, v in previous.items() if k not in ran]
+    doc = {
+        "tool": "cfmpa prove", "version": __version__, "z3": z3.get_version_string(),
+        "sympy": sympy.__version__, "ok": run.ok, "run": run.record,
+        "summary": {g: _counts(ps) for g, ps in _groups(run.proofs).items()},
+        "totals": _counts(run.proofs),
+        "missing_ids": list(run.missing_ids), "unexpected_ids": list(run.unexpected_ids),
+        "verdict_mismatch": list(run.verdict_mismatch), "duplicate_ids": list(run.duplicate_ids),
+        "scenarios_note": run.scenarios_note,
+        "removed_since_last_run": list(run.removed),
+        "obligations": entries + carried,
+        "assumptions": [{"id": a.id, "what": a.what, "why": a.why, "used_by": a.used_by}
+                        for a in run.assumptions],
+        "seconds": round(run.seconds, 3),
+    }
+    return json.dumps(doc, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
+
+
+def render_report(run: ProveRun) -> str:
+    """The gnatprove.out-like text: summary table, one line per obligation, changes, ledger."""
+    groups = _groups(run.proofs)
+    width = max([len(g) for g in groups] + [len("Total")])
+    heads = [f"{c:>{max(len(c), 5)}}" for c in _COLUMNS]
+    lines = ["Summary of proof obligations", ""] + ([run.scenarios_note, ""] if run.scenarios_note
+                                                  else []) + [
+             f"{'Group':<{width}}  " + "  ".join(heads),
+             "-" * (width + 2 + sum(len(h) + 2 for h in heads))]
+
+    def row(name: str, c: dict[str, int]) -> str:
+        return f"{name:<{width}}  " + "  ".join(f"{c[k]:>{len(h)}}" for k, h in zip(_COLUMNS, heads))
+    for g, ps in groups.items():
+        lines.append(row(g, _counts(ps)))
+    lines.append("-" * (width + 2 + sum(len(h) + 2 for h in heads)))
+    lines.append(row("Total", _counts(run.proofs)))
+    lines += ["", "Obligations", ""]
+    idw = max([len(p.id) for p in run.proofs] + [10])
+    for p in run.proofs:
+        pin = pinned_verdict(p.id)
+        want = pin if pin is not None else p.expected
+        flag = "" if p.as_expected and p.verdict is want else f"  << expected {want}"
+        # The verdict is "proved" either way; the line says how: a data check is not a proof.
+        shown = ("checked on data" if p.method is Method.DATA and p.verdict is Verdict.PROVED
+                 else p.verdict.value)
+        lines.append(f"{p.id:<{idw}}  {shown:<20} {p.seconds:7.2f}s  "
+                     f"[{run.changes[p.id]}]{flag}")
+        if p.verdict in (Verdict.UNKNOWN, Verdict.FAILED) or not p.as_expected:
+            lines.append(f"{'':<{idw}}  reason: {p.reason}"
+                         + (f" ({p.reason_unknown})" if p.reason_unknown else ""))
+        if p.counterexample:
+            lines += [f"{'':<{idw}}  | {ln}" for ln in p.counterexample.splitlines()]
+    changed = {k: sum(1 for v in run.changes.values() if v == k) for k in ("new", "changed", "same")}
+    lines += ["", "Since the last run: " + ", ".join(f"{v} {k}" for k, v in changed.items())
+              + (f", {len(run.removed)} removed ({', '.join(run.removed)})" if run.removed else "")]
+    if run.missing_ids:
+        lines.append("MISSING obligations (expected, not produced): " + ", ".join(run.missing_ids))
+    if run.unexpected_ids:
+        lines.append("UNEXPECTED obligations (produced, not in the expected list): "
+                     + ", ".join(run.unexpected_ids))
+    if run.verdict_mismatch:
+        lines.append("VERDICTS differing from the pinned expectation (EXPECTED_VERDICTS): "
+                     + ", ".join(run.verdict_mismatch))
+    if run.duplicate_ids:
+        lines.append("DUPLICATE obligation ids: " + ", ".join(run.duplicate_ids))
+    lines += ["", "Assumptions (not proved)", ""]
+    for a in run.assumptions:
+        lines += [f"{a.id}: {a.what}", f"    why: {a.why}", f"    used by: {a.used_by}"]
+    verdict = "OK: every verdict as expected" if run.ok else "NOT OK"
+    lines += ["", f"{verdict}; {len(run.proofs)} obligations in {run.seconds:.1f} s"]
+    return "\n".join(lines) + "\n"

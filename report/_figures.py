@@ -1,0 +1,637 @@
+"""The report's pictures (matplotlib, Agg backend; the only module of cfmpa that plots).
+
+Every function returns a ``Figure``: PNG bytes with a caption and alt text, embedded in the HTML
+as a data URI. PNGs carry no software or date metadata, so the same data gives the same bytes.
+Units: metres and millimetres in the workcell, radians in joint space, seconds in time.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")  # no display, no GUI toolkit: the report is written headless
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import numpy.typing as npt  # noqa: E402
+import shapely  # noqa: E402
+import shapely.ops  # noqa: E402
+from matplotlib.colors import ListedColormap  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch, Polygon as MplPolygon, Rectangle  # noqa: E402
+
+from ..spec import Grid, Scenario, Variant, arm_corners, left_angles  # noqa: E402
+from ._findings import (EarlyArrivalData, InconsistencyData, NaiveHullData, Prop8Data,  # noqa: E402
+                        right_angles_at)
+
+__all__ = [
+    "Figure",
+    "workcell_figure",
+    "workcell_instants",
+    "cspace_figure",
+    "variants_figure",
+    "clearance_figure",
+    "naive_hull_figure",
+    "inconsistency_figure",
+    "prop8_figure",
+    "early_arrival_figure",
+    "compare_figure",
+    "VARIANT_COLORS",
+]
+
+#: Pixels per inch: sharp on screen and legible printed at A4 width.
+DPI = 120
+VARIANT_COLORS = {Variant.ORIGINAL: "#c0392b", Variant.MODIFIED: "#7d3c98",
+                  Variant.TIGHT: "#1e8449"}
+VARIANT_STYLES = {Variant.ORIGINAL: "-", Variant.MODIFIED: "--", Variant.TIGHT: ":"}
+LEFT_COLOR = "#2e5c9a"     # the principal
+RIGHT_COLOR = "#e07b00"    # the subordinate
+ZONE_COLOR = "#f4e19c"     # the shared zone
+FREE_COLOR = "#eef3fb"
+FloatArray = npt.NDArray[np.float64]
+BLOCKED_COLOR = "#4d4d4d"
+
+plt.rcParams.update({
+    "font.size": 9, "axes.titlesize": 9.5, "axes.labelsize": 9, "legend.fontsize": 8,
+    "figure.dpi": DPI, "savefig.dpi": DPI, "axes.grid": True, "grid.alpha": 0.25,
+})
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A rendered picture: an id (unique in a report), caption, alt text and PNG bytes."""
+
+    id: str
+    caption: str
+    alt: str
+    png: bytes
+
+    @property
+    def data_uri(self) -> str:
+        return "data:image/png;base64," + base64.b64encode(self.png).decode("ascii")
+
+
+def _save(fig: Any, fid: str, caption: str, alt: str) -> Figure:
+    """Render to PNG, then reduce to a 256-colour palette: a third of the bytes, no visible change
+    for line art (Pillow is matplotlib's own dependency)."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight", metadata={"Software": None})
+    plt.close(fig)
+    buf.seek(0)
+    img = Image.open(buf).convert("RGB").quantize(colors=256, method=Image.Quantize.MEDIANCUT,
+                                                  dither=Image.Dither.NONE)
+    out = io.BytesIO()
+    img.save(out, format="PNG", optimize=True)
+    return Figure(fid, caption, alt, out.getvalue())
+
+
+# --- drawing helpers ----------------------------------------------------------------------------
+
+def _draw_arm(ax: Any, arm: Any, theta: Sequence[float], color: str, *, alpha: float = 0.55,
+              lw: float = 1.0, ls: str = "-", fill: bool = True, label: str | None = None) -> None:
+    for k, rect in enumerate(arm_corners(arm, (float(theta[0]), float(theta[1])))):
+        ax.add_patch(MplPolygon(rect, closed=True, facecolor=color if fill else "none",
+                                edgecolor=color, alpha=alpha if fill else 1.0, lw=lw, ls=ls,
+                                label=label if k == 0 else None))
+    ax.plot(*arm.base, marker="o", color="black", ms=3, zorder=5)
+
+
+def _draw_poly(ax: Any, poly: npt.ArrayLike, color: str, *, alpha: float = 0.25, lw: float = 1.2,
+               ls: str = "-", label: str | None = None, fill: bool = True, zorder: int = 2) -> None:
+    p = np.asarray(poly, dtype=float)
+    if fill:
+        ax.add_patch(MplPolygon(p, closed=True, facecolor=color, edgecolor="none", alpha=alpha,
+                                zorder=zorder))
+    ax.add_patch(MplPolygon(p, closed=True, facecolor="none", edgecolor=color, lw=lw, ls=ls,
+                            label=label, zorder=zorder + 1))
+
+
+def _reach(arm: Any) -> float:
+    """Farthest point of the arm from its base (m)."""
+    return math.hypot(arm.links[0] + arm.links[1] + arm.width / 2, arm.width / 2)
+
+
+def _shared_zone(s: Scenario) -> Any:
+    a = shapely.Point(*s.left.base).buffer(_reach(s.left), quad_segs=64)
+    b = shapely.Point(*s.right.base).buffer(_reach(s.right), quad_segs=64)
+    return a.intersection(b)
+
+
+def _zone(ax: Any, s: Scenario, label: bool = True) -> None:
+    z = _shared_zone(s)
+    if not z.is_empty and z.geom_type == "Polygon":
+        ax.add_patch(MplPolygon(np.asarray(z.exterior.coords), closed=True, facecolor=ZONE_COLOR,
+                                edgecolor="#c9a227", lw=0.8, alpha=0.6, zorder=0,
+                                label="shared zone (both reach disks)" if label else None))
+
+
+def _zoom(ax: Any, polys: Sequence[npt.ArrayLike], pad: float = 0.03) -> None:
+    pts = np.concatenate([np.asarray(p, dtype=float).reshape(-1, 2) for p in polys])
+    lo, hi = pts.min(axis=0) - pad, pts.max(axis=0) + pad
+    c, half = (lo + hi) / 2, (hi - lo).max() / 2
+    ax.set_xlim(c[0] - half, c[0] + half)
+    ax.set_ylim(c[1] - half, c[1] + half)
+    ax.set_aspect("equal")
+
+
+def _nearest(a: Sequence[npt.ArrayLike], b: Sequence[npt.ArrayLike]
+             ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The closest pair of points between two unions of polygons (equal points when they meet)."""
+    ua = shapely.union_all([shapely.Polygon(np.asarray(p, dtype=float)) for p in a])
+    ub = shapely.union_all([shapely.Polygon(np.asarray(p, dtype=float)) for p in b])
+    pa, pb = shapely.ops.nearest_points(ua, ub)
+    return np.array([pa.x, pa.y]), np.array([pb.x, pb.y])
+
+
+def _gap_line(ax: Any, pa: npt.NDArray[np.float64], pb: npt.NDArray[np.float64], text: str) -> None:
+    ax.plot([pa[0], pb[0]], [pa[1], pb[1]], color="black", lw=1.2, marker="|", ms=6)
+    ax.annotate(text, xy=(pa + pb) / 2, xytext=(8, 8), textcoords="offset points", fontsize=8,
+                bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "#999", "alpha": 0.9})
+
+
+def _motion_bounds(ax: Any, s: Scenario, g: Grid, cells: npt.NDArray[np.int64], t_end: float
+                   ) -> None:
+    """Axes limits around everything both arms cover during the motion (equal aspect)."""
+    t = np.linspace(0.0, t_end, 60)
+    la, ra = left_angles(s, t), right_angles_at(g, cells, t)
+    pts = [np.asarray(r) for th in la for r in arm_corners(s.left, (th[0], th[1]))]
+    pts += [np.asarray(r) for th in ra for r in arm_corners(s.right, (th[0], th[1]))]
+    _zoom(ax, pts, pad=0.05)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+
+
+def _motion_end(s: Scenario, g: Grid, path: Sequence[Sequence[int]]) -> float:
+    return max((len(path) - 1) * s.dt, g.Tf)
+
+
+def _tip_traces(ax: Any, s: Scenario, g: Grid, path: Sequence[Sequence[int]]) -> None:
+    t = np.linspace(0.0, _motion_end(s, g, path), 200)
+    la = left_angles(s, t)
+    ra = right_angles_at(g, np.asarray(path, dtype=np.int64).reshape(-1, 2), t)
+    for arm, ang, color, name in ((s.left, la, LEFT_COLOR, "principal"),
+                                  (s.right, ra, RIGHT_COLOR, "subordinate")):
+        u1 = np.stack([np.cos(ang[:, 0]), np.sin(ang[:, 0])], 1)
+        e = np.asarray(arm.base) + arm.links[0] * u1
+        p = e + arm.links[1] * np.stack([np.cos(ang.sum(1)), np.sin(ang.sum(1))], 1)
+        ax.plot(p[:, 0], p[:, 1], color=color, lw=0.8, ls="--", alpha=0.8,
+                label=f"{name} tip path")
+
+
+# --- per scenario -------------------------------------------------------------------------------
+
+def workcell_instants(tf: float, t_end: float, dt: float, t_min: float | None) -> list[float]:
+    """The instants the workcell picture shows: four spread over the principal's motion [0, Tf],
+    the end of the subordinate's motion when it ends after Tf, and the least-clearance instant
+    ``t_min`` (in place of an inner instant within Tf/6 of it; added unless within dt/2 of one)."""
+    times = [0.0, tf / 3, 2 * tf / 3, tf] if tf > 0 else [0.0]
+    if t_end > tf + dt / 2:
+        times.append(t_end)
+    if t_min is not None and min(abs(t_min - x) for x in times) > dt / 2:
+        inner = [k for k in (1, 2) if tf > 0 and abs(times[k] - t_min) <= tf / 6]
+        if inner:
+            times[inner[0]] = t_min
+        else:
+            times.append(t_min)
+    return sorted(times)
+
+
+def workcell_figure(fid: str, s: Scenario, g: Grid, path: Sequence[Sequence[int]],
+                    variant: Variant, t_min: float | None, d_min: float | None) -> Figure:
+    """Both arms at instants spread over the principal's motion and one after, the zone shaded."""
+    if path:
+        t_end = _motion_end(s, g, path)
+        cells = np.asarray(path, dtype=np.int64).reshape(-1, 2)
+    else:
+        t_end = g.Tf
+        cells = np.asarray([s.right.start_cell], dtype=np.int64)
+    times = workcell_instants(g.Tf, t_end, s.dt, t_min if path else None)
+    # Three panels a row: each wide enough that its tick labels read at A4 width.
+    cols = 3
+    rows = math.ceil(len(times) / cols)
+    spare = rows * cols > len(times)                  # a free slot holds the legend
+    with plt.rc_context({"font.size": 10, "axes.titlesize": 10.5, "axes.labelsize": 10,
+                         "legend.fontsize": 9.5, "xtick.labelsize": 9, "ytick.labelsize": 9}):
+        fig, axes = plt.subplots(rows, cols, figsize=(10.5, 3.55 * rows), squeeze=False)
+        flat = list(axes.flat)
+        for ax, t in zip(flat, times):
+            _zone(ax, s)
+            if path:
+                _tip_traces(ax, s, g, path)
+            _draw_arm(ax, s.left, left_angles(s, t), LEFT_COLOR, label="principal (left)")
+            _draw_arm(ax, s.right, right_angles_at(g, cells, np.array([t]))[0], RIGHT_COLOR,
+                      label="subordinate (right)")
+            _motion_bounds(ax, s, g, cells, t_end)
+            when = ("start" if t == 0 else "principal arrives (Tf)" if abs(t - g.Tf) < 1e-12
+                    else "subordinate arrives" if abs(t - t_end) < 1e-12 and path
+                    else "principal at rest" if t > g.Tf else f"{t / g.Tf:.0%} of Tf")
+            title = f"t = {t:.3f} s: {when}"
+            if t_min is not None and d_min is not None and abs(t - t_min) < 1e-12:
+                title += f"\nleast sampled clearance {d_min * 1000:.1f} mm"
+            ax.set_title(title)
+        for k, ax in enumerate(flat):
+            if k % cols:
+                ax.set_ylabel("")
+        handles, labels = flat[0].get_legend_handles_labels()
+        for ax in flat[len(times):]:
+            ax.set_axis_off()
+        fig.suptitle(f"{s.name}: workcell, {variant.value} plan (Tf = {g.Tf:.3f} s)" if path
+                     else f"{s.name}: workcell (no path; subordinate at its start)")
+        if spare:
+            flat[len(times)].legend(handles, labels, loc="center", frameon=False)
+            fig.tight_layout()
+        else:
+            fig.tight_layout(rect=(0, 0.06 / rows, 1, 1))
+            fig.legend(handles, labels, loc="lower center", ncol=3, frameon=False)
+    what = "the planned motion" if path else "the principal's motion (no path was found)"
+    return _save(fig, fid, f"{s.name}: both arms at {len(times)} instants of {what} "
+                 f"({variant.value} variant): four spread over the principal's motion up to "
+                 f"Tf = {g.Tf:.3f} s"
+                 + (", then the end of the subordinate's motion" if t_end > g.Tf + s.dt / 2
+                    else "") + "; shaded: where both arms can reach; dashed: the tips' paths.",
+                 f"Workcell of {s.name} with both arms at {len(times)} instants")
+
+
+def _layers(N: int) -> list[int]:
+    ks = sorted({0, round((N - 1) / 4), round((N - 1) / 2), round(3 * (N - 1) / 4), N - 1})
+    return ks + [N]
+
+
+def cspace_figure(fid: str, s: Scenario, g: Grid, dr: npt.NDArray[np.uint8],
+                  path: Sequence[Sequence[int]], variant: Variant) -> Figure:
+    """Selected layers of D_R (the paper's Fig. 3), the path's cell at each marked, and R."""
+    ks = _layers(g.N)
+    cols = 3
+    rows = math.ceil(len(ks) / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(11, 3.6 * rows), squeeze=False)
+    cmap = ListedColormap([FREE_COLOR, BLOCKED_COLOR])
+    ext = (g.lo[0] - g.h[0] / 2, g.lo[0] + (g.m - 0.5) * g.h[0],
+           g.lo[1] - g.h[1] / 2, g.lo[1] + (g.n - 0.5) * g.h[1])
+    cells = np.asarray(path, dtype=np.int64).reshape(-1, 2)
+    ang = (np.stack([g.lo[0] + cells[:, 0] * g.h[0], g.lo[1] + cells[:, 1] * g.h[1]], 1)
+           if len(cells) else np.zeros((0, 2)))
+    start, goal = g.angles(s.right.start_cell), g.angles(s.right.goal_cell)
+    last = len(ang) - 1
+    for ax, k in zip(axes.flat, ks):
+        ax.imshow(dr[k].T, origin="lower", extent=ext, cmap=cmap, vmin=0, vmax=1,
+                  interpolation="nearest", aspect="auto")
+        ax.grid(False)
+        ax.plot(*start, marker="^", ms=7, mfc="#00a050", mec="white", ls="", zorder=4)
+        ax.plot(*goal, marker="*", ms=10, mfc="#ffd000", mec="black", mew=0.6, ls="", zorder=4)
+        state = ""
+        if len(ang):
+            # Layer k holds step k; R holds every step from N on. Solid: the steps up to the one
+            # this layer holds; faded: the rest, which other layers judge.
+            step = min(k, last)
+            done, rest = ang[: step + 1], ang[step:]
+            if k == g.N:
+                done, rest = ang[min(g.N, last):], ang[: min(g.N, last) + 1]
+            ax.plot(rest[:, 0], rest[:, 1], color=RIGHT_COLOR, lw=1.0, alpha=0.35, ls="--",
+                    zorder=3)
+            ax.plot(done[:, 0], done[:, 1], color=RIGHT_COLOR, lw=1.6, zorder=3)
+            waiting = step == last or (step > 0 and bool((cells[step] == cells[step - 1]).all()))
+            ax.plot(*ang[step], marker="o", ms=7, mfc="#ff2020", mec="white", mew=1.0, ls="",
+                    zorder=6)
+            if k == g.N:
+                state = (", waiting at the goal" if last <= g.N else
+                         f", steps {g.N}..{last} in R")
+            elif waiting:
+                state = ", waiting at the goal" if step == last else ", waiting"
+        free = 1.0 - float(dr[k].mean())
+        if k < g.N:
+            ax.set_title(f"layer k = {k}: t in [{k * g.dt:.2f}, {(k + 1) * g.dt:.2f}] s, "
+                         f"{free:.1%} free{state}")
+        else:
+            ax.set_title(f"rest layer R (index {g.N}), {free:.1%} free{state}")
+        ax.set_xlabel("θ1 of the subordinate (rad)")
+        ax.set_ylabel("θ2 (rad)")
+    for ax in list(axes.flat)[len(ks):]:
+        ax.set_visible(False)
+    handles = [Patch(facecolor=FREE_COLOR, edgecolor="#999", label="free (P = 0)"),
+               Patch(facecolor=BLOCKED_COLOR, label="blocked (P = 1)"),
+               Line2D([], [], color=RIGHT_COLOR, lw=1.6, label="path up to the layer's step"),
+               Line2D([], [], color=RIGHT_COLOR, lw=1.0, alpha=0.35, ls="--",
+                      label="rest of the path"),
+               Line2D([], [], ls="", marker="o", mfc="#ff2020", mec="white",
+                      label="cell occupied at the layer's step"),
+               Line2D([], [], ls="", marker="^", mfc="#00a050", mec="white", label="start"),
+               Line2D([], [], ls="", marker="*", ms=10, mfc="#ffd000", mec="black", label="goal")]
+    fig.legend(handles=handles, loc="lower center", ncol=4, bbox_to_anchor=(0.5, -0.06))
+    fig.suptitle(f"{s.name}: C-space layers of D_R ({variant.value}), grid {g.m} x {g.n}, "
+                 f"N = {g.N}", y=1.0)
+    fig.tight_layout()
+    return _save(fig, fid, f"{s.name}: layers of D_R for the {variant.value} variant (as in the "
+                 f"paper's Fig. 3): light cells are free, dark blocked. Layer k is the grid the "
+                 f"subordinate's step k is judged against: solid, the path up to step k, with the "
+                 f"cell it occupies then (red); dashed, the rest of the path, judged in other "
+                 f"layers. The last panel is the rest layer R, which holds every step from N on.",
+                 f"C-space layers of D_R for {s.name}")
+
+
+def variants_figure(fid: str, s: Scenario, g: Grid, drs: Mapping[Variant, npt.NDArray[np.uint8]],
+                    regions: Mapping[Variant, tuple[npt.ArrayLike, npt.ArrayLike]], layer: int
+                    ) -> Figure:
+    """Free cells per layer under each variant, and the principal's region at one layer (Fig. 4)."""
+    fig = plt.figure(figsize=(11, 7.4))
+    grid = fig.add_gridspec(2, 3, height_ratios=[1, 1.15])
+    a = fig.add_subplot(grid[0, :])
+    k = np.arange(g.N)
+    markers = {Variant.ORIGINAL: "s", Variant.MODIFIED: "D", Variant.TIGHT: "^"}
+    for v, dr in drs.items():
+        free = 100.0 * (1.0 - dr.reshape(dr.shape[0], -1).mean(axis=1))
+        a.plot(k, free[: g.N], color=VARIANT_COLORS[v], ls=VARIANT_STYLES[v], lw=1.6,
+               label=f"{v.value}: mean {free.mean():.2f} % free, rest layer {free[g.N]:.2f} %")
+        a.plot([g.N], [free[g.N]], marker=markers[v], color=VARIANT_COLORS[v], ls="", ms=6)
+    a.axvline(layer, color="#999", lw=0.8, ls="--")
+    a.set_xlabel(f"layer k (t from k x {g.dt} s); the markers at k = {g.N} are the rest layer R")
+    a.set_ylabel("free cells (%)")
+    a.set_title(f"{s.name}: free cells per layer (dashed line: the layer drawn below)",
+                pad=26)
+    # Above the axes, not over the curves (they rise to the top right in every scenario).
+    a.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=3, frameon=False,
+             fontsize=8)
+    order = [v for v in (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT) if v in regions]
+    polys = [p for v in order for p in regions[v]]
+    for col, v in enumerate(order):
+        b = fig.add_subplot(grid[1, col])
+        for idx, p in enumerate(regions[v]):
+            _draw_poly(b, p, VARIANT_COLORS[v], alpha=0.25, lw=1.4,
+                       label=f"{v.value} region" if idx == 0 else None)
+        _draw_arm(b, s.left, left_angles(s, layer * s.dt), LEFT_COLOR, fill=False, lw=1.0,
+                  label=f"principal at t = {layer * s.dt:.2f} s")
+        _draw_arm(b, s.left, left_angles(s, (layer + 1) * s.dt), LEFT_COLOR, fill=False, ls="--",
+                  lw=1.0, label=f"principal at t = {(layer + 1) * s.dt:.2f} s")
+        area = shapely.union_all([shapely.Polygon(np.asarray(p, dtype=float))
+                                  for p in regions[v]]).area
+        _zoom(b, polys)
+        b.set_xlabel("x (m)")
+        b.set_ylabel("y (m)" if col == 0 else "")
+        b.set_title(f"{v.value}: layer {layer}, area {area * 1e4:.1f} cm²")
+    # One legend under the three panels: inside them it covered the arm's base.
+    handles = [Patch(facecolor=VARIANT_COLORS[v], alpha=0.4, edgecolor=VARIANT_COLORS[v],
+                     label=f"{v.value} region") for v in order]
+    handles += [Line2D([], [], color=LEFT_COLOR, lw=1.0,
+                       label=f"principal at t = {layer * s.dt:.2f} s (layer start)"),
+                Line2D([], [], color=LEFT_COLOR, lw=1.0, ls="--",
+                       label=f"principal at t = {(layer + 1) * s.dt:.2f} s (layer end)")]
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), frameon=False,
+               bbox_to_anchor=(0.5, 0.0))
+    return _save(fig, fid, f"{s.name}: original / modified / tight side by side. Top: the share "
+                 f"of free cells per layer. Bottom: the principal's swept region at layer {layer} "
+                 f"under each variant (as in the paper's Fig. 4), with the principal at the "
+                 f"layer's start (solid) and end (dashed).", f"Variants compared for {s.name}")
+
+
+def clearance_figure(fid: str, s: Scenario, g: Grid,
+                     series: Mapping[Variant, tuple[FloatArray, FloatArray]],
+                     minima: Mapping[Variant, tuple[float, float]], missing: Sequence[Variant],
+                     same_as: Mapping[Variant, Variant] | None = None,
+                     bounds: Mapping[Variant, float] | None = None) -> Figure:
+    """Distance between the arms along each variant's planned motion, least sampled value and
+    the certificate's proved lower bound marked; variants with the same path drawn once."""
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    same_as, bounds = same_as or {}, bounds or {}
+    t_last = 0.0
+    for v, (t, d) in series.items():
+        if v in same_as:
+            continue
+        group = [v, *(u for u in series if same_as.get(u) is v)]
+        names = ", ".join(u.value for u in group)
+        color, style = VARIANT_COLORS[v], VARIANT_STYLES[v]
+        t_last = max(t_last, float(t[-1]))
+        ax.plot(t, d * 1000, color=color, ls=style, lw=1.6,
+                label=f"{names} (one path)" if len(group) > 1 else names)
+        if v in minima:
+            tm, dm = minima[v]
+            ax.plot([tm], [dm * 1000], marker="v", ms=8, color=color, ls="", zorder=5,
+                    label=f"least sampled: {dm * 1000:.2f} mm at t = {tm:.3f} s")
+        if bounds.get(v):
+            ax.plot([t[0], t[-1]], [bounds[v] * 1000] * 2, color=color, lw=1.0, ls=(0, (1, 2)),
+                    label=f"proved lower bound: {bounds[v] * 1000:.2f} mm (certificate)")
+    for v in missing:
+        ax.plot([], [], color=VARIANT_COLORS[v], ls=VARIANT_STYLES[v], label=f"{v.value}: no path")
+    ax.axvline(g.Tf, color="#777", lw=0.8, ls="-.")
+    ax.text(g.Tf, 0.98, " principal arrives (Tf)", va="top", ha="left", fontsize=8,
+            color="#555", transform=ax.get_xaxis_transform())
+    ax.axhline(0.0, color="black", lw=0.8)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("distance between the arms (mm)")
+    ax.set_title(f"{s.name}: clearance along the planned motion")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
+    fig.tight_layout()
+    return _save(fig, fid, f"{s.name}: the least distance between any link of the principal and "
+                 f"any link of the subordinate along each variant's executed motion (sampled 16 "
+                 f"times per dt); variants that plan the same path share one curve. Triangles: "
+                 f"the certificate's least sampled clearance; dotted: its proved lower bound over "
+                 f"the whole motion.", f"Clearance over time for {s.name}")
+
+
+# --- findings -----------------------------------------------------------------------------------
+
+def naive_hull_figure(fid: str, d: NaiveHullData) -> Figure:
+    """The link's poses over a box, the naive hull of the end poses, the sound region."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
+    for ax in axes:
+        for r in d.samples[:: max(1, len(d.samples) // 60)]:
+            ax.add_patch(MplPolygon(r, closed=True, facecolor="none", edgecolor="#9aa5b1",
+                                    lw=0.4, alpha=0.7))
+        _draw_poly(ax, d.sound, VARIANT_COLORS[Variant.TIGHT], alpha=0.08, lw=1.4,
+                   label="sound region (lattice hull + margin δ)")
+        _draw_poly(ax, d.naive, VARIANT_COLORS[Variant.ORIGINAL], alpha=0.10, lw=1.6, ls="--",
+                   label="naive hull of the corner poses")
+        ax.add_patch(MplPolygon(d.worst_rect, closed=True, facecolor=RIGHT_COLOR, alpha=0.45,
+                                edgecolor=RIGHT_COLOR, lw=1.2, label="pose leaving the naive hull"))
+        ax.plot(*d.worst_point, marker="x", ms=9, mew=2, color="black",
+                label=f"worst point: {d.protrusion_m * 1000:.1f} mm outside")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    axes[0].plot([], [], color="#9aa5b1", lw=0.6, label="link 2 at sampled poses in the box")
+    _zoom(axes[0], [d.sound, d.naive])
+    axes[0].set_title(f"link {d.link + 1} over θ1 in [{d.box[0][0]:.2f}, {d.box[0][1]:.2f}], "
+                      f"θ2 in [{d.box[1][0]:.2f}, {d.box[1][1]:.2f}] rad")
+    axes[0].legend(loc="lower left", fontsize=7)
+    wx, wy = d.worst_point
+    half = max(4 * d.protrusion_m, 0.02)
+    axes[1].set_xlim(wx - half, wx + half)
+    axes[1].set_ylim(wy - half, wy + half)
+    axes[1].set_aspect("equal")
+    axes[1].set_title("zoom on the worst point")
+    fig.tight_layout()
+    return _save(fig, fid, "The naive hull (dashed red) of the link at the box's corner poses "
+                 "misses the link at poses in between (orange); the sound region (green) covers "
+                 "every sampled pose.", "The naive hull's unsoundness, drawn")
+
+
+def inconsistency_figure(fid: str, d: InconsistencyData) -> Figure:
+    """Joint-space boxes per variant at one layer, and the regions they sweep in the workcell."""
+    s = d.scenario
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(13, 4.8))
+    t = np.linspace(0, d.grid.Tf, 200)
+    th = left_angles(s, t)
+    a.plot(th[:, 0], th[:, 1], color=LEFT_COLOR, lw=1, label="principal's planned motion")
+    for v in (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT):
+        (x0, x1), (y0, y1) = d.boxes[v]
+        if x1 - x0 < 1e-9 and y1 - y0 < 1e-9:
+            a.plot([x0], [y0], marker="P", ms=9, color=VARIANT_COLORS[v], ls="",
+                   label=f"{v.value} box (a point: the principal has arrived)")
+            continue
+        a.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, facecolor=VARIANT_COLORS[v],
+                              alpha=0.15, edgecolor=VARIANT_COLORS[v], ls=VARIANT_STYLES[v], lw=1.6,
+                              label=f"{v.value} box"))
+    a.plot(*d.theta_now, marker="o", color="black", ms=4, ls="", label=f"θ(k Δt), k = {d.layer}")
+    a.plot(*d.theta_next, marker="s", color="black", mfc="none", ms=7, ls="",
+           label="θ((k+1) Δt)")
+    (x0, x1), (y0, y1) = d.boxes[Variant.ORIGINAL]
+    px, py = (x1 - x0) * 0.6, (y1 - y0) * 0.6
+    a.set_xlim(x0 - px, x1 + px)
+    a.set_ylim(y0 - py, y1 + py)
+    a.set_aspect("equal")
+    a.set_xlabel("θ1 of the principal (rad)")
+    a.set_ylabel("θ2 of the principal (rad)")
+    a.set_title(f"joint boxes at the last layer k = {d.layer}")
+    a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), fontsize=7)
+    order = (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT)
+    for ax in (b, c):
+        for v in order:
+            for idx, p in enumerate(d.regions[v]):
+                _draw_poly(ax, p, VARIANT_COLORS[v], alpha=0.08, ls=VARIANT_STYLES[v], lw=1.4,
+                           label=(f"{v.value} region: {d.distances_m[v] * 1000:.1f} mm from the "
+                                  f"goal cell's region") if idx == 0 else None)
+        for idx, p in enumerate(d.right_region):
+            _draw_poly(ax, p, RIGHT_COLOR, alpha=0.3, label="subordinate's region at its goal cell"
+                       if idx == 0 else None)
+        _draw_arm(ax, s.right, d.right_goal, RIGHT_COLOR, fill=False, lw=0.8,
+                  label="subordinate at its goal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    polys = [p for v in order for p in d.regions[v]] + list(d.right_region)
+    _zoom(b, polys, pad=0.01)
+    b.set_title(f"{s.name}: regions at layer {d.layer}")
+    b.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), fontsize=7)
+    pa, pb = _nearest(d.regions[Variant.MODIFIED], d.right_region)
+    qa, _ = _nearest(d.regions[Variant.ORIGINAL], d.right_region)
+    _zoom(c, [np.stack([pa, pb, qa])], pad=max(1.5 * float(np.hypot(*(pa - pb))), 0.01))
+    _gap_line(c, pa, pb, f"modified: {d.distances_m[Variant.MODIFIED] * 1000:.1f} mm")
+    c.plot(*qa, marker="x", color=VARIANT_COLORS[Variant.ORIGINAL], ms=9, mew=2)
+    c.set_title("zoom: original meets the goal cell's region (x)")
+    fig.tight_layout()
+    return _save(fig, fid, f"The two-sided box of Algorithm 1 against the one-sided (modified) "
+                 f"and planned (tight) boxes at the last layer of {s.name}: in joint space (left), "
+                 f"as swept regions with the subordinate's region at its goal cell (middle), and "
+                 f"zoomed where they come closest (right).",
+                 "The inconsistency: two-sided against one-sided box")
+
+
+def prop8_figure(fid: str, d: Prop8Data) -> Figure:
+    """S (original) meets the subordinate's cell region, S' (modified) does not."""
+    s = d.scenario
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+    for ax in axes:
+        for v, reg, name in ((Variant.ORIGINAL, d.region_s, "S (original)"),
+                             (Variant.MODIFIED, d.region_s_prime, "S' (modified)")):
+            for idx, p in enumerate(reg):
+                _draw_poly(ax, p, VARIANT_COLORS[v], alpha=0.12, ls=VARIANT_STYLES[v], lw=1.4,
+                           label=name if idx == 0 else None)
+        for idx, p in enumerate(d.right_region):
+            _draw_poly(ax, p, RIGHT_COLOR, alpha=0.3,
+                       label=f"subordinate's region at cell {d.cell}" if idx == 0 else None)
+        _draw_arm(ax, s.left, d.theta_left, LEFT_COLOR, fill=False, lw=0.8,
+                  label="principal at k Δt")
+        _draw_arm(ax, s.right, d.theta_right, RIGHT_COLOR, fill=False, lw=0.8,
+                  label="subordinate at the cell's pose")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    _zone(axes[0], s)
+    _zoom(axes[0], [*d.region_s, *d.right_region], pad=0.05)
+    axes[0].set_title(f"{s.name}, layer k = {d.layer}, cell {d.cell}")
+    axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=7, ncol=2)
+    pa, pb = _nearest(d.region_s_prime, d.right_region)
+    qa, _ = _nearest(d.region_s, d.right_region)
+    _zoom(axes[1], [np.stack([pa, pb, qa])], pad=max(1.5 * float(np.hypot(*(pa - pb))), 0.01))
+    _gap_line(axes[1], pa, pb, f"S' to the cell's region: {d.gap_s_prime_m * 1000:.1f} mm")
+    axes[1].plot(*qa, marker="x", color=VARIANT_COLORS[Variant.ORIGINAL], ms=9, mew=2)
+    axes[1].set_title("zoom: S meets the cell's region (x), S' does not")
+    fig.tight_layout()
+    return _save(fig, fid, f"Property 8 as printed, refuted on {s.name}: at layer {d.layer}, cell "
+                 f"{d.cell} is blocked under S (P = 1) but free under S', so P is not the table of "
+                 f"S'.", "Counterexample to Property 8 as printed")
+
+
+def early_arrival_figure(fid: str, d: EarlyArrivalData) -> Figure:
+    """The early path waiting at its goal while the principal sweeps through it."""
+    s, g = d.scenario, d.grid
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.4), gridspec_kw={"width_ratios": [1, 1.2]})
+    cells = np.asarray(d.path, dtype=np.int64)
+    _zone(a, s)
+    t_c = d.contact_t_s if d.contact_t_s is not None else g.Tf / 2
+    for t in np.linspace(0.0, t_c, 5)[:-1]:
+        _draw_arm(a, s.left, left_angles(s, t), LEFT_COLOR, fill=False, lw=0.6, ls=":")
+    _draw_arm(a, s.left, left_angles(s, t_c), LEFT_COLOR, label=f"principal at t = {t_c:.3f} s")
+    _draw_arm(a, s.right, right_angles_at(g, cells, np.array([t_c]))[0], RIGHT_COLOR,
+              label="subordinate waiting at its goal")
+    a.plot([], [], color=LEFT_COLOR, ls=":", label="principal earlier")
+    _motion_bounds(a, s, g, cells, t_c)
+    a.set_title("the arms in contact while the subordinate waits" if d.contact_t_s is not None
+                else "no contact found")
+    a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=7, ncol=2)
+    b.plot(d.times_s, d.clearance_m * 1000, color=VARIANT_COLORS[Variant.ORIGINAL], lw=1.5,
+           label=f"straight {len(d.path)}-cell path (passes the printed is_path)")
+    if len(d.optimal_times_s):
+        b.plot(d.optimal_times_s, d.optimal_clearance_m * 1000, color=VARIANT_COLORS[Variant.TIGHT],
+               lw=1.5, ls="--", label=f"optimal path under the fixed is_path "
+               f"({len(d.optimal_path)} cells, modified)")
+    if d.contact_t_s is not None:
+        b.plot([d.contact_t_s], [0.0], marker="X", ms=9, color="black", ls="",
+               label=f"contact (certificate) at t = {d.contact_t_s:.3f} s")
+    b.axvline((len(d.path) - 1) * s.dt, color="#777", ls="--", lw=0.8)
+    b.text((len(d.path) - 1) * s.dt, 0.98, " list ends: the arm waits", va="top", fontsize=8,
+           color="#555", transform=b.get_xaxis_transform())
+    b.axhline(0.0, color="black", lw=0.8)
+    b.set_xlabel("time t (s)")
+    b.set_ylabel("distance between the arms (mm)")
+    b.set_title("clearance along the early path")
+    b.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=7)
+    fig.tight_layout()
+    return _save(fig, fid, f"The printed is_path's flaw on {s.name}: the shortest list arrives "
+                 f"early, passes the printed definition, and the principal then sweeps through the "
+                 f"waiting subordinate.", "The is_path flaw: a collision after the list ends")
+
+
+def compare_figure(fid: str, doc: Mapping[str, Any]) -> Figure:
+    """The campaign: success rate per variant and how many workcells each variant alone solves."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 3.8))
+    rows = doc["table"]
+    names = [r["variant"] for r in rows]
+    colors = [VARIANT_COLORS[Variant(n)] for n in names]
+    rates = [100 * r["success_rate"] for r in rows]
+    bars = a.bar(names, rates, color=colors, alpha=0.8)
+    for bar, r in zip(bars, rows):
+        a.text(bar.get_x() + bar.get_width() / 2, bar.get_height(), f"{r['found']}/{doc['n']}",
+               ha="center", va="bottom", fontsize=8)
+    a.set_ylim(0, 105)
+    a.set_ylabel("workcells with a path (%)")
+    a.set_xlabel("variant")
+    a.set_title(f"success over {doc['n']} random workcells (seed {doc['seed']})")
+    free = [100 * r["mean_free_fraction"] for r in rows]
+    b.bar(names, free, color=colors, alpha=0.8)
+    # From 0, like the left panel: a cut axis would make a point of difference look like half.
+    b.set_ylim(0, 105)
+    for x, f in zip(names, free):
+        b.text(x, f, f"{f:.2f} %", ha="center", va="bottom", fontsize=8)
+    b.set_ylabel("mean free cells (%)")
+    b.set_xlabel("variant")
+    b.set_title("mean share of free cells in D_R")
+    fig.tight_layout()
+    return _save(fig, fid, f"The seeded campaign: share of the {doc['n']} random workcells each "
+                 f"variant solves, and the mean share of free cells.",
+                 "Campaign results per variant")

@@ -1,0 +1,233 @@
+"""The report's proof data: obligations, the assumptions ledger and the mutation self-check.
+
+Where the obligations come from (decided here, printed in the report):
+- ``proofs_json`` given (what ``make prove`` passes: ``build/proofs/results.json``, just written):
+  read from that file, so the report shows exactly the run that ``make prove`` printed;
+- otherwise a fresh run of the prove machinery (``cfmpa.proofs.collect_obligations``, each
+  obligation discharged in this process by ``discharge``; nothing is written under build/proofs).
+Either way the ids are checked here against ``cfmpa.proofs.expected_ids`` (or the list the caller
+gives): none missing, none extra, none twice; what a results.json says of its own ids is not taken
+on trust.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = [
+    "ObligationRow",
+    "ProofData",
+    "SUMMARY_COLUMNS",
+    "check_ids",
+    "load_proofs",
+    "summary_table",
+    "load_selftest",
+]
+
+#: The summary's columns (gnatprove.out style), key -> heading.
+SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("total", "total"),
+    ("proved_z3", "proved by Z3"),
+    ("proved_sympy", "proved by sympy"),
+    ("checked_data", "checked on data"),
+    ("tested_only", "tested only"),
+    ("refuted_as_expected", "refuted as expected"),
+    ("unproved", "unproved"),
+)
+
+_VERDICTS = ("proved", "refuted as expected", "unknown", "failed")
+
+
+@dataclass(frozen=True)
+class ObligationRow:
+    """One obligation's outcome as the report prints it."""
+
+    id: str
+    group: str
+    paper_ref: str
+    statement: str
+    method: str
+    verdict: str
+    expected: str
+    seconds: float | None
+    counterexample: str | None
+    reason: str
+    sha256: str
+    change: str | None = None      # new | changed | same | not run, against the previous prove run
+
+    @property
+    def as_expected(self) -> bool:
+        return self.verdict == self.expected
+
+    def as_json(self) -> dict[str, Any]:
+        return {"id": self.id, "group": self.group, "paper_ref": self.paper_ref,
+                "statement": self.statement, "method": self.method, "verdict": self.verdict,
+                "expected": self.expected, "as_expected": self.as_expected,
+                "seconds": self.seconds, "counterexample": self.counterexample,
+                "reason": self.reason, "sha256": self.sha256, "change": self.change}
+
+
+@dataclass(frozen=True)
+class ProofData:
+    """Obligations and ledger, with where they came from; ``available`` False: none this run."""
+
+    available: bool
+    source: str
+    note: str
+    rows: tuple[ObligationRow, ...]
+    ledger: tuple[dict[str, str], ...]
+    ledger_available: bool
+    missing_ids: tuple[str, ...] = ()      # expected by the prove machinery, not in the data
+    unexpected_ids: tuple[str, ...] = ()   # in the data, not expected
+    run: dict[str, Any] | None = None      # results.json's "run" record (None: fresh, or absent)
+    not_run: tuple[str, ...] = ()          # ids results.json carried over from an earlier run
+
+
+def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
+                expected: Sequence[str] | None = None) -> ProofData:
+    """Obligations and ledger from ``proofs_json``, else from a fresh run (module docstring).
+
+    ``expected``: the ids the data must hold (None: ``expected_ids(scenarios_dir)``, every
+    obligation; a prove run restricted with ``--only`` is then reported with ids missing).
+    """
+    from ..proofs import expected_ids
+
+    want = tuple(expected) if expected is not None else expected_ids(Path(scenarios_dir))
+    if proofs_json is not None:
+        return _from_file(Path(proofs_json), want)
+    return _fresh(Path(scenarios_dir), want)
+
+
+def check_ids(ids: Sequence[str], expected: Sequence[str]) -> tuple[tuple[str, ...],
+                                                                     tuple[str, ...]]:
+    """(missing, unexpected): by the prove run's own rule (``proofs.compare_ids``), with each
+    repeated id listed among the unexpected as ``"<id> (twice)"``, or its count."""
+    from ..proofs import compare_ids
+
+    missing, unexpected, repeated = compare_ids(ids, expected)
+    return missing, unexpected + tuple(f"{i} ({'twice' if n == 2 else f'{n} times'})"
+                                       for i, n in repeated.items())
+
+
+def summary_table(rows: Iterable[ObligationRow]) -> dict[str, Any]:
+    """Counts per group (in first-seen order) and in total, by the columns of SUMMARY_COLUMNS.
+
+    "proved by Z3 / sympy", "checked on data" and "tested only" count proved verdicts by their
+    method (data: an exhaustive check on concrete data; test: method 'test', if any obligation
+    declares it); "unproved" counts unknown and failed verdicts.
+    """
+    groups: dict[str, dict[str, int]] = {}
+    total = {k: 0 for k, _ in SUMMARY_COLUMNS}
+    for r in rows:
+        g = groups.setdefault(r.group, {k: 0 for k, _ in SUMMARY_COLUMNS})
+        key = _column(r)
+        for bucket in (g, total):
+            bucket["total"] += 1
+            bucket[key] += 1
+    return {"columns": [{"key": k, "heading": h} for k, h in SUMMARY_COLUMNS],
+            "rows": [{"group": name, **counts} for name, counts in groups.items()],
+            "total": total}
+
+
+def _column(r: ObligationRow) -> str:
+    if r.verdict == "proved":
+        return {"z3": "proved_z3", "sympy": "proved_sympy", "data": "checked_data",
+                "test": "tested_only"}.get(r.method, "unproved")
+    if r.verdict == "refuted as expected":
+        return "refuted_as_expected"
+    return "unproved"
+
+
+# --- from results.json ------------------------------------------------------------------------
+
+def _from_file(path: Path, expected: Sequence[str]) -> ProofData:
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError("proofs_json", str(path),
+                         f"cannot be read ({exc.strerror or exc})") from None
+    except json.JSONDecodeError as exc:
+        raise InputError("proofs_json", str(path), f"is not valid JSON ({exc.msg}, line "
+                         f"{exc.lineno})") from None
+    items = doc.get("obligations") if isinstance(doc, dict) else None
+    if not isinstance(items, list):
+        raise InputError("proofs_json", str(path), "has no 'obligations' list")
+    rows = tuple(_row_from_json(item, k, path) for k, item in enumerate(items))
+    ledger_doc = doc.get("assumptions")
+    ledger = _ledger_entries(ledger_doc) if isinstance(ledger_doc, list) else ()
+    missing, unexpected = check_ids([r.id for r in rows], expected)
+    run = doc.get("run") if isinstance(doc.get("run"), dict) else None
+    return ProofData(available=True, source=f"read from {path}",
+                     note="the results the prove run recorded, not re-run for this report",
+                     rows=rows, ledger=ledger, ledger_available=isinstance(ledger_doc, list),
+                     missing_ids=missing, unexpected_ids=unexpected, run=run,
+                     not_run=tuple(r.id for r in rows if r.change == "not run"))
+
+
+def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
+    if not isinstance(item, dict) or not isinstance(item.get("id"), str):
+        raise InputError(f"obligations[{k}]", item, f"in {path} must be an object with an 'id'")
+    verdict = str(item.get("verdict", ""))
+    if verdict not in _VERDICTS:
+        raise InputError(f"obligations[{k}].verdict", verdict,
+                         f"in {path} must be one of {', '.join(_VERDICTS)}")
+    seconds = item.get("seconds")
+    return ObligationRow(
+        id=item["id"], group=str(item.get("group") or "ungrouped"),
+        paper_ref=str(item.get("paper_ref") or ""), statement=str(item.get("statement") or ""),
+        method=str(item.get("method", "")), verdict=verdict,
+        expected=str(item.get("expected", "proved")),
+        seconds=float(seconds) if isinstance(seconds, (int, float)) else None,
+        counterexample=item.get("counterexample"), reason=str(item.get("reason", "")),
+        sha256=str(item.get("sha256", "")), change=item.get("change"))
+
+
+# --- a fresh run --------------------------------------------------------------------------------
+
+def _fresh(scenarios_dir: Path, expected: Sequence[str]) -> ProofData:
+    from ..proofs import ASSUMPTIONS, collect_obligations, discharge
+
+    rows = []
+    for ob in collect_obligations(scenarios_dir):
+        p = discharge(ob)
+        rows.append(ObligationRow(
+            id=ob.id, group=ob.group, paper_ref=ob.paper_ref, statement=ob.statement,
+            method=p.method.value, verdict=p.verdict.value, expected=p.expected.value,
+            seconds=float(p.seconds), counterexample=p.counterexample, reason=p.reason,
+            sha256=p.sha256))
+    missing, unexpected = check_ids([r.id for r in rows], expected)
+    return ProofData(available=True, source="a fresh run of the prove machinery for this report",
+                     note=f"{len(rows)} obligations discharged in this process, "
+                     f"{sum(r.seconds or 0.0 for r in rows):.1f} s in all; nothing written under "
+                     "build/proofs",
+                     rows=tuple(rows), ledger=_ledger_entries(ASSUMPTIONS), ledger_available=True,
+                     missing_ids=missing, unexpected_ids=unexpected)
+
+
+def _ledger_entries(entries: Iterable[Any]) -> tuple[dict[str, str], ...]:
+    """Ledger entries {id, what, why, used_by} from Assumption values or their JSON."""
+    out = []
+    for e in entries:
+        get = e.get if isinstance(e, dict) else (lambda k, _e=e: getattr(_e, k, None))
+        out.append({k: str(get(k) or "") for k in ("id", "what", "why", "used_by")})
+    return tuple(out)
+
+
+# --- mutation self-check ------------------------------------------------------------------------
+
+def load_selftest() -> dict[str, Any]:
+    """The mutation self-check, run now: ``cfmpa.runs.selftest_rows()``."""
+    from .. import runs as _selftest
+
+    rows = [dataclasses.asdict(r) for r in _selftest.selftest_rows()]
+    return {"available": True, "source": "cfmpa.runs.selftest_rows(), run for this "
+            "report", "note": f"sampled mode: {_selftest.SAMPLE} random cells (seed 0) plus the "
+            "cells the path occupies; full mode: every cell, and optimality by the independent "
+            "search opt_path", "rows": rows}

@@ -1,0 +1,50 @@
+"""Provenance of a report: tool and library versions, git commit and cleanliness, command, date."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import importlib.metadata as _metadata
+import shlex
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+from ..gitstate import git_state, repo_root
+
+__all__ = ["REPORTED_DISTRIBUTIONS", "git_state", "library_versions", "provenance"]
+
+#: Distributions besides those of ``cfmpa.runs.versions`` whose version the report gives:
+#: the prover's second engine (sympy), the fast kernels' compiler (numba on llvmlite), and what
+#: draws and writes the report (matplotlib with Pillow, Jinja2).
+REPORTED_DISTRIBUTIONS = {"sympy": "sympy", "numba": "numba", "llvmlite": "llvmlite",
+                          "matplotlib": "matplotlib", "pillow": "pillow", "jinja2": "jinja2"}
+
+
+def library_versions() -> dict[str, str]:
+    """Installed versions of REPORTED_DISTRIBUTIONS, read from package metadata (no import)."""
+    out = {}
+    for key, dist in REPORTED_DISTRIBUTIONS.items():
+        try:
+            out[key] = _metadata.version(dist)
+        except _metadata.PackageNotFoundError:
+            out[key] = "not installed"
+    return out
+
+
+def provenance(argv: Sequence[str] | None, scenarios: Sequence[Any]) -> dict[str, Any]:
+    """The report's provenance header; ``scenarios`` are validated Scenario values."""
+    from ..runs import versions
+
+    v = versions()
+    v.update(library_versions())
+    args = list(sys.argv if argv is None else argv)
+    repo = repo_root()
+    return {
+        "tool": "cfmpa",
+        "version": v["cfmpa"],
+        "versions": dict(sorted(v.items())),
+        "git": git_state(repo),
+        "command_line": shlex.join(args),
+        "date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "scenarios": [{"name": s.name, "path": s.source, "sha256": s.sha256} for s in scenarios],
+    }

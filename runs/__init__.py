@@ -1,0 +1,39 @@
+"""Checked runs: a plan under the paper's contracts, `cfmpa check` of another planner's files,
+and the seeded-fault self-check (`cfmpa selftest`).
+
+This layer uses both ``spec`` (the contracts and the certificate) and ``impl`` (the planner it
+checks). The pipeline, stage by stage (docs/model.md §7, §9):
+
+=============  ==========================================  ======================
+stage          function                                    file
+=============  ==========================================  ======================
+scenario       ``spec.load_scenario`` / ``parse_scenario``  ``spec/_scenario.py``
+grid           ``spec.make_grid``                           ``spec/_grid.py``
+regions        ``impl.left_regions`` / ``right_regions``    ``impl/_builtdr.py``
+D_R            ``impl.build_dr`` (fast: ``build_dr_fast``)  ``impl/_builtdr.py``
+               under ``checked_build_dr``                   ``runs/_contracts.py``
+path           ``impl.search_opt_path`` (fast variant)      ``impl/_search.py``
+               under ``checked_search``                     ``runs/_contracts.py``
+certificate    ``spec.certify``                             ``spec/_certificate.py``
+plan.json      ``plan``, ``plan_json``, ``write_plan``      ``runs/_plan.py``
+check          ``run_check`` (another planner's files)      ``runs/_check.py``
+report         ``report.run_audit``                         ``report/_audit.py``
+=============  ==========================================  ======================
+"""
+
+from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
+from ._contracts import DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json, violation_json
+from ._plan import CERTIFICATE, PlanResult, plan, plan_json, versions, write_plan
+from ._selftest import (FAULTS, SAMPLE, WORKCELLS, Fault, SelftestRow, run_fault, run_selftest,
+                        selftest_rows, selftest_table, workcell)
+
+__all__ = [
+    # a plan under contracts (docs/model.md §7, §9)
+    "CERTIFICATE", "DEFAULT_SAMPLE", "Mode", "PlanResult", "Settings", "TripleRun",
+    "contracts_json", "plan", "plan_json", "versions", "violation_json", "write_plan",
+    # another planner's files
+    "CheckReport", "check_outputs", "read_dr", "read_plan", "run_check",
+    # seeded faults
+    "FAULTS", "Fault", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault", "run_selftest",
+    "selftest_rows", "selftest_table", "workcell",
+]

@@ -1,0 +1,322 @@
+"""`cfmpa check SCENARIO --dr FILE --plan FILE`: another planner's outputs against the spec.
+
+The outputs are docs/model.md §9's dr.npy and plan.json. Checked, all in full: D_R's shape and dtype
+and Theorem 1/3's postcondition for the plan's variant at every cell (the spec's own regions);
+the path by is_path; J1 and J2 as reported; optimality against opt_path (the spec's independent
+search); the continuous-time certificate. Also, when plan.json states them: the scenario's
+hash, the grid, the angles of the path's cells, and dr_sha256 against the dr file's bytes (a
+mismatch means the two files are not from the same run).
+Exit 0 when everything holds, 1 with a listing of what failed, 2 when an input cannot be read
+(missing file, not .npy, bad JSON, missing or mistyped keys), as ``file: error: ...``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import MISSING, ContractViolation, InputError
+from ..spec import Grid, Scenario, Variant, load_scenario, make_grid
+from ..spec import certify, require_clear
+from ..spec import SearchResult, SearchStatus
+from ..spec import cost_failures, search_triple
+from ._contracts import Mode, Settings, TripleRun, builtdr_post, search_post, search_pre
+from ._plan import CERTIFICATE
+
+__all__ = ["CheckLine", "CheckReport", "PlanDoc", "check_outputs", "read_dr", "read_plan",
+           "run_check"]
+
+#: Relative tolerance for plan.json's floats (grid dt, lo, h; angles) against the spec's.
+FLOAT_TOL = 1e-9
+
+
+@dataclass(frozen=True)
+class PlanDoc:
+    """What check reads from plan.json: the variant, the search's answer, and optional claims."""
+
+    variant: Variant
+    result: SearchResult
+    sha256: str | None
+    grid: dict[str, Any] | None
+    angles: tuple[tuple[float, float], ...] | None
+    dr_sha256: str | None = None
+
+
+@dataclass(frozen=True)
+class CheckLine:
+    """One line of the listing: ``ok``, ``FAIL`` or ``skip``, what, and the values if it failed."""
+
+    status: str
+    what: str
+    values: tuple[tuple[str, Any], ...] = ()
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """Every check made, in order."""
+
+    lines: tuple[CheckLine, ...]
+
+    @property
+    def ok(self) -> bool:
+        return all(line.status != "FAIL" for line in self.lines)
+
+    @property
+    def failed(self) -> tuple[CheckLine, ...]:
+        return tuple(line for line in self.lines if line.status == "FAIL")
+
+    def text(self) -> str:
+        out = []
+        for line in self.lines:
+            out.append(f"{line.status:<5} {line.what}")
+            out += [f"      {name} was {value!r}" for name, value in line.values]
+        n = len(self.failed)
+        out.append("result: all checks hold" if n == 0 else
+                   f"result: {n} of {sum(x.status != 'skip' for x in self.lines)} checks failed")
+        return "\n".join(out)
+
+
+def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | Path) -> int:
+    """Check the outputs, print the listing; 0 all hold, 1 some failed, 2 unreadable input."""
+    try:
+        s = load_scenario(scenario_path)
+        dr = read_dr(dr_path)
+        dr_sha = _file_sha256(dr_path)
+        doc = read_plan(plan_path)
+    except InputError as exc:
+        print(exc.render(), file=sys.stderr)
+        return 2
+    print(f"check     {Path(dr_path)} and {Path(plan_path)} against {s.name} ({scenario_path}), "
+          f"variant {doc.variant.value}")
+    report = check_outputs(s, dr, doc, dr_sha256=dr_sha)
+    print(report.text())
+    return 0 if report.ok else 1
+
+
+def _file_sha256(path: str | Path) -> str:
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as exc:
+        raise InputError("dr", MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=str(path)) from None
+
+
+def read_dr(path: str | Path) -> npt.NDArray[Any]:
+    """dr.npy as an array (of any dtype: the check judges it); InputError if unreadable."""
+    source = str(path)
+    try:
+        arr = np.load(path, allow_pickle=False)
+    except OSError as exc:
+        raise InputError("dr", MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=source) from None
+    except ValueError as exc:
+        raise InputError("dr", MISSING, f"is not a .npy array file ({exc})",
+                         source=source) from None
+    if not isinstance(arr, np.ndarray):
+        raise InputError("dr", MISSING, "is not a single .npy array", source=source)
+    return arr
+
+
+def read_plan(path: str | Path) -> PlanDoc:
+    """plan.json's keys that check needs (docs/model.md §9); InputError names a missing or bad key."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise InputError("plan", MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=source) from None
+    except UnicodeDecodeError:
+        raise InputError("plan", MISSING, "is not UTF-8 text", source=source) from None
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError("json", MISSING, f"is not valid: {exc.msg} (column {exc.colno})",
+                         source=source, line=exc.lineno) from None
+
+    def bad(key: str, value: Any, message: str) -> InputError:
+        return InputError(key, value, message, source=source)
+
+    if not isinstance(doc, dict):
+        raise bad("<document>", type(doc).__name__, "must be a JSON object")
+    for key in ("variant", "status", "path", "J1", "J2"):
+        if key not in doc:
+            raise bad(key, MISSING, "is required (docs/model.md §9)")
+    try:
+        variant = Variant(doc["variant"])
+    except ValueError:
+        raise bad("variant", doc["variant"], "must be one of original, modified, tight") from None
+    if doc["status"] not in ("found", "no_path"):
+        raise bad("status", doc["status"], "must be 'found' or 'no_path'")
+    path = doc["path"]
+    if not isinstance(path, list) or not all(_is_cell(c) for c in path):
+        raise bad("path", _short(path), "must be a list of [i, j] integer pairs")
+    cells = tuple((int(c[0]), int(c[1])) for c in path)
+    if doc["status"] == "found":
+        for key in ("J1", "J2"):
+            if not _is_int(doc[key]):
+                raise bad(key, doc[key], "must be an integer when status is 'found'")
+        if not cells:
+            raise bad("path", [], "must not be empty when status is 'found'")
+        result = SearchResult(SearchStatus.FOUND, None, cells, doc["J1"], doc["J2"])
+    else:
+        reason = doc.get("reason")
+        result = SearchResult(SearchStatus.NO_PATH, None if reason is None else str(reason),
+                              cells, None, None)
+    sha = doc.get("scenario_sha256")
+    if sha is not None and not isinstance(sha, str):
+        raise bad("scenario_sha256", sha, "must be a string")
+    dr_sha = doc.get("dr_sha256")
+    if dr_sha is not None and not isinstance(dr_sha, str):
+        raise bad("dr_sha256", dr_sha, "must be a string")
+    grid = doc.get("grid")
+    if grid is not None and not isinstance(grid, dict):
+        raise bad("grid", grid, "must be an object")
+    angles = doc.get("angles")
+    if angles is not None:
+        if not isinstance(angles, list) or not all(
+                isinstance(a, list) and len(a) == 2 and all(_is_number(x) for x in a)
+                for a in angles):
+            raise bad("angles", _short(angles), "must be a list of [t1, t2] number pairs")
+        angles = tuple((float(a[0]), float(a[1])) for a in angles)
+    return PlanDoc(variant, result, sha, grid, angles, dr_sha)
+
+
+def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc, *,
+                  dr_sha256: str | None = None) -> CheckReport:
+    """Every check of this module on already-read outputs (see the module docstring).
+
+    ``dr_sha256`` is the hash of the dr file's bytes, checked against plan.json's when both
+    are known."""
+    g = make_grid(s)
+    lines: list[CheckLine] = []
+    if doc.dr_sha256 is not None and dr_sha256 is not None:
+        lines.append(_line(doc.dr_sha256 == dr_sha256, "plan.json dr_sha256 is the dr file's "
+                           "(the two files are from one run)",
+                           (("plan's", doc.dr_sha256), ("file's", dr_sha256))))
+    if doc.sha256 is not None and s.sha256:
+        lines.append(_line(doc.sha256 == s.sha256, "plan.json scenario_sha256 is the scenario "
+                           "file's", (("plan's", doc.sha256), ("file's", s.sha256))))
+    if doc.grid is not None:
+        lines.append(_grid_line(g, doc.grid))
+    full = Settings(Mode.FULL)
+    post = builtdr_post(s, doc.variant, g, dr, full)
+    lines += _run_lines(post)
+    start, goal = s.right.start_cell, s.right.goal_cell
+    r = doc.result
+    shape_ok = not any(f.condition == "post.shape" for f in post.failures)
+    if shape_ok:
+        lines += _run_lines(search_pre(doc.variant, g, dr, start, goal, post))
+        lines += _run_lines(search_post(doc.variant, dr, start, goal, r, full))
+    else:
+        # J1 and J2 are the path's alone: a bad D_R does not excuse misreported costs.
+        costs = cost_failures(r)
+        what = f"{search_triple(doc.variant).name} post.costs"
+        if r.status is not SearchStatus.FOUND:
+            lines.append(CheckLine("ok", f"{what}: nothing to check: no path reported"))
+        elif not costs:
+            lines.append(CheckLine("ok", f"{what}: J1 and J2 recomputed"))
+        else:
+            lines += [CheckLine("FAIL", f"{what}: {f.message}", f.values) for f in costs]
+        lines.append(CheckLine("skip", "the path (is_path, optimality): D_R has the wrong shape"))
+    found = r.status is SearchStatus.FOUND
+    if found and doc.angles is not None:
+        lines.append(_angles_line(g, r.path, doc.angles))
+    inside = all(0 <= i < g.m and 0 <= j < g.n for i, j in r.path)
+    if found and inside:
+        cert = certify(s, g, r.path)
+        try:
+            require_clear(cert, name=CERTIFICATE)
+            lines.append(CheckLine("ok", f"{CERTIFICATE}: clear, proved lower bound "
+                                   f"{cert.lower_bound_m:.6g} m at every instant; sampled "
+                                   f"minimum {cert.min_clearance_m:.6g} m at t = "
+                                   f"{cert.t_min_s:.6g} s ({cert.intervals} intervals)"))
+        except ContractViolation as exc:
+            lines.append(CheckLine("FAIL", f"{exc.triple}: {exc.condition}",
+                                   tuple(exc.values.items())))
+    elif found:
+        lines.append(CheckLine("skip", f"{CERTIFICATE}: the path leaves the grid"))
+    return CheckReport(tuple(lines))
+
+
+def _run_lines(run: TripleRun) -> list[CheckLine]:
+    out = []
+    for c in run.checks:
+        what = f"{run.triple.name} {c.condition}: {c.scope}"
+        if c.ok is None:
+            out.append(CheckLine("skip", what))
+            continue
+        fails = [f for f in run.failures if f.condition == c.condition]
+        if not fails:
+            out.append(CheckLine("ok", what))
+        for f in fails:
+            values = f.values + ((("instances failing", f.count),) if f.count > 1 else ())
+            out.append(CheckLine("FAIL", f"{run.triple.name} {c.condition}: {f.message}", values))
+    return out
+
+
+def _line(ok: bool, what: str, values: tuple[tuple[str, Any], ...]) -> CheckLine:
+    return CheckLine("ok", what) if ok else CheckLine("FAIL", what, values)
+
+
+def _close(a: Any, b: float) -> bool:
+    return _is_number(a) and abs(float(a) - b) <= FLOAT_TOL * max(1.0, abs(b))
+
+
+def _grid_line(g: Grid, claimed: dict[str, Any]) -> CheckLine:
+    want = g.as_json()
+    wrong = []
+    for key in ("N", "m", "n"):
+        if key in claimed and claimed[key] != want[key]:
+            wrong.append((key, claimed[key]))
+    for key in ("dt", "Tf"):
+        if key in claimed and not _close(claimed[key], want[key]):
+            wrong.append((key, claimed[key]))
+    for key in ("lo", "h"):
+        if key in claimed:
+            v = claimed[key]
+            if not (isinstance(v, list) and len(v) == 2
+                    and all(_close(x, y) for x, y in zip(v, want[key]))):
+                wrong.append((key, v))
+    values = tuple((f"plan's {k}", v) for k, v in wrong) + tuple(
+        (f"spec's {k}", want[k]) for k, _ in wrong)
+    return _line(not wrong, "plan.json grid is the scenario's (docs/model.md §2)", values)
+
+
+def _angles_line(g: Grid, path: tuple[tuple[int, int], ...],
+                 angles: tuple[tuple[float, float], ...]) -> CheckLine:
+    if len(angles) != len(path):
+        return CheckLine("FAIL", "plan.json angles: one pair per path cell",
+                         (("angles", len(angles)), ("cells", len(path))))
+    for k, (c, a) in enumerate(zip(path, angles)):
+        want = (float(g.angle(0, c[0])), float(g.angle(1, c[1])))
+        if not (_close(a[0], want[0]) and _close(a[1], want[1])):
+            return CheckLine("FAIL", "plan.json angles are the path cells' grid angles",
+                             (("step", k), ("cell", list(c)), ("angles", list(a)),
+                              ("grid angles", list(want))))
+    return CheckLine("ok", f"plan.json angles are the path cells' grid angles ({len(path)})")
+
+
+def _is_int(x: Any) -> bool:
+    return isinstance(x, int) and not isinstance(x, bool)
+
+
+def _is_number(x: Any) -> bool:
+    return (isinstance(x, (int, float)) and not isinstance(x, bool)
+            and math.isfinite(float(x)))
+
+
+def _is_cell(c: Any) -> bool:
+    return isinstance(c, list) and len(c) == 2 and all(_is_int(x) for x in c)
+
+
+def _short(x: Any) -> Any:
+    text = repr(x)
+    return x if len(text) <= 80 else text[:77] + "..."

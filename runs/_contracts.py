@@ -1,0 +1,375 @@
+"""Contract-checked BuiltDR and searchoptpath: the triples of ``spec._triples`` at run time.
+
+Modes (docs/model.md §7):
+- ``off``: nothing is checked.
+- ``sampled``: every precondition; D_R's shape; Theorem 1/3's cell condition at ``sample`` cells
+  drawn uniformly without replacement (seeded, recorded) plus every cell the found path
+  occupies (the entries its safety rests on); is_path and J1/J2 on the path. Optimality is not
+  checked. With no mismatch among n random cells, the fraction of wrong cells is below 3/n with
+  95% confidence (P(miss) = (1 - p)^n <= 0.05 for p >= 3/n): 0.073% at n = 4096. That is all a
+  sample shows: its checks are recorded with coverage ``sample``, and pre.dr.spec (which rests
+  on them) says it held on the sample only.
+- ``full``: every cell by the spec's own regions (shapely, sharing no code with impl/), the path
+  by is_path, J1/J2 recomputed, and optimality against ``opt_path``, the spec's independent
+  Dijkstra.
+
+A failed precondition always stops the run (the triple says nothing about C then); a failed
+postcondition raises ContractViolation too, unless the caller asked to record and go on.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from enum import Enum
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import ContractViolation, InputError
+from ..files import jsonable
+from ..impl import build_dr, search_opt_path
+from ..spec import Grid, Scenario, Variant
+from ..spec import SearchResult, SearchStatus, opt_path
+from ..spec import (Failure, Triple, builtdr_triple, cells_failures, dr_cell_failures,
+                             dr_shape_failures, grid_failures, path_cells, search_failures,
+                             search_triple)
+
+__all__ = [
+    "DEFAULT_SAMPLE",
+    "Check",
+    "Mode",
+    "Settings",
+    "TripleRun",
+    "builtdr_pre",
+    "builtdr_post",
+    "builtdr_path_cells",
+    "search_pre",
+    "search_post",
+    "checked_build_dr",
+    "checked_search",
+    "contracts_json",
+    "sample_cells",
+    "violation_json",
+]
+
+#: Cells of the sampled mode's random sample; see the module docstring for the confidence. It
+#: costs about 0.5-0.8 s of shapely on the default grid (measured here, in process), so against
+#: the fast BuiltDR that `cfmpa plan` uses (0.8-1.4 s) it adds 40-100%, not "a few per cent";
+#: only against the reference BuiltDR (~7.5 s) is it under a tenth.
+DEFAULT_SAMPLE = 4096
+
+DR = npt.NDArray[np.uint8]
+Builder = Callable[[Scenario, Variant, Grid], DR]
+Searcher = Callable[[DR, tuple[int, int], tuple[int, int]], SearchResult]
+
+
+class Mode(str, Enum):
+    """How much of the triples a run checks."""
+
+    OFF = "off"
+    SAMPLED = "sampled"
+    FULL = "full"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The contract mode, and for ``sampled`` the seed and the number of random cells."""
+
+    mode: Mode = Mode.SAMPLED
+    seed: int = 0
+    sample: int = DEFAULT_SAMPLE
+
+    @classmethod
+    def of(cls, mode: Mode | str = Mode.SAMPLED, seed: int = 0,
+           sample: int | None = None) -> Settings:
+        """Validated settings; InputError names the bad option."""
+        try:
+            m = Mode(mode)
+        except ValueError:
+            raise InputError("--contracts", mode, "must be one of off, sampled, full") from None
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise InputError("--seed", seed, "must be an integer >= 0")
+        n = DEFAULT_SAMPLE if sample is None else sample
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise InputError("--sample", sample, "must be an integer >= 1")
+        return cls(m, seed, n)
+
+
+@dataclass(frozen=True)
+class Check:
+    """One condition as a run checked it: over what (``scope``), how many items, and the verdict.
+
+    ``ok`` is None when the condition was not checked (the scope says why). ``coverage`` is
+    ``all`` when ``ok`` speaks for the whole condition, ``sample`` when only for the items
+    checked (a seeded sample of cells: the condition may still fail elsewhere), ``none`` when
+    not checked.
+    """
+
+    part: str
+    condition: str
+    scope: str
+    count: int
+    ok: bool | None
+    coverage: str = "all"
+
+
+@dataclass(frozen=True)
+class TripleRun:
+    """What one check of one triple did: its checks and the failures found."""
+
+    triple: Triple
+    checks: tuple[Check, ...]
+    failures: tuple[Failure, ...]
+
+    @property
+    def ok(self) -> bool:
+        return not self.failures
+
+    @property
+    def checked(self) -> int:
+        return sum(c.count for c in self.checks)
+
+    def violations(self) -> list[ContractViolation]:
+        return [self.triple.violation(f) for f in self.failures]
+
+    def raise_first(self) -> None:
+        """Raise the first failure as ContractViolation; return when there is none."""
+        if self.failures:
+            raise self.triple.violation(self.failures[0])
+
+
+#: (condition, scope, count, failures or None for "not checked"[, coverage]).
+Item = (tuple[str, str, int, list[Failure] | None]
+        | tuple[str, str, int, list[Failure] | None, str])
+
+
+def _run(triple: Triple, part: str, items: Sequence[Item]) -> TripleRun:
+    """A TripleRun from (condition, scope, count, failures or None for 'not checked'[, coverage]);
+    coverage is ``all`` unless given (``none`` when not checked)."""
+    checks, failures = [], []
+    for cid, scope, count, fails, *rest in items:
+        ok = None if fails is None else not fails
+        coverage = "none" if fails is None else (rest[0] if rest else "all")
+        checks.append(Check(part, cid, scope, count if fails is not None else 0, ok, coverage))
+        failures += fails or []
+    return TripleRun(triple, tuple(checks), tuple(failures))
+
+
+# --- the checks, as values (no raising) -------------------------------------------------------
+
+
+def builtdr_pre(s: Scenario, variant: Variant | str, grid: Grid) -> TripleRun:
+    """Theorem 1/3's precondition: the grid is well formed and start/goal lie in it."""
+    fails = grid_failures(s, grid)
+    by = {cid: [f for f in fails if f.condition == cid]
+          for cid in ("pre.grid.N", "pre.grid.h", "pre.grid.scenario")}
+    cells = cells_failures(grid, s.right.start_cell, s.right.goal_cell)
+    return _run(builtdr_triple(variant), "pre", [
+        ("pre.grid.N", "N and dt against Tf, exact", 1, by["pre.grid.N"]),
+        ("pre.grid.h", "h against omega dt per joint, exact; span of the limits", 2,
+         by["pre.grid.h"]),
+        ("pre.grid.scenario", "dt, Tf, lower limits", 1, by["pre.grid.scenario"]),
+        ("pre.cells", "start and goal cells", 2, cells),
+    ])
+
+
+def sample_cells(shape: tuple[int, int, int], n: int, seed: int) -> npt.NDArray[np.int64]:
+    """``n`` distinct cells (k, i, j) drawn uniformly from ``shape`` with numpy's PCG64(seed),
+    sorted; all cells when n >= their number."""
+    total = math.prod(shape)
+    if n >= total:
+        flat = np.arange(total)
+    else:
+        flat = np.sort(np.random.default_rng(seed).choice(total, size=n, replace=False))
+    return np.column_stack(np.unravel_index(flat, shape)).astype(np.int64)
+
+
+def builtdr_post(s: Scenario, variant: Variant | str, grid: Grid, dr: Any,
+                 settings: Settings) -> TripleRun:
+    """Theorem 1/3's postcondition: D_R's shape, and its cells (all, or a seeded sample)."""
+    triple = builtdr_triple(variant)
+    shape = dr_shape_failures(grid, dr)
+    items: list[Item] = [("post.shape", f"shape {list(grid.shape)}, uint8, values 0/1", 1, shape)]
+    total = math.prod(grid.shape)
+    if shape:
+        items.append(("post.cells", "not checked: D_R has the wrong shape", 0, None))
+    elif settings.mode is Mode.FULL or settings.sample >= total:
+        n, fails = dr_cell_failures(s, variant, grid, dr)
+        items.append(("post.cells", f"all {n} cells", n, fails))
+    else:
+        cells = sample_cells(grid.shape, settings.sample, settings.seed)
+        n, fails = dr_cell_failures(s, variant, grid, dr, cells)
+        items.append(("post.cells", f"{n} random cells of {total} (seed {settings.seed}): a "
+                      "sample, not every cell", n, fails, "sample"))
+    return _run(triple, "post", items)
+
+
+def builtdr_path_cells(s: Scenario, variant: Variant | str, grid: Grid, dr: DR,
+                       path: Sequence[Sequence[int]]) -> TripleRun:
+    """Theorem 1/3's cell condition at the cells a path occupies (each step's layer, and R)."""
+    cells = path_cells(path, grid.N)
+    n, fails = dr_cell_failures(s, variant, grid, dr, cells)
+    return _run(builtdr_triple(variant), "post", [
+        ("post.cells", f"the {n} cells the path occupies (step k in its layer, then R)", n,
+         fails, "sample")])
+
+
+def search_pre(variant: Variant | str, grid: Grid, dr: Any, start: Sequence[int],
+               goal: Sequence[int], established: TripleRun | None) -> TripleRun:
+    """Theorem 2/4's precondition; pre.dr.spec is taken from the BuiltDR check ``established``.
+
+    It is established (coverage ``all``) only when that check covered every cell; after a
+    sampled check the record says that it held on the sample, and no more."""
+    spec: list[Failure] | None
+    coverage = "all"
+    if established is None:
+        scope, spec = "not checked: no BuiltDR postcondition check in this run", None
+    else:
+        cells = [c for c in established.checks if c.condition == "post.cells"]
+        name = established.triple.name
+        if cells and all(c.coverage == "all" for c in cells):
+            scope = f"by {name}'s post.cells check: " + "; ".join(c.scope for c in cells)
+        else:
+            coverage = "sample"
+            scope = (f"on a sample only: {name}'s post.cells at "
+                     + "; ".join(c.scope.split(":")[0] for c in cells)
+                     + "; the other cells of D_R are not checked")
+        spec = [Failure("pre.dr.spec", f"D_R fails {name}'s {f.condition}: "
+                        f"{f.message}", f.values, f.count) for f in established.failures]
+    return _run(search_triple(variant), "pre", [
+        ("pre.dr.shape", f"shape {list(grid.shape)}, uint8, values 0/1", 1,
+         dr_shape_failures(grid, dr, "pre.dr.shape")),
+        ("pre.cells", "start and goal cells", 2, cells_failures(grid, start, goal)),
+        ("pre.dr.spec", scope, 0, spec, coverage),
+    ])
+
+
+def search_post(variant: Variant | str, dr: DR, start: Sequence[int], goal: Sequence[int],
+                result: SearchResult, settings: Settings) -> TripleRun:
+    """Theorem 2/4's postcondition: is_path and J1/J2 always; optimality in full mode only."""
+    found = result.status is SearchStatus.FOUND
+    optimum = opt_path(dr, tuple(start), tuple(goal)) if settings.mode is Mode.FULL else None
+    fails = search_failures(dr, start, goal, result, optimum)
+
+    def of(cid: str) -> list[Failure]:
+        return [f for f in fails if f.condition == cid]
+
+    steps = max(len(result.path), dr.shape[0] - 1) + 1
+    items: list[Item]
+    if found:
+        items = [("post.is_path", f"{len(result.path)} cells, {steps} step checks", steps,
+                  of("post.is_path")),
+                 ("post.costs", "J1 and J2 recomputed", 2, of("post.costs"))]
+    else:
+        items = [("post.is_path", "nothing to check: no path reported", 0, []),
+                 ("post.costs", "nothing to check: no path reported", 0, [])]
+    if optimum is None:
+        items.append(("post.optimal", "not checked in sampled mode (full mode runs the "
+                      "independent search opt_path)", 0, None))
+    else:
+        items.append(("post.optimal", "against opt_path, the spec's independent Dijkstra", 1,
+                      of("post.optimal")))
+    return _run(search_triple(variant), "post", items)
+
+
+def _without(run: TripleRun, condition: str) -> TripleRun:
+    return replace(run, failures=tuple(f for f in run.failures if f.condition != condition))
+
+
+# --- the wrappers -----------------------------------------------------------------------------
+
+
+def checked_build_dr(s: Scenario, variant: Variant | str, grid: Grid, settings: Settings, *,
+                     build: Builder = build_dr, stop: bool = True
+                     ) -> tuple[DR, tuple[TripleRun, ...]]:
+    """``build(s, variant, grid)`` under Theorem 1/3: (D_R, the checks run).
+
+    A failed precondition raises ContractViolation before building; a failed postcondition
+    raises after it when ``stop``, else it is returned in the runs.
+    """
+    v = Variant(variant)
+    if settings.mode is Mode.OFF:
+        return build(s, v, grid), ()
+    pre = builtdr_pre(s, v, grid)
+    pre.raise_first()
+    dr = build(s, v, grid)
+    post = builtdr_post(s, v, grid, dr, settings)
+    if stop:
+        post.raise_first()
+    return dr, (pre, post)
+
+
+def checked_search(s: Scenario, variant: Variant | str, grid: Grid, dr: DR,
+                   settings: Settings, *, established: TripleRun | None = None,
+                   search: Searcher = search_opt_path, stop: bool = True
+                   ) -> tuple[SearchResult, tuple[TripleRun, ...]]:
+    """``search(dr, start, goal)`` under Theorem 2/4: (the result, the checks run).
+
+    ``established`` is the BuiltDR postcondition check that discharges pre.dr.spec. In sampled
+    mode, Theorem 1/3's cell condition is also checked at every cell the found path occupies.
+    """
+    v = Variant(variant)
+    start, goal = s.right.start_cell, s.right.goal_cell
+    if settings.mode is Mode.OFF:
+        return search(dr, start, goal), ()
+    pre = search_pre(v, grid, dr, start, goal, established)
+    # A D_R that fails BuiltDR's postcondition is already a recorded violation; without ``stop``
+    # the search still runs on it (any 0/1 array of the right shape is a valid input).
+    (pre if stop else _without(pre, "pre.dr.spec")).raise_first()
+    result = search(dr, start, goal)
+    runs = [pre, search_post(v, dr, start, goal, result, settings)]
+    if settings.mode is Mode.SAMPLED and result.status is SearchStatus.FOUND:
+        runs.append(builtdr_path_cells(s, v, grid, dr, result.path))
+    if stop:
+        for r in runs[1:]:
+            r.raise_first()
+    return result, tuple(runs)
+
+
+# --- the record in plan.json ------------------------------------------------------------------
+
+
+def violation_json(v: ContractViolation) -> dict[str, Any]:
+    """A violation as plan.json records it: triple, condition, and its values.
+
+    ``condition`` joins the id and the message (kept as it was); ``condition_id`` (``post.costs``,
+    ``certificate.contact``) and ``message`` are the two apart."""
+    return {"triple": v.triple, "condition": v.condition, "condition_id": v.condition_id,
+            "message": v.message, "values": jsonable(v.values)}
+
+
+def contracts_json(settings: Settings, runs: Sequence[TripleRun],
+                   certificate: ContractViolation | None = None,
+                   certificate_checked: bool = False) -> dict[str, Any]:
+    """plan.json's ``contracts``: {mode, checked, seed, sample, violations, triples, ...}.
+
+    ``checked`` counts the items examined (cells, path steps, conditions). The certificate is
+    not a triple; ``certificate_enforced`` says whether a contact counted as a violation (since
+    a contact is one in every mode, plan() always passes True; the key stays for readers).
+    """
+    sampled = settings.mode is Mode.SAMPLED
+    violations = [violation_json(v) for r in runs for v in r.violations()]
+    if certificate is not None:
+        violations.append(violation_json(certificate))
+    triples: dict[str, dict[str, Any]] = {}
+    for r in runs:
+        t = triples.setdefault(r.triple.name, {
+            "name": r.triple.name, "title": r.triple.title, "reference": r.triple.reference,
+            "statement": str(r.triple), "checks": []})
+        t["checks"] += [{"part": c.part, "condition": c.condition, "scope": c.scope,
+                         "count": c.count, "ok": c.ok, "coverage": c.coverage} for c in r.checks]
+    return {
+        "mode": settings.mode.value,
+        "seed": settings.seed if sampled else None,
+        "sample": settings.sample if sampled else None,
+        "checked": sum(r.checked for r in runs),
+        "violations": violations,
+        "triples": list(triples.values()),
+        "certificate_enforced": certificate_checked,
+    }

@@ -1,0 +1,225 @@
+"""`cfmpa plan`: BuiltDR, searchoptpath (under contracts) and the certificate, as docs/model.md §9's files.
+
+Output is deterministic: the same scenario bytes, variant and version give byte-identical JSON
+apart from the ``timings_s`` object. A found path whose certificate is not clear (a contact, or
+an interval left undecided) is a violation in every contract mode, ``off`` included: the
+certificate is the safety result, not a contract. Files are written even when there are
+violations (they are the evidence); `cfmpa plan` then exits 1.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+import numpy.typing as npt
+
+from .. import __version__
+from ..files import dumps_json, npy_bytes, write_bytes_atomic
+from ..errors import ContractViolation
+from ..impl import build_dr_fast, kernel_name, search_opt_path_fast
+from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
+from ..spec import Certificate, certificate_json, certify, require_clear
+from ..spec import SearchResult, SearchStatus
+from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
+                         checked_search, contracts_json)
+
+R = TypeVar("R")
+
+__all__ = ["CERTIFICATE", "PlanResult", "plan", "plan_json", "write_plan", "versions"]
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """One planning run: the grid, D_R, the search's answer, the certificate, the contracts' record
+    (plan.json's ``contracts``) and the timings; ``runs`` are the contract checks as values."""
+
+    scenario: Scenario
+    variant: Variant
+    grid: Grid
+    dr: npt.NDArray[np.uint8]
+    search: SearchResult
+    certificate: Certificate | None
+    contracts: dict[str, Any] | None
+    timings_s: dict[str, float] = field(default_factory=dict)
+    runs: tuple[TripleRun, ...] = ()
+    kernel: str = "custom"
+    settings: Settings = field(default_factory=Settings)
+
+    @property
+    def checked(self) -> int:
+        """Items the contracts examined (cells, path steps, conditions)."""
+        return sum(r.checked for r in self.runs)
+
+    @property
+    def free_fraction(self) -> float:
+        return 1.0 - float(self.dr.mean())
+
+    @property
+    def violations(self) -> list[ContractViolation]:
+        """Every violation recorded (empty unless the run was asked not to stop at one)."""
+        out = [v for r in self.runs for v in r.violations()]
+        cert = self.certificate
+        if cert is not None and not cert.clear:
+            out.append(_certificate_violation(cert))
+        return out
+
+
+def versions() -> dict[str, str]:
+    """Versions that can change an answer: the tool, Python, numpy, shapely, Z3."""
+    import shapely
+    import z3
+
+    return {"cfmpa": __version__, "python": platform.python_version(), "numpy": np.__version__,
+            "shapely": shapely.__version__, "z3": z3.get_version_string()}
+
+
+def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
+         sample: int | None = None, stop: bool = True, grid: Grid | None = None,
+         build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast,
+         kernel: str | None = None) -> PlanResult:
+    """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
+
+    ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
+    (``sample`` random cells, ``seed``) or full (see _contracts).
+    In every mode, off included, a certificate that is not clear (a contact, or an interval left
+    undecided) is a violation. A violation raises ContractViolation; with ``stop=False``
+    postcondition and certificate violations are recorded in ``contracts`` and the run goes on
+    (a failed precondition always stops it). ``grid``, ``build`` and ``search`` replace the
+    scenario's grid and the kernels (by default the fast ones, bit-identical to the reference
+    and tested against it): for the reference itself, another implementation, or a seeded
+    fault. ``kernel`` names
+    them in plan.json ("fast", "reference"; by default told from ``build`` and ``search``, and
+    "custom" for anything else). With the fast kernels, the first run in a process first calls
+    them on a tiny input, so that timings_s.kernel_load holds numba's compile or cache-load time
+    and build_dr / search hold the work alone (kernel_load is 0.0 once they are loaded).
+    """
+    v = Variant(variant)
+    settings = Settings.of(contracts, seed, sample)
+    g = grid or make_grid(s)
+    enforce = settings.mode is not Mode.OFF
+    kernel = kernel or kernel_name(build, search)
+    t: dict[str, float] = {}
+    if kernel == "fast":
+        t["kernel_load"] = _load_fast_kernels()
+    t0 = time.perf_counter()
+    dr, runs = checked_build_dr(s, v, g, settings, build=_timed(build, t, "build_dr"), stop=stop)
+    if enforce:
+        t["contracts_builtdr"] = time.perf_counter() - t0 - t["build_dr"]
+    t0 = time.perf_counter()
+    result, search_runs = checked_search(s, v, g, dr, settings, established=runs[-1] if runs
+                                         else None, search=_timed(search, t, "search"), stop=stop)
+    if enforce:
+        t["contracts_search"] = time.perf_counter() - t0 - t["search"]
+    runs += search_runs
+    cert = None
+    if result.status is SearchStatus.FOUND:
+        t0 = time.perf_counter()
+        cert = certify(s, g, result.path)
+        t["certificate"] = time.perf_counter() - t0
+        if stop:
+            require_clear(cert, name=CERTIFICATE)
+    record = contracts_json(settings, runs,
+                            _certificate_violation(cert) if cert and not cert.clear else None,
+                            certificate_checked=True)
+    return PlanResult(scenario=s, variant=v, grid=g, dr=dr, search=result, certificate=cert,
+                      contracts=record, timings_s=t, runs=tuple(runs), kernel=kernel,
+                      settings=settings)
+
+
+#: A workcell with a 4 x 14 x 14 grid: calling the fast kernels on it loads (or compiles) every
+#: numba specialisation a real run uses (same dtypes and layouts), in milliseconds of work.
+_WARM_UP = {
+    "name": "kernel-warm-up", "purpose": "load the fast kernels", "dt": 0.5,
+    "left": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.0, 0.0],
+             "start": [0.3, 0.8], "goal": [1.6, 2.2]},
+    "right": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.6, 0.0],
+              "limits": [[0.0, 6.283185307179586], [0.0, 6.283185307179586]],
+              "start_cell": [0, 4], "goal_cell": [7, 4]},
+}
+_loaded: list[float] = []
+
+
+def _load_fast_kernels() -> float:
+    """Seconds spent loading the fast kernels in this process by this call (0.0 if done before)."""
+    if _loaded:
+        return 0.0
+    t0 = time.perf_counter()
+    s = parse_scenario(_WARM_UP, check_budget=False)
+    dr = build_dr_fast(s, Variant.MODIFIED, make_grid(s), progress=False)
+    search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False)
+    _loaded.append(time.perf_counter() - t0)
+    return _loaded[0]
+
+
+#: The certificate's name in violations (it is not one of the paper's triples).
+CERTIFICATE = "continuous-time certificate"
+
+
+def _certificate_violation(cert: Certificate) -> ContractViolation:
+    try:
+        require_clear(cert, name=CERTIFICATE)
+    except ContractViolation as exc:
+        return exc
+    raise AssertionError("require_clear accepted a certificate that is not clear")
+
+
+def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[..., R]:
+    """``fn``, recording its own time in t[key] (so contract time can be told apart from it)."""
+    def run(*args: Any) -> R:
+        t0 = time.perf_counter()
+        try:
+            return fn(*args)
+        finally:
+            t[key] = time.perf_counter() - t0
+    return run
+
+
+def plan_json(p: PlanResult, dr_bytes: bytes | None = None) -> dict[str, Any]:
+    """The plan.json document of docs/model.md §9 (keys are stable: add, never rename).
+
+    ``dr_sha256`` is the sha256 of dr.npy's bytes (``dr_bytes``, by default ``npy_bytes(p.dr)``,
+    what write_plan writes), so that a dr.npy from another run is detectable. In ``clearance``,
+    ``min_m`` / ``t_s`` are the least SAMPLED distance and its instant (an upper bound on the
+    true minimum); ``lower_bound_m`` is the PROVED lower bound over every instant.
+    """
+    r = p.search
+    found = r.status is SearchStatus.FOUND
+    g = p.grid
+    return {
+        "scenario": p.scenario.name,
+        "scenario_sha256": p.scenario.sha256,
+        "variant": p.variant.value,
+        "grid": {"N": g.N, "m": g.m, "n": g.n, "dt": g.dt, "Tf": g.Tf, "lo": list(g.lo),
+                 "h": list(g.h)},
+        "status": r.status.value,
+        "reason": r.reason,
+        "path": [list(c) for c in r.path],
+        "angles": [list(g.angles(c)) for c in r.path],
+        "J1": r.J1 if found else None,
+        "J2": r.J2 if found else None,
+        "path_length": len(r.path),
+        "free_fraction": p.free_fraction,
+        "dr_sha256": hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest(),
+        "kernel": p.kernel,
+        "clearance": certificate_json(p.certificate) if p.certificate is not None else None,
+        "contracts": p.contracts,
+        "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
+        "versions": versions(),
+    }
+
+
+def write_plan(p: PlanResult, out: str | Path) -> tuple[Path, Path]:
+    """Write DIR/dr.npy and DIR/plan.json, each atomically (temporary name, then rename);
+    plan.json's dr_sha256 is the hash of the very bytes written to dr.npy."""
+    out = Path(out)
+    data = npy_bytes(p.dr)
+    dr_path = write_bytes_atomic(out / "dr.npy", data)
+    plan_path = write_bytes_atomic(out / "plan.json", dumps_json(plan_json(p, data)).encode())
+    return dr_path, plan_path

@@ -1,0 +1,36 @@
+"""The paper's definitions, triples and properties as executable predicates (imports no impl).
+
+The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
+"""
+
+from ._grid import (EPS, Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
+                    make_grid, rest_is_goal, right_box)
+from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
+from ._kinematics import arm_corners, joints, link_corners
+from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
+                     Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
+                     is_opt_path, is_path, is_path_paper, opt_path, path_violations)
+from ._polygon import polygon_distance, polygon_distances
+from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
+                        load_scenario, max_cells, parse_scenario)
+from ._triples import (TRIPLES, Failure, Triple, builtdr_triple, cells_failures, cost_failures,
+                       dr_cell_failures, dr_shape_failures, grid_failures, path_cells,
+                       search_failures, search_triple)
+
+__all__ = [
+    # scenario, grids and motion (docs/model.md §2-§3)
+    "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm",
+    "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
+    "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_is_goal", "right_box",
+    # geometry
+    "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
+    # paths (docs/model.md §5)
+    "Cell", "J1", "J2", "MOVES", "PathViolation", "REASON_GOAL_BLOCKED", "REASON_START_BLOCKED",
+    "REASON_UNREACHABLE", "SearchResult", "SearchStatus", "check_search_inputs", "is_opt_path",
+    "is_path", "is_path_paper", "opt_path", "path_violations",
+    # triples and the certificate (docs/model.md §7)
+    "TRIPLES", "Failure", "Triple", "builtdr_triple", "cells_failures", "cost_failures",
+    "dr_cell_failures", "dr_shape_failures", "grid_failures", "path_cells", "search_failures",
+    "search_triple",
+    "Certificate", "ContactDetail", "certificate_json", "certify", "require_clear",
+]

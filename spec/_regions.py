@@ -1,0 +1,94 @@
+"""The swept regions S_LArm[k] and S_RArm[i][j] as docs/model.md §4 defines them (the spec's own code).
+
+A region is the convex hull of the link rectangles, grown by the margin delta, at the lattice
+points of the joint box (lattice anchored at the box's anchor, spacing g per joint, the box rounded
+outward). delta = sum over joints with more than one lattice point of g_q^2/8 * R_q, plus
+SNAP * g_q * R_q for rounding box ends onto the lattice (R_1 = R_base, R_2 = R_elbow).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+import shapely
+
+from ._grid import Grid, Variant, left_angles, left_box
+from ._kinematics import corners, reach
+from ._scenario import Arm, Scenario
+
+__all__ = ["SNAP", "margin", "lattice", "left_region_polygons", "right_region_polygons"]
+
+SNAP = 1e-9
+
+
+def lattice(lo: float, hi: float, anchor: float, g: float) -> npt.NDArray[np.float64]:
+    """Angles anchor + i g for the lattice indices covering [lo, hi] (ends snapped within SNAP g)."""
+    a = math.floor((lo - anchor) / g + SNAP)
+    b = math.ceil((hi - anchor) / g - SNAP)
+    a, b = min(a, b), max(a, b)
+    return anchor + np.arange(a, b + 1) * g
+
+
+def margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int]) -> float:
+    """delta for a lattice of ``sizes`` points per joint with spacing ``g``."""
+    R = reach(arm, link)
+    return sum((g[q] ** 2 / 8 * R[q] if sizes[q] > 1 else 0.0) + SNAP * g[q] * R[q]
+               for q in range(2))
+
+
+def _hulls(points: npt.NDArray[np.float64]) -> npt.NDArray[np.object_]:
+    """Convex hulls of point clouds (..., P, 2) as shapely geometries."""
+    flat = points.reshape(-1, points.shape[-2], 2)
+    return shapely.convex_hull(shapely.multipoints(flat))
+
+
+def _region(arm: Arm, link: int, box: tuple[tuple[float, float], tuple[float, float]],
+            anchor: tuple[float, float], g: tuple[float, float]) -> shapely.Geometry:
+    axes = [lattice(box[q][0], box[q][1], anchor[q], g[q]) for q in range(2)]
+    grow = margin(arm, link, g, (len(axes[0]), len(axes[1])))
+    t1, t2 = np.meshgrid(*axes, indexing="ij")
+    pts = corners(arm, t1, t2, link, arm.width / 2 + grow).reshape(-1, 2)
+    return _hulls(pts[None])[0]
+
+
+def left_region_polygons(s: Scenario, variant: Variant | str, grid: Grid
+                         ) -> list[tuple[shapely.Geometry, shapely.Geometry]]:
+    """S_LArm for layers 0..N-1 and the rest layer R (index N), per variant."""
+    v = Variant(variant)
+    g = (s.left.omega[0] * s.dt, s.left.omega[1] * s.dt)
+    out = []
+    for k in range(grid.N):
+        a = left_angles(s, k * s.dt)
+        anchor = (float(a[0]), float(a[1]))
+        box = left_box(s, v, k)
+        out.append((_region(s.left, 0, box, anchor, g), _region(s.left, 1, box, anchor, g)))
+    if v is Variant.TIGHT:
+        goal = (float(s.left.goal[0]), float(s.left.goal[1]))
+        box = ((goal[0], goal[0]), (goal[1], goal[1]))
+        out.append((_region(s.left, 0, box, goal, g), _region(s.left, 1, box, goal, g)))
+    else:
+        out.append(out[-1])
+    return out
+
+
+def right_region_polygons(s: Scenario, grid: Grid, i: npt.ArrayLike, j: npt.ArrayLike
+                          ) -> tuple[npt.NDArray[np.object_], npt.NDArray[np.object_]]:
+    """S_RArm at cells (i, j) (arrays of equal shape): link 1 and link 2 geometries."""
+    i = np.asarray(i)
+    j = np.asarray(j)
+    h = grid.h
+    ti = grid.lo[0] + i * h[0]
+    tj = grid.lo[1] + j * h[1]
+    steps = np.array([-1.0, 0.0, 1.0])
+    # The 3 x 3 lattice of the box [t_i -+ h1] x [t_j -+ h2], anchored at the cell's own angles.
+    t1 = ti[..., None, None] + steps[:, None] * h[0]
+    t2 = tj[..., None, None] + steps[None, :] * h[1]
+    t1, t2 = np.broadcast_arrays(t1, t2)
+    out = []
+    for link in (0, 1):
+        grow = margin(s.right, link, h, (3, 3))
+        pts = corners(s.right, t1, t2, link, s.right.width / 2 + grow)
+        out.append(_hulls(pts.reshape(*i.shape, 36, 2)).reshape(i.shape))
+    return out[0], out[1]

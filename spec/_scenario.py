@@ -1,0 +1,377 @@
+"""Scenario files (docs/model.md §3): a frozen value object, validated before any work starts.
+
+Every refusal is an InputError naming the field and the value, e.g.
+``right.omega[1] must be > 0, got -1.0``. Beyond finiteness and sign, values must lie in a
+physical range (so that no float in the geometry overflows): base coordinates within
+MAX_BASE_M = 1000 m, link lengths and widths in (0, MAX_LENGTH_M = 100 m], angles (start, goal,
+limits) within MAX_ANGLE_RAD = 1000 rad, and omega_q * dt <= MAX_STEP_RAD = 3.14 rad for every
+joint of both arms (the margin lemma, ``Lemma.sweep_margin``, is proved for lattice spacings
+g <= 3.14; the left spacing is omega dt, the right h_q <= omega_q dt). The grid's size is
+computed in exact integers and held to the memory budget before any float grid step exists.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import re
+import tomllib
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from ..errors import MISSING, InputError
+from ._counts import joint_points, time_steps
+
+__all__ = [
+    "Arm",
+    "LeftArm",
+    "RightArm",
+    "Scenario",
+    "load_scenario",
+    "parse_scenario",
+    "max_cells",
+    "DEFAULT_MAX_CELLS",
+    "ANGLE_TOLERANCE",
+    "MAX_BASE_M",
+    "MAX_LENGTH_M",
+    "MAX_ANGLE_RAD",
+    "MAX_STEP_RAD",
+]
+
+#: Cells of D_R, (N + 1) * m * n, allowed before any work starts. About 1 byte per cell for
+#: dr.npy and ~20 bytes per cell at the search's peak; raise with CFMPA_MAX_CELLS.
+DEFAULT_MAX_CELLS = 60_000_000
+#: An angle given for the right arm's start or goal must be this close to a grid point (rad).
+ANGLE_TOLERANCE = 1e-9
+#: Physical range: |base coordinate| <= MAX_BASE_M (m); 0 < link length, width <= MAX_LENGTH_M (m).
+MAX_BASE_M = 1000.0
+MAX_LENGTH_M = 100.0
+#: |angle| <= MAX_ANGLE_RAD for start, goal and limits: the grid's angles keep ~1e-13 rad ulps.
+MAX_ANGLE_RAD = 1000.0
+#: omega_q * dt <= MAX_STEP_RAD per joint: the margin lemma holds for spacings g <= 3.14 rad.
+MAX_STEP_RAD = 3.14
+#: Cells beyond this are refused even with check_budget=False: no machine holds them, and
+#: counts this large no longer convert to floats.
+_HARD_MAX_CELLS = 2**53
+#: Numbers in messages are printed in full up to this many digits, else in scientific notation.
+_MAX_DIGITS = 15
+
+Pair = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Arm:
+    """A planar two-link arm: base position, link lengths, link width, joint speed limits."""
+
+    base: Pair
+    links: Pair
+    width: float
+    omega: Pair
+
+
+@dataclass(frozen=True)
+class LeftArm(Arm):
+    """The principal arm, moving point-to-point from ``start`` to ``goal`` (radians)."""
+
+    start: Pair
+    goal: Pair
+
+
+@dataclass(frozen=True)
+class RightArm(Arm):
+    """The subordinate arm: joint limits, and start/goal as grid cells (i, j)."""
+
+    limits: tuple[Pair, Pair]
+    start_cell: tuple[int, int]
+    goal_cell: tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated workcell; ``sha256`` hashes the file's bytes (empty for in-memory data)."""
+
+    name: str
+    purpose: str
+    dt: float
+    left: LeftArm
+    right: RightArm
+    source: str = "<memory>"
+    sha256: str = ""
+
+    @property
+    def cells(self) -> int:
+        """(N + 1) * m * n: the size of D_R for this scenario."""
+        R, L = self.right, self.left
+        m, n = _grid_sizes(R.limits, R.omega, self.dt)
+        return (time_steps(L.start, L.goal, L.omega, self.dt) + 1) * m * n
+
+
+_TOP_KEYS = {"name", "purpose", "dt", "left", "right"}
+_ARM_KEYS = {"base", "links", "width", "omega"}
+_LEFT_KEYS = _ARM_KEYS | {"start", "goal"}
+_RIGHT_KEYS = _ARM_KEYS | {"limits", "start_cell", "goal_cell", "start", "goal"}
+
+
+def max_cells() -> int:
+    """The memory budget in cells: CFMPA_MAX_CELLS if set (a positive integer), else the default."""
+    raw = os.environ.get("CFMPA_MAX_CELLS")
+    if raw is None:
+        return DEFAULT_MAX_CELLS
+    try:
+        value = int(raw)
+    except ValueError:
+        value = -1
+    if value <= 0:
+        raise InputError("CFMPA_MAX_CELLS", raw, "must be a positive integer")
+    return value
+
+
+class _Reader:
+    """Validates fields of one TOML document, keeping the source for line numbers."""
+
+    def __init__(self, text: str | None, source: str | None) -> None:
+        self.text = text
+        self.source = source
+
+    def line_of(self, field: str) -> int | None:
+        if self.text is None:
+            return None
+        key = field.split(".")[-1].split("[")[0]
+        table = field.split(".")[0] if "." in field else None
+        in_table = table is None
+        for n, line in enumerate(self.text.splitlines(), start=1):
+            stripped = line.strip()
+            if stripped.startswith("["):
+                # A header may carry a comment: `[left]   # principal`.
+                header = stripped.split("#", 1)[0].strip()
+                in_table = table is not None and header.strip("[] ") == table
+                if table is None:
+                    in_table = False
+                continue
+            if in_table and re.match(rf"{re.escape(key)}\s*=", stripped):
+                return n
+        return None
+
+    def fail(self, field: str, value: Any, message: str) -> InputError:
+        return InputError(field, value, message, source=self.source, line=self.line_of(field))
+
+    def table(self, doc: dict[str, Any], key: str, allowed: set[str], required: set[str],
+              prefix: str = "") -> dict[str, Any]:
+        field = f"{prefix}{key}"
+        if key not in doc:
+            raise self.fail(field, MISSING, "is required")
+        value = doc[key]
+        if not isinstance(value, dict):
+            raise self.fail(field, value, "must be a table")
+        self.keys(value, allowed, required, f"{field}.")
+        return value
+
+    def keys(self, doc: dict[str, Any], allowed: set[str], required: set[str], prefix: str) -> None:
+        for key in sorted(doc):
+            if key not in allowed:
+                raise self.fail(f"{prefix}{key}", doc[key],
+                                f"is not a known key (known: {', '.join(sorted(allowed))})")
+        for key in sorted(required):
+            if key not in doc:
+                raise self.fail(f"{prefix}{key}", MISSING, "is required")
+
+    def number(self, value: Any, field: str, *, positive: bool = False,
+               bound: float | None = None, unit: str = "") -> float:
+        """A finite float; > 0 if ``positive``; |x| <= ``bound`` if given (stated in the message)."""
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(field, value, "must be a number")
+        try:
+            x = float(value)
+        except OverflowError:  # an integer beyond the float range
+            raise self.fail(field, _short(value), "must be finite") from None
+        if not math.isfinite(x):
+            raise self.fail(field, value, "must be finite")
+        if positive and not x > 0:
+            raise self.fail(field, value, "must be > 0")
+        if bound is not None and not abs(x) <= bound:
+            within = f"<= {bound:g}{unit}" if positive else f"within [-{bound:g}, {bound:g}]{unit}"
+            raise self.fail(field, value, f"must be {within} (the physical range)")
+        return x
+
+    def pair(self, value: Any, field: str, *, positive: bool = False,
+             bound: float | None = None, unit: str = "") -> Pair:
+        if not isinstance(value, list) or len(value) != 2:
+            raise self.fail(field, value, "must be a list of 2 numbers")
+        return (self.number(value[0], f"{field}[0]", positive=positive, bound=bound, unit=unit),
+                self.number(value[1], f"{field}[1]", positive=positive, bound=bound, unit=unit))
+
+    def cell(self, value: Any, field: str) -> tuple[int, int]:
+        if not isinstance(value, list) or len(value) != 2:
+            raise self.fail(field, value, "must be a list of 2 integers")
+        out = []
+        for q, x in enumerate(value):
+            if isinstance(x, bool) or not isinstance(x, int):
+                raise self.fail(f"{field}[{q}]", x, "must be an integer")
+            out.append(x)
+        return (out[0], out[1])
+
+    def string(self, value: Any, field: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(field, value, "must be a non-empty string")
+        return value
+
+
+def _short(x: Any) -> Any:
+    """An integer too long to print usefully, as a string in scientific notation."""
+    if isinstance(x, int) and not isinstance(x, bool) and len(str(abs(x))) > _MAX_DIGITS:
+        digits = str(abs(x))
+        return f"{'-' if x < 0 else ''}{digits[0]}.{digits[1:4]}e+{len(digits) - 1}"
+    return x
+
+
+def _arm_common(r: _Reader, doc: dict[str, Any], side: str, dt: float) -> dict[str, Any]:
+    out = {
+        "base": r.pair(doc["base"], f"{side}.base", bound=MAX_BASE_M, unit=" m"),
+        "links": r.pair(doc["links"], f"{side}.links", positive=True, bound=MAX_LENGTH_M,
+                        unit=" m"),
+        "width": r.number(doc["width"], f"{side}.width", positive=True, bound=MAX_LENGTH_M,
+                          unit=" m"),
+        "omega": r.pair(doc["omega"], f"{side}.omega", positive=True),
+    }
+    for q in range(2):
+        step = out["omega"][q] * dt
+        if not step <= MAX_STEP_RAD:
+            raise r.fail(f"{side}.omega[{q}]", out["omega"][q],
+                         f"times dt = {dt!r} is {step!r} rad per step, must be <= {MAX_STEP_RAD} "
+                         "(the margin lemma holds for lattice spacings up to 3.14 rad)")
+    return out
+
+
+def _grid_sizes(limits: tuple[Pair, Pair], omega: Pair, dt: float) -> tuple[int, int]:
+    return (joint_points(limits[0][0], limits[0][1], omega[0], dt),
+            joint_points(limits[1][0], limits[1][1], omega[1], dt))
+
+
+def _check_budget(r: _Reader, N: int, m: int, n: int, budget: int | None) -> None:
+    """Refuse (N + 1) * m * n over ``budget`` (None: only the hard limit), in exact integers."""
+    cells = (N + 1) * m * n
+    if cells <= min(budget or _HARD_MAX_CELLS, _HARD_MAX_CELLS):
+        return
+    # Blame the largest factor's inputs: N comes from dt and the left arm's motion, m and n
+    # from the right arm's limits, omega and dt.
+    factors = {"N + 1": (N + 1, "dt, left.omega, left.start, left.goal"),
+               "m": (m, "right.limits[0], right.omega[0], dt"),
+               "n": (n, "right.limits[1], right.omega[1], dt")}
+    name, (_, inputs) = max(factors.items(), key=lambda kv: kv[1][0])
+    if budget is not None and cells > budget:
+        over = f"the memory budget of {_short(budget)} cells (raise it with CFMPA_MAX_CELLS)"
+    else:
+        over = f"the hard limit of 2**53 = {_short(_HARD_MAX_CELLS)} cells"
+    if budget is not None and cells > _HARD_MAX_CELLS and budget < _HARD_MAX_CELLS:
+        over += f"; no budget may exceed 2**53 = {_short(_HARD_MAX_CELLS)} cells"
+    raise r.fail("grid", f"N={_short(N)}, m={_short(m)}, n={_short(n)}",
+                 f"has (N + 1) * m * n = {_short(cells)} cells, over {over}; the largest factor "
+                 f"is {name} (from {inputs}): coarsen it")
+
+
+def _grid_point(r: _Reader, doc: dict[str, Any], which: str, limits: tuple[Pair, Pair],
+                sizes: tuple[int, int]) -> tuple[int, int]:
+    """Reads ``which``_cell, or ``which`` as angles snapped to the grid (within ANGLE_TOLERANCE)."""
+    cell_key, angle_key = f"{which}_cell", which
+    if (cell_key in doc) == (angle_key in doc):
+        raise r.fail(f"right.{cell_key}", doc.get(cell_key, doc.get(angle_key, MISSING)),
+                     f"exactly one of right.{cell_key} or right.{angle_key} must be given")
+    if cell_key in doc:
+        cell = r.cell(doc[cell_key], f"right.{cell_key}")
+        for q in range(2):
+            if not 0 <= cell[q] < sizes[q]:
+                raise r.fail(f"right.{cell_key}[{q}]", cell[q],
+                             f"must be a grid index in [0, {sizes[q] - 1}]")
+        return cell
+    angles = r.pair(doc[angle_key], f"right.{angle_key}", bound=MAX_ANGLE_RAD, unit=" rad")
+    out = []
+    for q in range(2):
+        lo, hi = limits[q]
+        m = sizes[q]
+        field = f"right.{angle_key}[{q}]"
+        if not lo - ANGLE_TOLERANCE <= angles[q] <= hi + ANGLE_TOLERANCE:
+            raise r.fail(field, angles[q], f"must lie within the limits [{lo!r}, {hi!r}]")
+        h = (hi - lo) / (m - 1)
+        x = (angles[q] - lo) / h
+        i = min(max(round(x), 0), m - 1)
+        if abs(lo + i * h - angles[q]) > ANGLE_TOLERANCE:
+            below = min(max(math.floor(x), 0), m - 1)
+            above = min(below + 1, m - 1)
+            raise r.fail(field, angles[q],
+                         f"must be a grid point (within {ANGLE_TOLERANCE} rad); nearest are index "
+                         f"{below} = {lo + below * h!r} and index {above} = {lo + above * h!r}")
+        out.append(i)
+    return (out[0], out[1])
+
+
+def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str | None = None,
+                   sha256: str = "", check_budget: bool = True) -> Scenario:
+    """Validate a parsed TOML document; the result satisfies every precondition of BuiltDR."""
+    r = _Reader(text, source)
+    if not isinstance(doc, dict):
+        raise r.fail("<document>", doc, "must be a table")
+    r.keys(doc, _TOP_KEYS, _TOP_KEYS, "")
+    name = r.string(doc["name"], "name")
+    purpose = r.string(doc["purpose"], "purpose")
+    dt = r.number(doc["dt"], "dt", positive=True)
+
+    ld = r.table(doc, "left", _LEFT_KEYS, _LEFT_KEYS)
+    angle = {"bound": MAX_ANGLE_RAD, "unit": " rad"}
+    left = LeftArm(**_arm_common(r, ld, "left", dt), start=r.pair(ld["start"], "left.start", **angle),
+                   goal=r.pair(ld["goal"], "left.goal", **angle))
+
+    rd = r.table(doc, "right", _RIGHT_KEYS, _ARM_KEYS | {"limits"})
+    common = _arm_common(r, rd, "right", dt)
+    lim = rd["limits"]
+    if not isinstance(lim, list) or len(lim) != 2:
+        raise r.fail("right.limits", lim, "must be a list of 2 [lo, hi] pairs")
+    limits = (r.pair(lim[0], "right.limits[0]"), r.pair(lim[1], "right.limits[1]"))
+    for q in range(2):
+        lo, hi = limits[q]
+        if not lo < hi:
+            raise r.fail(f"right.limits[{q}]", list(limits[q]), "must have lo < hi")
+        if not math.isfinite(hi - lo):
+            raise r.fail(f"right.limits[{q}]", list(limits[q]),
+                         "must have a finite span hi - lo (as a float)")
+        for e in range(2):
+            r.number(limits[q][e], f"right.limits[{q}][{e}]", **angle)
+    omega = common["omega"]
+    # The grid's size in exact integers, before any float grid step is formed.
+    sizes = _grid_sizes(limits, omega, dt)
+    N = time_steps(left.start, left.goal, left.omega, dt)
+    _check_budget(r, N, sizes[0], sizes[1], max_cells() if check_budget else None)
+    start_cell = _grid_point(r, rd, "start", limits, sizes)
+    goal_cell = _grid_point(r, rd, "goal", limits, sizes)
+    right = RightArm(**common, limits=limits, start_cell=start_cell, goal_cell=goal_cell)
+    return Scenario(name=name, purpose=purpose, dt=dt, left=left, right=right,
+                    source=source or "<memory>", sha256=sha256)
+
+
+def load_scenario(path: str | os.PathLike[str]) -> Scenario:
+    """Read and validate a scenario TOML file; InputError (exit 2) names what is wrong."""
+    p = Path(path)
+    source = str(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise InputError("scenario", MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=source) from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError("scenario", MISSING, "is not UTF-8 text", source=source) from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        m = re.search(r"line (\d+)", str(exc))
+        raise InputError("toml", str(exc), "is not valid TOML", source=source,
+                         line=int(m.group(1)) if m else None) from None
+    return parse_scenario(doc, source=source, text=text, sha256=hashlib.sha256(data).hexdigest())
+
+
+def exact(x: float) -> Fraction:
+    """The float's exact rational value (floats are dyadic rationals)."""
+    return Fraction(x)

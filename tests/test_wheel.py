@@ -1,0 +1,63 @@
+"""The package as a user installs it: a wheel in a fresh virtual environment, run outside the
+checkout, plans a bundled scenario and proves every obligation (slow: CI runs it once)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+pytestmark = pytest.mark.slow
+
+
+def _run(args: list[str], cwd: Path, timeout: float = 900) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=timeout,
+                          check=False)
+
+
+@pytest.fixture(scope="module")
+def venv(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    where = tmp_path_factory.mktemp("wheel")
+    built = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(where),
+                  str(ROOT)], cwd=where)
+    assert built.returncode == 0, built.stderr
+    (wheel,) = where.glob("cfmpa-*.whl")
+    env = where / "venv"
+    assert _run([sys.executable, "-m", "venv", str(env)], cwd=where).returncode == 0
+    inst = _run([str(env / "bin" / "python"), "-m", "pip", "install", "-q", str(wheel)], cwd=where)
+    assert inst.returncode == 0, inst.stderr
+    return env
+
+
+def test_the_wheel_installs_one_package_with_its_scenarios(venv: Path):
+    out = _run([str(venv / "bin" / "python"), "-c",
+                "import sysconfig; print(sysconfig.get_paths()['purelib'])"], cwd=venv)
+    site = Path(out.stdout.strip())
+    assert not (site / "spec").exists() and not (site / "impl").exists()
+    names = sorted(p.name for p in (site / "cfmpa").iterdir() if p.is_dir())
+    for pkg in ("impl", "proofs", "report", "runs", "scenarios", "spec"):
+        assert pkg in names, names
+    assert (site / "cfmpa" / "scenarios" / "default.toml").is_file()
+    assert sysconfig.get_paths()["purelib"] != str(site)      # not this interpreter's own
+
+
+def test_plan_and_prove_run_from_an_unrelated_folder(venv: Path, tmp_path: Path):
+    cfmpa = str(venv / "bin" / "cfmpa")
+    listed = _run([cfmpa, "scenarios"], cwd=tmp_path)
+    assert listed.returncode == 0, listed.stderr
+    assert "default" in listed.stdout and "early-arrival" in listed.stdout
+    planned = _run([cfmpa, "plan", "default", "--out", "out"], cwd=tmp_path)
+    assert planned.returncode == 0, planned.stderr
+    doc = json.loads((tmp_path / "out" / "plan.json").read_text())
+    assert doc["status"] == "found" and doc["scenario"] == "default" and doc["J1"] > 0
+    proved = _run([cfmpa, "prove", "--out", "proofs"], cwd=tmp_path)
+    assert proved.returncode == 0, proved.stdout[-3000:] + proved.stderr[-3000:]
+    results = json.loads((tmp_path / "proofs" / "results.json").read_text())
+    ids = [r["id"] for r in results["obligations"]]
+    assert "Scenario.default.containment" in ids
