@@ -188,9 +188,9 @@ def scenario_obligations(scenarios_dir: str | Path) -> list[Obligation]:
             Obligation(scenario_check_id(f.stem, "time_grid"), group, "docs/model.md §2 (time grid)",
                        f"{f.name}: in the binary reading N dt >= Tf and N is the least such; in "
                        f"the decimal reading the code's N also covers Tf ({_READINGS}). The "
-                       "readings can differ: default's Tf = 1.4 = 70 * 0.02 exactly in decimal "
-                       "(least N = 70, on the boundary) while the doubles give N = 71; "
-                       "limited-joints' Tf = 1.625 = 65 * 0.025 sits on the boundary in decimal.",
+                       "readings can differ on a boundary: default's Tf = 1.2 = 60 * 0.02 and "
+                       "limited-joints' Tf = 1.625 = 65 * 0.025 are exact multiples of dt in "
+                       "decimal.",
                        D, P, lambda f=f: _query(f, _time_grid, "time_grid")),
             Obligation(scenario_check_id(f.stem, "cspace_grid"), group, "docs/model.md §2 (C-space grid)",
                        f"{f.name}: h_q = (hi_q - lo_q)/(m_q - 1) <= omega_q dt for both joints, "

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+from pathlib import Path
 from typing import Any
 
 from cfmpa.spec import Scenario, parse_scenario
@@ -46,3 +47,17 @@ def toml(doc: dict[str, Any]) -> str:
     for side in ("left", "right"):
         lines += [f"[{side}]"] + [f"{k} = {json.dumps(v)}" for k, v in doc[side].items()]
     return "\n".join(lines) + "\n"
+
+
+#: The bundled default before it was made to show avoidance (its optimal path is a straight L);
+#: tests that build coarse copies by editing its text, or quote figures measured on it, read it.
+FORMER_DEFAULT = Path(__file__).resolve().parent / "data" / "former-default.toml"
+
+
+def edited(text: str, *pairs: tuple[str, str]) -> str:
+    """``text`` with each (old, new) replaced; an ``old`` that is not there is an error, so a
+    changed source file cannot turn the edit into a silent no-op."""
+    for old, new in pairs:
+        assert old in text, f"{old!r} is not in the text being edited"
+        text = text.replace(old, new)
+    return text

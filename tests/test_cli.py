@@ -19,12 +19,13 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture
 def tiny_file(tmp_path):
-    text = (ROOT / "scenarios" / "default.toml").read_text()
+    text = factory.FORMER_DEFAULT.read_text()
     p = tmp_path / "tiny.toml"
-    # The default workcell at dt = 0.25 s (grid 7 x 27 x 27), with cells between which a path
-    # exists under every variant.
-    p.write_text(text.replace("dt = 0.02", "dt = 0.25").replace("start_cell = [40, 100]",
-                 "start_cell = [2, 8]").replace("goal_cell = [150, 60]", "goal_cell = [13, 5]"))
+    # The former default workcell at dt = 0.25 s (grid 7 x 27 x 27), with cells between which a
+    # path exists under every variant.
+    p.write_text(factory.edited(text, ("dt = 0.02", "dt = 0.25"),
+                                ("start_cell = [40, 100]", "start_cell = [2, 8]"),
+                                ("goal_cell = [150, 60]", "goal_cell = [13, 5]")))
     return p
 
 

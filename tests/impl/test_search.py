@@ -235,7 +235,7 @@ def test_rejects_bad_inputs() -> None:
 
 
 def test_refuses_grids_too_large_for_exact_cost_keys() -> None:
-    _check_size(71, 316, 316)   # the default scenario is far inside the limit
+    _check_size(71, 316, 316)   # a default-sized grid is far inside the limit
     with pytest.raises(InputError, match="too large"):
         _check_size(1 << 29, 1, 1)
 

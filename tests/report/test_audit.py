@@ -31,6 +31,7 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 import jsonschema
+import factory
 import pytest
 from markupsafe import escape
 
@@ -57,12 +58,12 @@ EXPECTED = [i for i in expected_ids(ROOT / "scenarios") if selected(i, OBLIGATIO
 
 @pytest.fixture(scope="module")
 def tiny_file(tmp_path_factory):
-    text = (ROOT / "scenarios" / "default.toml").read_text()
+    text = factory.FORMER_DEFAULT.read_text()
     p = tmp_path_factory.mktemp("scen") / "tiny.toml"
-    p.write_text(text.replace('name = "default"', 'name = "tiny-default"')
-                 .replace("dt = 0.02", "dt = 0.125").replace("start_cell = [40, 100]",
-                                                              "start_cell = [6, 16]")
-                 .replace("goal_cell = [150, 60]", "goal_cell = [24, 10]"))
+    p.write_text(factory.edited(text, ('name = "former-default"', 'name = "tiny-default"'),
+                                ("dt = 0.02", "dt = 0.125"),
+                                ("start_cell = [40, 100]", "start_cell = [6, 16]"),
+                                ("goal_cell = [150, 60]", "goal_cell = [24, 10]")))
     return p
 
 
