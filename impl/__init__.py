@@ -1,7 +1,8 @@
 """The reference planner: kinematics, swept regions, BuiltDR, searchoptpath (clear first)."""
 
 from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
-                       containment_slack, left_regions, left_spacing, right_regions)
+                       contained_exactly, containment_slack, left_regions, left_spacing,
+                       right_regions)
 from ._fast_builtdr import build_dr_fast
 from ._fast_search import search_opt_path_fast
 from ._kernels import KERNELS, kernel_name, kernels
@@ -11,8 +12,8 @@ from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin
 
 __all__ = [
     "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "RightRegions", "build_dr",
-    "build_dr_fast", "check_containment", "containment_slack", "convex_hull", "kernel_name",
-    "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
+    "build_dr_fast", "check_containment", "contained_exactly", "containment_slack", "convex_hull",
+    "kernel_name", "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
     "naive_hull", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
     "swept_region",
 ]

@@ -168,8 +168,8 @@ def _query(path: Path, check: Callable[[Scenario, _Decimal], CheckOutcome], what
     dec = _decimal(path)
     src = check_source(check, _decimal, _dec)
     if check is _containment:
-        from ..impl import check_containment, containment_slack
-        src += "\n" + check_source(check_containment, containment_slack)
+        from ..impl import check_containment, contained_exactly, containment_slack
+        src += "\n" + check_source(check_containment, contained_exactly, containment_slack)
     content = f"scenario {path.name} sha256 {s.sha256}\ncheck {what}\n\n{src}\n"
     return CheckQuery(lambda: check(s, dec), content)
 
@@ -208,9 +208,11 @@ def scenario_obligations(scenarios_dir: str | Path) -> list[Obligation]:
                        D, P, lambda f=f: _query(f, _margin_side, "margin_side")),
             Obligation(scenario_check_id(f.stem, "containment"), group, "docs/model.md §4 (containment chain)",
                        f"{f.name}: region_tight ⊆ region_modified ⊆ region_original on the computed "
-                       "polygons, every layer and the rest layer, both links (vertices inside "
-                       "the outer polygon's edges up to 1e-12 m of float slack; the worst slack "
-                       "and a digest of the polygons are reported).",
+                       "polygons, every layer and the rest layer, both links: every vertex of the "
+                       "inner polygon on the inner side of every edge of the outer one, decided "
+                       "exactly on the doubles (a filtered cross product, Fractions where the "
+                       "float sign is not certain); the least float slack and a digest of the "
+                       "polygons are reported.",
                        D, P, lambda f=f: _query(f, _containment, "containment")),
         ]
     return out

@@ -1,0 +1,206 @@
+"""Rigorous re-decision of the cells a path occupies (docs/model.md §4.3, §7).
+
+The planner and the spec decide "free" in floating point: distance between two regions > eps.
+Here each (layer, cell) that a found path uses is decided again in ball arithmetic (python-flint's
+``arb``): the corner points that define both regions (the spec's construction: link rectangles of
+half-width w/2 + delta at the lattice angles, delta = g^2/8 R + SNAP g R per joint) are enclosed
+with rigorous sin and cos, and a separating direction n taken from the float geometry is checked:
+
+    min over B of n.b  -  max over A of n.a  >  eps |n|
+
+The regions are the convex hulls of those points, so this bounds their distance from below: a
+cell that passes is free whatever the float rounding of the polygons. A cell that fails is
+"undecided" (its float decision then rests on rounding alone), never silently free.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from flint import arb, ctx
+
+from ._grid import EPS, Grid, Variant, left_angles, left_box
+from ._regions import SNAP, lattice
+from ._scenario import Arm, Scenario
+
+__all__ = ["EXACT_PREC_BITS", "ExactCell", "ExactGaps", "exact_path_gaps", "path_layer_cells"]
+
+#: Working precision of the balls (bits); doubles carry 53, so rounding is far below any gap.
+EXACT_PREC_BITS = 128
+
+Cell = tuple[int, int]
+Points = list[tuple[arb, arb]]
+
+
+@dataclass(frozen=True)
+class ExactCell:
+    """One (layer, cell) pair of a path: the proved lower bound on its least region gap (m),
+    and whether that bound exceeds eps (``free``)."""
+
+    layer: int
+    cell: Cell
+    gap_lower_m: float
+    free: bool
+
+
+@dataclass(frozen=True)
+class ExactGaps:
+    """The path's cells re-decided in ball arithmetic; ``ok`` iff every one is proved free."""
+
+    cells: tuple[ExactCell, ...]
+    least_gap_m: float
+    least_at: tuple[int, Cell] | None
+
+    @property
+    def ok(self) -> bool:
+        return all(c.free for c in self.cells)
+
+    @property
+    def undecided(self) -> tuple[ExactCell, ...]:
+        return tuple(c for c in self.cells if not c.free)
+
+    def as_json(self) -> dict[str, object]:
+        return {"method": f"arb ball arithmetic ({EXACT_PREC_BITS} bits), separating direction",
+                "cells": len(self.cells), "ok": self.ok, "least_gap_m": self.least_gap_m,
+                "least_at": None if self.least_at is None
+                else {"layer": self.least_at[0], "cell": list(self.least_at[1])},
+                "undecided": [{"layer": c.layer, "cell": list(c.cell),
+                               "gap_lower_m": c.gap_lower_m} for c in self.undecided]}
+
+
+def path_layer_cells(path: Sequence[Sequence[int]], N: int) -> list[tuple[int, Cell]]:
+    """The (layer, cell) pairs the fixed is_path reads: step k holds cell L_min(k, len-1) in layer
+    min(k, N), for k = 0 .. max(len - 1, N), so the goal is checked in the rest layer too."""
+    cells = [(int(c[0]), int(c[1])) for c in path]
+    out: dict[tuple[int, Cell], None] = {}
+    for k in range(max(len(cells) - 1, N) + 1):
+        out[(min(k, N), cells[min(k, len(cells) - 1)])] = None
+    return list(out)
+
+
+def _corners(arm: Arm, t1: float, t2: float, link: int, r: arb) -> Points:
+    """The four corners of the link's rectangle of half-width ``r`` at the float angles
+    (t1, t2), enclosed in balls (the spec's ``corners`` formula, term for term)."""
+    a1 = arb(t1)
+    bx, by = arb(arm.base[0]), arb(arm.base[1])
+    ex, ey = bx + arb(arm.links[0]) * a1.cos(), by + arb(arm.links[0]) * a1.sin()
+    if link == 0:
+        phi = a1
+        px, py, qx, qy = bx, by, ex, ey
+    else:
+        phi = a1 + arb(t2)
+        px, py = ex, ey
+        qx, qy = ex + arb(arm.links[1]) * phi.cos(), ey + arb(arm.links[1]) * phi.sin()
+    ux, uy = r * phi.cos(), r * phi.sin()
+    return [(px - ux + uy, py - uy - ux), (qx + ux + uy, qy + uy - ux),
+            (qx + ux - uy, qy + uy + ux), (px - ux - uy, py - uy + ux)]
+
+
+def _margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int]) -> arb:
+    """delta of the spec's regions (``_regions.margin``) in balls, with R as the exact hypot."""
+    r = arb(arm.width) / 2
+    if link == 0:
+        R = ((arb(arm.links[0]) + r) ** 2 + r ** 2).sqrt(), arb(0)
+    else:
+        far = ((arb(arm.links[1]) + r) ** 2 + r ** 2).sqrt()
+        R = arb(arm.links[0]) + far, far
+    out = arb(0)
+    for q in range(2):
+        gq = arb(g[q])
+        if sizes[q] > 1:
+            out += gq ** 2 / 8 * R[q]
+        out += arb(SNAP) * gq * R[q]
+    return out
+
+
+def _region_points(arm: Arm, link: int, axes: tuple[np.ndarray, np.ndarray],
+                   g: tuple[float, float]) -> tuple[Points, np.ndarray]:
+    """(ball corner points, float corner points) of a region over the lattice ``axes``."""
+    r = arb(arm.width) / 2 + _margin(arm, link, g, (len(axes[0]), len(axes[1])))
+    balls: Points = []
+    for t1 in axes[0]:
+        for t2 in axes[1]:
+            balls += _corners(arm, float(t1), float(t2), link, r)
+    floats = np.array([[float(x.mid()), float(y.mid())] for x, y in balls])
+    return balls, floats
+
+
+def _gap(a: tuple[Points, np.ndarray], b: tuple[Points, np.ndarray]) -> arb:
+    """A ball containing a lower bound on dist(hull A, hull B), by the float nearest direction;
+    arb(0) when the float hulls already meet (no direction separates them)."""
+    ha = shapely.convex_hull(shapely.multipoints(a[1]))
+    hb = shapely.convex_hull(shapely.multipoints(b[1]))
+    line = shapely.shortest_line(ha, hb)
+    (x0, y0), (x1, y1) = line.coords[0], line.coords[1]
+    dx, dy = x1 - x0, y1 - y0
+    if dx == 0.0 and dy == 0.0:
+        return arb(0)
+    nx, ny = arb(dx), arb(dy)
+    hi_a = max((nx * x + ny * y).upper() for x, y in a[0])
+    lo_b = min((nx * x + ny * y).lower() for x, y in b[0])
+    return (lo_b - hi_a) / (nx * nx + ny * ny).sqrt()
+
+
+def _lower_float(x: arb) -> float:
+    """A float at or below every point of the ball ``x``."""
+    lo = x.lower()
+    f = float(lo.mid())
+    return f if arb(f) <= lo else math.nextafter(f, -math.inf)
+
+
+def exact_path_gaps(s: Scenario, variant: Variant | str, grid: Grid,
+                    path: Sequence[Sequence[int]]) -> ExactGaps:
+    """Every (layer, cell) of ``path`` re-decided in ball arithmetic against eps."""
+    v = Variant(variant)
+    gl = (s.left.omega[0] * s.dt, s.left.omega[1] * s.dt)
+    old = ctx.prec
+    ctx.prec = EXACT_PREC_BITS
+    try:
+        left: dict[int, list[tuple[Points, np.ndarray]]] = {}
+        right: dict[Cell, list[tuple[Points, np.ndarray]]] = {}
+        out = []
+        for layer, cell in path_layer_cells(path, grid.N):
+            if layer not in left:
+                left[layer] = _left_points(s, v, grid, layer, gl)
+            if cell not in right:
+                right[cell] = _right_points(s, grid, cell)
+            gap = min((_gap(a, b) for a in left[layer] for b in right[cell]),
+                      key=lambda x: _lower_float(x))
+            out.append(ExactCell(layer, cell, _lower_float(gap), bool(gap > arb(EPS))))
+    finally:
+        ctx.prec = old
+    least = min(out, key=lambda c: c.gap_lower_m, default=None)
+    return ExactGaps(cells=tuple(out), least_gap_m=least.gap_lower_m if least else math.inf,
+                     least_at=(least.layer, least.cell) if least else None)
+
+
+def _left_points(s: Scenario, v: Variant, grid: Grid, layer: int, g: tuple[float, float]
+                 ) -> list[tuple[Points, np.ndarray]]:
+    """The principal's two regions of ``layer`` (the rest layer is N), as the spec builds them."""
+    if layer == grid.N:
+        if v is Variant.TIGHT:
+            goal = (float(s.left.goal[0]), float(s.left.goal[1]))
+            box, anchor = ((goal[0], goal[0]), (goal[1], goal[1])), goal
+        else:
+            return _left_points(s, v, grid, grid.N - 1, g)
+    else:
+        a = left_angles(s, layer * s.dt)
+        anchor = (float(a[0]), float(a[1]))
+        box = left_box(s, v, layer)
+    axes = (lattice(box[0][0], box[0][1], anchor[0], g[0]),
+            lattice(box[1][0], box[1][1], anchor[1], g[1]))
+    return [_region_points(s.left, link, axes, g) for link in (0, 1)]
+
+
+def _right_points(s: Scenario, grid: Grid, cell: Cell) -> list[tuple[Points, np.ndarray]]:
+    """The subordinate's two regions at ``cell``: the 3 x 3 lattice of its box."""
+    h = grid.h
+    ti = grid.lo[0] + cell[0] * h[0]
+    tj = grid.lo[1] + cell[1] * h[1]
+    steps = np.array([-1.0, 0.0, 1.0])
+    axes = (ti + steps * h[0], tj + steps * h[1])
+    return [_region_points(s.right, link, axes, h) for link in (0, 1)]
