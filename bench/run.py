@@ -5,6 +5,10 @@ after a warm-up, with min and max, and each item's peak resident memory (its own
 Items slower than their time budget get fewer runs; the table says how many. --quick is a smoke
 run on a coarse grid (one run each, one process for all in-process items, so its memory column
 is that process's high-water mark so far; no warm-up). Never imported by the package.
+
+The campaign item (`cfmpa compare`, a fixed campaign with 1 and 2 local workers, and the
+speed-up) runs in the full bench and alone with ``--only campaign`` (merged into an existing
+results.json); --quick leaves it out (its cluster start alone is seconds).
 """
 
 from __future__ import annotations
@@ -244,8 +248,106 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
                                           "--out", str(tmp / "one"), "--contracts", "sampled"])
         if have_cli else no_cli,
     }
+    if not cfg.quick:   # the smoke run's key set stays as it was (see the module docstring)
+        res["campaign"] = campaign_section(cfg, tmp)
+    res["monitor"] = monitor_section(cfg, tmp, base, have_cli and cli_has("monitor"))
     res["targets"] = targets(res, cfg)
     return res
+
+
+def monitor_section(cfg: Config, tmp: Path, base: dict[str, Any], have_cli: bool
+                    ) -> dict[str, Any]:
+    """`cfmpa monitor` on a simulated log of 10^6 samples (--quick: 2 x 10^4) of the default
+    plan's traj.csv, and on one a tenth as long: throughput (the stream alone, from the monitor's
+    own timings_s, and the whole process) and each process's peak memory, which should not grow
+    with the log (it is read a block at a time)."""
+    if not have_cli:
+        return skipped("no `cfmpa monitor` in this checkout")
+    exe = str(cfmpa_exe())
+    toml = scenario_file(base, tmp)
+    folder = tmp / "monitor"
+    proc = subprocess.run([exe, "plan", str(toml), "--out", str(folder), "--contracts", "off"],
+                          cwd=ROOT, capture_output=True, text=True)
+    traj = folder / "traj.csv"
+    if not traj.exists():
+        return {"error": f"no traj.csv from cfmpa plan (exit {proc.returncode}): "
+                         f"{proc.stderr[-300:]}"}
+    big = 20_000 if cfg.quick else 1_000_000
+    out: dict[str, Any] = {"scenario": base, "traj_rows": len(traj.read_text().splitlines()) - 1,
+                           "note": "log: cfmpa simulate --samples N --noise 0.002 (17 significant "
+                                   "digits a value, ~96 bytes a sample); stream: the monitor's "
+                                   "own timings_s.monitor (reading, parsing, checking); cli: the "
+                                   "whole process (imports and the certificate included)"}
+    for key, n in (("log", big), ("log_tenth", big // 10)):
+        log = tmp / f"monitor-{n}.csv"
+        sim = subprocess.run([exe, "simulate", str(toml), "--traj", str(traj), "--out", str(log),
+                              "--samples", str(n), "--noise", "0.002", "--seed", "0"],
+                             cwd=ROOT, capture_output=True, text=True)
+        if sim.returncode != 0:
+            return {"error": f"cfmpa simulate failed: {sim.stderr[-300:]}"}
+        report = tmp / f"monitor-{n}.json"
+        run = cli_run(cfg, ["monitor", str(toml), "--traj", str(traj), "--log", str(log),
+                            "--json", str(report)])
+        entry: dict[str, Any] = {"samples": n, "bytes": log.stat().st_size, "cli": run}
+        if "median_s" in run:
+            doc = json.loads(report.read_text())
+            stream = doc["timings_s"]["monitor"]
+            entry.update(status=doc["status"], outside=doc["outside"], stream_s=stream,
+                         samples_per_s=n / stream, cli_samples_per_s=n / run["median_s"],
+                         peak_rss_mb=run["peak_rss_mb"])
+        out[key] = entry
+        log.unlink()
+    if "peak_rss_mb" in out["log"] and "peak_rss_mb" in out["log_tenth"]:
+        out["peak_growth_mb"] = round(out["log"]["peak_rss_mb"] - out["log_tenth"]["peak_rss_mb"], 1)
+    return out
+
+
+#: The fixed campaign timed with 1 and 2 workers: `cfmpa compare --n 40 --dt 0.1 --seed 0`.
+CAMPAIGN = {"n": 40, "dt": 0.1, "seed": 0, "workers": (1, 2)}
+
+
+def campaign_section(cfg: Config, tmp: Path) -> dict[str, Any]:
+    """`cfmpa compare` of CAMPAIGN in a fresh process per run (a fresh output folder each, so
+    nothing is reused) with each number of local workers: the whole command (interpreter,
+    cluster start, warm-up of the workers, tasks, report) and the tasks alone (compare.json's
+    timings_s.tasks: first submit to last result). Speed-up = 1 worker's median / 2 workers'.
+    compare.json must be the same apart from timings_s whatever the workers."""
+    if not cli_has("compare"):
+        return skipped("no `cfmpa compare` in this checkout")
+    runs = min(cfg.runs, 3)
+    out: dict[str, Any] = {k: v for k, v in CAMPAIGN.items() if k != "workers"}
+    out["argv"] = ["compare", "--n", str(CAMPAIGN["n"]), "--dt", str(CAMPAIGN["dt"]),
+                   "--seed", str(CAMPAIGN["seed"]), "--workers", "K", "--out", "DIR"]
+    docs = []
+    for k in CAMPAIGN["workers"]:
+        wall, tasks, start = [], [], []
+        for r in range(runs):
+            folder = tmp / f"campaign-{k}-{r}"
+            argv = [a.replace("K", str(k)).replace("DIR", str(folder)) if a in ("K", "DIR")
+                    else a for a in out["argv"]]
+            t0 = time.perf_counter()
+            proc = subprocess.run([str(cfmpa_exe()), *argv], cwd=ROOT, capture_output=True,
+                                  text=True)
+            seconds = time.perf_counter() - t0
+            if proc.returncode != 0:
+                return {"error": f"exit {proc.returncode}: {proc.stderr.strip()[-500:]}",
+                        "argv": argv}
+            doc = json.loads((folder / "compare.json").read_text())
+            timings = doc.pop("timings_s")
+            docs.append(doc)
+            wall.append(seconds)
+            tasks.append(timings["tasks"])
+            start.append(timings["engine_start"])
+        out[f"workers_{k}"] = stats(wall, tasks_median_s=statistics.median(tasks),
+                                    engine_start_median_s=statistics.median(start))
+    one, two = out["workers_1"], out["workers_2"]
+    out["speedup_2_over_1"] = {"end_to_end": one["median_s"] / two["median_s"],
+                               "tasks": one["tasks_median_s"] / two["tasks_median_s"]}
+    out["same_compare_json"] = all(d == docs[0] for d in docs)
+    out["note"] = ("fresh `cfmpa compare` processes on this machine's CPUs (shared with other "
+                   "users); end_to_end includes the interpreter, the cluster start and the "
+                   "workers' warm-up (imports, kernel cache), tasks the planning alone")
+    return out
 
 
 def shapely_section(res: dict[str, Any], variant: str, loop: dict[str, Any],
@@ -415,6 +517,9 @@ def table(res: dict[str, Any]) -> str:
     if "cli_ratios" in c:
         lines.append(f"contracts, fresh processes: sampled/off "
                      f"{c['cli_ratios']['sampled_over_off']:.2f}x")
+    camp = res.get("campaign")
+    if camp is not None:
+        lines += campaign_lines(camp)
     lines.append("")
     lines.append("targets:")
     for t in res["targets"]:
@@ -426,14 +531,44 @@ def table(res: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def campaign_lines(camp: dict[str, Any]) -> list[str]:
+    """The campaign item's lines of the table: each number of workers, then the speed-up."""
+    if "skipped" in camp or "error" in camp:
+        return [f"campaign: {camp.get('skipped') or camp.get('error')}"]
+    lines = []
+    for k in CAMPAIGN["workers"]:
+        d = camp[f"workers_{k}"]
+        lines.append(f"campaign {camp['n']} workcells dt={camp['dt']}, {k} worker(s): "
+                     f"{d['median_s']:.1f} s end to end ({d['runs']} run(s)), tasks "
+                     f"{d['tasks_median_s']:.1f} s after {d['engine_start_median_s']:.1f} s "
+                     f"of cluster start")
+    sp = camp["speedup_2_over_1"]
+    lines.append(f"campaign speed-up, 2 workers over 1: {sp['tasks']:.2f}x on the tasks, "
+                 f"{sp['end_to_end']:.2f}x end to end; compare.json the same: "
+                 f"{camp['same_compare_json']}")
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke run on a coarse grid")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent),
                     help="folder for results.json (default: bench/)")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
+    ap.add_argument("--only", choices=["campaign"], default=None,
+                    help="run only this item and merge it into OUT/results.json")
     args = ap.parse_args(argv)
     cfg = Config.of(args.quick, args.runs)
+    if args.only == "campaign":
+        out = Path(args.out) / "results.json"
+        res = json.loads(out.read_text()) if out.exists() else {}
+        with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:
+            res["campaign"] = campaign_section(cfg, Path(tmp))
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(res, indent=1, default=str) + "\n")
+        print("\n".join(campaign_lines(res["campaign"])))
+        print(f"\nwrote {out} (campaign merged)")
+        return 0
     with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:
         res = bench(cfg, Path(tmp))
     out = Path(args.out) / "results.json"

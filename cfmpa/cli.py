@@ -112,10 +112,32 @@ def _clearance_line(c: Certificate) -> str:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """Check another planner's dr.npy and plan.json against the spec."""
+    """Check another planner's dr.npy and plan.json against the spec; with --batch DIR, every
+    plan folder under DIR, one task each (0 all pass, 1 any fails, 2 bad input)."""
+    from .errors import MISSING
+
+    if args.batch is not None:
+        from .runs import run_batch
+
+        for flag, value in (("--dr", args.dr), ("--plan", args.plan),
+                            ("--witness", args.witness)):
+            if value is not None:
+                raise InputError(flag, value, "cannot be combined with --batch (each plan "
+                                 "folder's own dr.npy and plan.json are checked)")
+        workers, scheduler = _engine(args)
+        return run_batch(args.batch, None if args.scenario is None else resolve(args.scenario),
+                         json_out=args.json, workers=workers, scheduler=scheduler,
+                         connect_timeout=args.connect_timeout)
     from .runs import run_check
 
-    return run_check(resolve(args.scenario), args.dr, args.plan)
+    for flag, value in (("SCENARIO", args.scenario), ("--dr", args.dr), ("--plan", args.plan)):
+        if value is None:
+            raise InputError(flag, MISSING, "is required (or check a folder of plans with "
+                             "--batch DIR [SCENARIO])")
+    for flag in ("--json", "--workers", "--scheduler"):
+        if getattr(args, flag[2:]) is not None:
+            raise InputError(flag, getattr(args, flag[2:]), "is an option of --batch")
+    return run_check(resolve(args.scenario), args.dr, args.plan, args.witness)
 
 
 def cmd_selftest(args: argparse.Namespace) -> int:
@@ -168,10 +190,41 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    """The paper's experimental claim, measured on seeded random workcells."""
+    """The paper's experimental claim, measured on seeded random workcells (one task each on a
+    local Dask cluster, a running one, or in this process); resumable in --out."""
     from .report import run_compare
 
-    return run_compare(n=args.n, seed=args.seed, out=args.out)
+    workers, scheduler = _engine(args)
+    return run_compare(n=args.n, seed=args.seed, out=args.out, dt=args.dt, workers=workers,
+                       scheduler=scheduler, connect_timeout=args.connect_timeout)
+
+
+def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
+    """(workers, scheduler) of --workers and --scheduler: a local cluster of one worker per CPU
+    unless either is given; both at once is refused."""
+    import os
+
+    if args.scheduler is not None and args.workers is not None:
+        raise InputError("--workers", args.workers, "cannot be combined with --scheduler (the "
+                         "cluster's own workers run the tasks)")
+    if args.scheduler is not None:
+        return 0, args.scheduler
+    if args.workers is not None:
+        return args.workers, None
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (
+        os.cpu_count() or 1), None
+
+
+def _engine_arguments(p: argparse.ArgumentParser) -> None:
+    """--workers, --scheduler, --connect-timeout (cfmpa compare, cfmpa check --batch)."""
+    p.add_argument("--workers", type=_positive, default=None, metavar="K",
+                   help="worker processes of a local Dask cluster (default: one per CPU; 0: "
+                        "run in this process, no cluster)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a running Dask cluster instead (tcp://HOST:PORT of `dask "
+                        "scheduler`; its workers need cfmpa installed)")
+    p.add_argument("--connect-timeout", type=float, default=10.0, metavar="S",
+                   help="seconds to wait for the scheduler and its first worker (default 10)")
 
 
 def _positive(value: str) -> int:
@@ -212,10 +265,22 @@ def _parser() -> argparse.ArgumentParser:
                     help="fast (default; bit-identical to the reference) or reference")
     pl.set_defaults(func=cmd_plan)
 
-    c = sub.add_parser("check", help="check another planner's dr.npy and plan.json")
-    c.add_argument("scenario", help="scenario the outputs are for: a bundled name or a TOML file")
-    c.add_argument("--dr", required=True, help="dr.npy (uint8, shape (N + 1, m, n))")
-    c.add_argument("--plan", required=True, help="plan.json (docs/model.md §9)")
+    c = sub.add_parser("check", help="check another planner's dr.npy and plan.json (or a "
+                                     "folder of plan folders with --batch)")
+    c.add_argument("scenario", nargs="?", default=None,
+                   help="scenario the outputs are for: a bundled name or a TOML file (with "
+                        "--batch: optional, else each plan's bundled scenario by its name)")
+    c.add_argument("--dr", default=None, help="dr.npy (uint8, shape (N + 1, m, n))")
+    c.add_argument("--plan", default=None, help="plan.json (docs/model.md §9)")
+    c.add_argument("--witness", default=None, metavar="FILE",
+                   help="a witness file (cfmpa plan --witness) to verify for optimality; "
+                        "without it the fast search computes one")
+    c.add_argument("--batch", default=None, metavar="DIR",
+                   help="check every folder under DIR holding plan.json and dr.npy, one task "
+                        "per plan; summary in DIR/check-batch.json")
+    c.add_argument("--json", default=None, metavar="OUT",
+                   help="with --batch: write the summary here instead")
+    _engine_arguments(c)
     c.set_defaults(func=cmd_check)
 
     st = sub.add_parser("selftest", help="seed faults; show which check catches each")
@@ -246,7 +311,13 @@ def _parser() -> argparse.ArgumentParser:
     co = sub.add_parser("compare", help="original vs modified vs tight on random workcells")
     co.add_argument("--n", type=_positive, default=100, help="workcells (default 100)")
     co.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
-    co.add_argument("--out", default=None, help="folder for compare.json")
+    co.add_argument("--dt", type=float, default=0.1,
+                    help="time step of the workcells in s (default 0.1; the bundled default "
+                         "scenario's is 0.02)")
+    co.add_argument("--out", default=None,
+                    help="folder for compare.json and the store compare.jsonl (a rerun of the "
+                         "same settings resumes from it)")
+    _engine_arguments(co)
     co.set_defaults(func=cmd_compare)
     return p
 

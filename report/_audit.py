@@ -381,9 +381,11 @@ def _compare(n: int, seed: int, figures: dict[str, F.Figure]) -> dict[str, Any]:
         return {"available": False, "note": "not run for this report (compare_n = 0)"}
     doc = campaign_json(run_campaign(n, seed))
     fig = F.compare_figure("fig-compare", doc)
-    figures[fig.id] = fig
+    rate = F.campaign_rate_figure("fig-compare-rate", doc)
+    figures[fig.id], figures[rate.id] = fig, rate
     return {"available": True, "note": "", "text": format_campaign(doc),
-            "figure": {"id": fig.id, "caption": fig.caption}, **doc}
+            "figure": {"id": fig.id, "caption": fig.caption},
+            "rate_figure": {"id": rate.id, "caption": rate.caption}, **doc}
 
 
 # --- the report's own verdict -------------------------------------------------------------------
@@ -436,8 +438,10 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     cmp_ = doc["compare"]
     if cmp_["available"]:
         bad = {k: v for k, v in cmp_["checks"].items() if v}
-        items.append(_item("campaign checks", not bad, f"{cmp_['n']} workcells"
-                           + (f"; failed: {bad}" if bad else "; all counts 0")))
+        raised = len(cmp_["errors"])
+        items.append(_item("campaign checks", not bad and not raised, f"{cmp_['n']} workcells"
+                           + (f"; failed: {bad}" if bad else "; all counts 0")
+                           + (f"; {raised} workcell(s) raised" if raised else "")))
     else:
         items.append(_item("campaign checks", None, cmp_["note"]))
     return {"ok": all(i["ok"] is not False for i in items), "items": items}

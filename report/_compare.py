@@ -1,41 +1,69 @@
 """`cfmpa compare`: the paper's experimental claim (Section IV.B), measured on random workcells.
 
-Each workcell i of a campaign is drawn from ``numpy.random.default_rng([seed, i])``, so a
-campaign is reproducible from its seed and a smaller campaign is a prefix of a larger one.
+Each workcell i of a campaign is drawn from ``numpy.random.default_rng([seed, i])`` alone, so a
+campaign is reproducible from its seed and dt, a smaller campaign is a prefix of a larger one,
+and a workcell's result does not depend on which worker plans it, in which order, or how often.
 A workcell: the principal's base at the origin; the subordinate's base at a distance of 0.35 to
 0.85 times the sum of both reaches (so the reach disks always overlap), within 0.3 rad of the +x
 axis; links 0.25-0.40 m, widths 0.04-0.07 m, joint speeds 0.8-1.5 rad/s; the principal turns
 each joint by 0.4-1.8 rad either way; the subordinate's joint 1 spans [0, 2 pi], joint 2
-[-2.6, 2.6]; dt = COMPARE_DT (a coarse grid, so a campaign of 100 takes seconds). The
-subordinate's start (goal) cell is drawn uniformly among cells whose pose is apart from the
-principal's start (goal) pose, as a real task would be; after MAX_DRAWS failed draws the last one
-is kept (and counted). Every workcell is planned under the three variants; every found path gets
-the continuous-time certificate.
+[-2.6, 2.6]; dt = COMPARE_DT by default (a coarse grid, so a campaign of 100 takes seconds;
+``--dt`` sets another). The subordinate's start (goal) cell is drawn uniformly among cells whose
+pose is apart from the principal's start (goal) pose, as a real task would be; after MAX_DRAWS
+failed draws the last one is kept (and counted). Every workcell is planned under the three
+variants; every found path gets the continuous-time certificate.
+
+Engine and store (docs/model.md §13): one task per workcell on ``cfmpa.runs.Engine`` (in this
+process, a local Dask cluster, or a scheduler's); with an output folder every finished workcell
+is appended to DIR/compare.jsonl (``_store``: a header with n, seed and dt, then one line per
+workcell, fsynced) as its task completes, and a rerun of the same settings reuses every
+recorded workcell and computes only the rest (and those whose task raised). compare.json is
+built from the records alone, sorted by index, so it is byte-identical whatever the workers,
+the order, the retries or the interruptions, apart from its ``timings_s`` key.
 """
 
 from __future__ import annotations
 
+import json
 import math
+import os
+import sys
 import time
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
 
 import numpy as np
 
+from ..errors import CfmpaError, InputError
 from ..files import dumps_json, write_bytes_atomic
-from ..errors import InputError
+from ..runs import CONNECT_TIMEOUT_S, Engine, ProgressBar, TaskLost, error_message
 from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
                     parse_scenario, polygon_distance)
+from ._stats import mcnemar_exact_p, wilson_interval
+from ._store import Store, open_store
 
-__all__ = ["COMPARE_DT", "CONTACT_NOTE", "MAX_DRAWS", "Campaign", "CaseResult", "VariantOutcome",
-           "random_workcell", "run_campaign", "campaign_json", "format_campaign", "run_compare"]
+__all__ = ["COMPARE_DT", "CONTACT_NOTE", "MAX_DRAWS", "MAX_DT", "PAIRS", "STORE_NAME",
+           "Campaign", "CaseError", "CaseResult", "VariantOutcome", "campaign_json",
+           "format_campaign", "plan_workcell", "random_workcell", "run_campaign", "run_compare",
+           "workcell_task"]
 
 #: Time step of campaign workcells (s): grids of about 10-30 layers of 60-80 x 50-65 cells.
 COMPARE_DT = 0.1
+#: The coarsest --dt accepted (s); the finest is what the cell budget allows (CFMPA_MAX_CELLS).
+MAX_DT = 1.0
 #: Draws of a start or goal cell before the campaign keeps a pose in contact (then counted).
 MAX_DRAWS = 200
 #: Appended to a workcell's purpose when a pose was kept in contact after MAX_DRAWS draws.
 CONTACT_NOTE = "(a pose drawn in contact)"
+#: The store of finished workcells in the output folder, and its format.
+STORE_NAME = "compare.jsonl"
+STORE_FORMAT, STORE_VERSION = "cfmpa-compare-store", 1
+#: The paired comparisons (a, b): b's region is inside a's, so b should succeed where a does.
+PAIRS = ((Variant.ORIGINAL, Variant.MODIFIED), (Variant.MODIFIED, Variant.TIGHT),
+         (Variant.ORIGINAL, Variant.TIGHT))
+KERNEL = "build_dr_fast + search_opt_path_fast"
 _TWO_PI = 6.283185307179586
 
 
@@ -72,23 +100,37 @@ class CaseResult:
 
 
 @dataclass(frozen=True)
+class CaseError:
+    """A workcell whose task raised (or was lost): its index and the message, kept, not dropped."""
+
+    index: int
+    message: str
+
+
+@dataclass(frozen=True)
 class Campaign:
-    """A seeded campaign: its cases and the kernel that built D_R."""
+    """A seeded campaign: its planned cases, the workcells that raised, the kernel that built
+    D_R; ``reused`` workcells came from the store; ``timings_s`` are this run's times (whole
+    run, engine start, tasks)."""
 
     n: int
     seed: int
     dt: float
     kernel: str
     cases: tuple[CaseResult, ...]
+    errors: tuple[CaseError, ...] = ()
+    reused: int = 0
+    timings_s: Mapping[str, float] = field(default_factory=dict)
 
 
-def random_workcell(seed: int, index: int) -> Scenario:
-    """Workcell ``index`` of the campaign with ``seed`` (see the module docstring); its purpose
-    ends with CONTACT_NOTE when a start or goal pose had to be kept in contact."""
-    return _workcell(seed, index)[0]
+def random_workcell(seed: int, index: int, dt: float = COMPARE_DT) -> Scenario:
+    """Workcell ``index`` of the campaign with ``seed`` at time step ``dt`` (see the module
+    docstring); its purpose ends with CONTACT_NOTE when a start or goal pose had to be kept in
+    contact."""
+    return _workcell(seed, index, dt)[0]
 
 
-def _workcell(seed: int, index: int) -> tuple[Scenario, bool]:
+def _workcell(seed: int, index: int, dt: float = COMPARE_DT) -> tuple[Scenario, bool]:
     """The workcell, and whether its start and goal poses were drawn apart from the principal."""
     rng = np.random.default_rng([seed, index])
 
@@ -105,13 +147,13 @@ def _workcell(seed: int, index: int) -> tuple[Scenario, bool]:
     doc: dict[str, Any] = {
         "name": f"random-{seed}-{index}",
         "purpose": f"cfmpa compare workcell {index} of seed {seed}",
-        "dt": COMPARE_DT,
+        "dt": dt,
         "left": {"base": [0.0, 0.0], **left, "start": start, "goal": goal},
         "right": {"base": [_r(d * math.cos(phi)), _r(d * math.sin(phi))], **right,
                   "limits": [[0.0, _TWO_PI], [-2.6, 2.6]],
                   "start_cell": [0, 0], "goal_cell": [0, 0]},
     }
-    s = parse_scenario(doc, check_budget=False)
+    s = parse_scenario(doc)
     g = make_grid(s)
     apart = True
     for key, pose in (("start_cell", start), ("goal_cell", goal)):
@@ -120,43 +162,233 @@ def _workcell(seed: int, index: int) -> tuple[Scenario, bool]:
         doc["right"][key] = list(cell)
     if not apart:
         doc["purpose"] += f" {CONTACT_NOTE}"
-    return parse_scenario(doc, check_budget=False), apart
+    return parse_scenario(doc), apart
 
 
-def run_campaign(n: int = 100, seed: int = 0) -> Campaign:
-    """Plan ``n`` random workcells under original, modified and tight."""
+def plan_workcell(seed: int, index: int, dt: float = COMPARE_DT) -> CaseResult:
+    """Workcell ``index`` planned under original, modified and tight, each path certified."""
+    build, search = _kernels()
+    s, apart = _workcell(seed, index, dt)
+    g = make_grid(s)
+    outcomes = []
+    for v in Variant:
+        t0 = time.perf_counter()
+        dr = build(s, v, g)
+        r = search(dr, s.right.start_cell, s.right.goal_cell)
+        cert = certify(s, g, r.path) if r.status is SearchStatus.FOUND else None
+        outcomes.append(VariantOutcome(
+            variant=v, status=r.status.value, reason=r.reason, J1=r.J1, J2=r.J2,
+            free_fraction=1.0 - float(dr.mean()),
+            certified_clear=None if cert is None else cert.clear,
+            min_clearance_m=None if cert is None else cert.min_clearance_m,
+            seconds=time.perf_counter() - t0, path=r.path))
+    return CaseResult(index=index, shape=g.shape, poses_apart=apart, outcomes=tuple(outcomes))
+
+
+def workcell_task(seed: int, index: int, dt: float, fault: str | None = None) -> dict[str, Any]:
+    """The task of one workcell (run on a worker): its store record, or an error record with the
+    message if planning raised. ``fault`` is for tests only: ``"raise"`` raises in the task,
+    ``"exit-once:PATH"`` kills the worker process the first time (PATH marks that it did),
+    ``"sleep:S"`` delays the task by S seconds."""
+    t0 = time.perf_counter()
+    try:
+        if fault is not None:
+            _inject(fault, index)
+        return _record(plan_workcell(seed, index, dt))
+    except Exception as exc:
+        return {"index": index, "status": "error", "error": error_message(exc),
+                "seconds": time.perf_counter() - t0}
+
+
+def _inject(fault: str, index: int) -> None:
+    if fault.startswith("sleep:"):      # a slow task (the result is the same)
+        time.sleep(float(fault.removeprefix("sleep:")))
+        return
+    if fault == "raise":
+        raise RuntimeError(f"fault injected into workcell {index}")
+    if fault.startswith("exit-once:"):
+        mark = Path(fault.removeprefix("exit-once:"))
+        if not mark.exists():
+            mark.write_text("killed once\n")
+            os._exit(70)   # the worker dies mid-task: the scheduler must run it again
+        return
+    raise ValueError(f"unknown fault {fault!r}")
+
+
+def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers: int = 0,
+                 scheduler: str | None = None, out: str | os.PathLike[str] | None = None,
+                 connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool | None = None,
+                 stream: TextIO | None = None, _faults: Mapping[int, str] | None = None,
+                 _after_record: Callable[[int], None] | None = None) -> Campaign:
+    """Plan ``n`` random workcells under original, modified and tight.
+
+    ``workers`` 0 plans them in this process; K >= 1 on a local Dask cluster of K processes;
+    ``scheduler`` on a running cluster. With ``out``, every finished workcell is appended to
+    ``out``/compare.jsonl and the workcells already recorded there (by a run with the same n,
+    seed and dt) are reused, not planned again; records of a workcell whose task raised are
+    planned again. ``stream`` gets the engine's and the store's messages (None: silent); the
+    progress bar is on stderr when it is a terminal (``progress`` forces it on or off).
+    ``_faults`` (index -> fault of ``workcell_task``; by default the JSON object in the
+    environment variable CFMPA_TEST_FAULTS, for tests of the command in a fresh process) and
+    ``_after_record`` (called with the number of records written so far in this run) are for
+    tests.
+    """
+    n, seed, dt = _check_settings(n, seed, dt)
+    t_start = time.perf_counter()
+    engine = Engine(workers, scheduler, connect_timeout=connect_timeout, stream=stream,
+                    warm=_warm)
+    _workcell(seed, 0, dt)           # a dt whose grids the budget refuses: before any work
+    store: Store | None = None
+    records: dict[int, dict[str, Any]] = {}
+    if out is not None:
+        store = open_store(Path(out) / STORE_NAME, STORE_FORMAT, STORE_VERSION,
+                           {"n": n, "seed": seed, "dt": dt})
+    try:
+        if store is not None:
+            for k, rec in enumerate(store.records):
+                _check_record(rec, n, store.path, k + 2)
+                records[rec["index"]] = rec          # a later line supersedes an earlier one
+        reused = sum(1 for r in records.values() if r["status"] == "ok")
+        todo = [i for i in range(n) if records.get(i, {}).get("status") != "ok"]
+        if store is not None and stream is not None:
+            retry = sum(1 for r in records.values() if r["status"] == "error")
+            print(f"store     {store.path}: reused {reused} finished workcell(s), computing "
+                  f"{len(todo)}" + (f" ({retry} that raised before)" if retry else "")
+                  + ("; dropped a torn last line (an interrupted write)" if store.torn else ""),
+                  file=stream, flush=True)
+        faults = dict(_faults) if _faults is not None else _env_faults()
+        written = 0
+
+        def on_done(pos: int, result: Any) -> None:
+            nonlocal written
+            i = todo[pos]
+            if isinstance(result, TaskLost):
+                result = {"index": i, "status": "error", "seconds": 0.0,
+                          "error": f"task lost (not retried further): {result.message}"}
+            # The record as the store holds it (JSON), so a clean run and a resumed one build
+            # compare.json from the same values.
+            try:
+                rec = json.loads(json.dumps(result, allow_nan=False))
+            except (TypeError, ValueError) as exc:
+                rec = {"index": i, "status": "error", "seconds": 0.0,
+                       "error": f"result is not JSON: {error_message(exc)}"}
+            if store is not None:
+                store.append(rec)
+            records[i] = rec
+            written += 1
+            if _after_record is not None:
+                _after_record(written)
+
+        if todo:
+            bar = ProgressBar.for_terminal("compare", n, start=n - len(todo), progress=progress)
+            with engine:
+                engine.run(workcell_task, [(seed, i, dt, faults.get(i)) for i in todo], on_done,
+                           name="workcell", progress=bar)
+    except KeyboardInterrupt:
+        if store is not None:
+            done = sum(1 for r in records.values() if r["status"] == "ok")
+            print(f"interrupted: {done} of {n} workcells are recorded in {store.path}; run the "
+                  f"same command again to resume", file=sys.stderr, flush=True)
+        raise
+    finally:
+        if store is not None:
+            store.close()
+    missing = [i for i in range(n) if i not in records]
+    if missing:   # the engine reports every task; this would be a bug of cfmpa, not of input
+        raise CfmpaError(f"campaign ended without a record of workcells {missing[:10]}")
+    cases, errors = [], []
+    for i in range(n):
+        rec = records[i]
+        if rec["status"] == "ok":
+            cases.append(_case_of(rec))
+        else:
+            errors.append(CaseError(i, rec["error"]))
+    timings = {"run": time.perf_counter() - t_start, **engine.timings_s}
+    return Campaign(n=n, seed=seed, dt=dt, kernel=KERNEL, cases=tuple(cases),
+                    errors=tuple(errors), reused=reused, timings_s=timings)
+
+
+def _env_faults() -> dict[int, str]:
+    """CFMPA_TEST_FAULTS: a JSON object {"index": "fault"} (tests only; absent: none)."""
+    text = os.environ.get("CFMPA_TEST_FAULTS")
+    if not text:
+        return {}
+    try:
+        return {int(k): str(v) for k, v in json.loads(text).items()}
+    except (ValueError, AttributeError):
+        raise InputError("CFMPA_TEST_FAULTS", text, 'must be a JSON object {"index": "fault"}'
+                         ) from None
+
+
+def _check_settings(n: Any, seed: Any, dt: Any) -> tuple[int, int, float]:
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise InputError("--n", n, "must be an integer >= 1")
-    build, search, kernel = _kernels()
-    cases = []
-    for i in range(n):
-        s, apart = _workcell(seed, i)
-        g = make_grid(s)
-        outcomes = []
-        for v in Variant:
-            t0 = time.perf_counter()
-            dr = build(s, v, g)
-            r = search(dr, s.right.start_cell, s.right.goal_cell)
-            cert = certify(s, g, r.path) if r.status is SearchStatus.FOUND else None
-            outcomes.append(VariantOutcome(
-                variant=v, status=r.status.value, reason=r.reason, J1=r.J1, J2=r.J2,
-                free_fraction=1.0 - float(dr.mean()),
-                certified_clear=None if cert is None else cert.clear,
-                min_clearance_m=None if cert is None else cert.min_clearance_m,
-                seconds=time.perf_counter() - t0, path=r.path))
-        cases.append(CaseResult(index=i, shape=g.shape, poses_apart=apart,
-                                outcomes=tuple(outcomes)))
-    return Campaign(n=n, seed=seed, dt=COMPARE_DT, kernel=kernel, cases=tuple(cases))
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise InputError("--seed", seed, "must be an integer >= 0")
+    if (isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt)
+            or not 0 < dt <= MAX_DT):
+        raise InputError("--dt", dt, f"must be a number of seconds in (0, {MAX_DT:g}]")
+    return n, seed, float(dt)
+
+
+def _record(c: CaseResult) -> dict[str, Any]:
+    """A planned workcell as its store line (plain JSON values)."""
+    return {"index": c.index, "status": "ok", "shape": list(c.shape), "poses_apart": c.poses_apart,
+            "seconds": sum(o.seconds for o in c.outcomes),
+            "outcomes": {o.variant.value: {
+                "status": o.status, "reason": o.reason, "J1": o.J1, "J2": o.J2,
+                "free_fraction": o.free_fraction, "certified_clear": o.certified_clear,
+                "min_clearance_m": o.min_clearance_m, "seconds": o.seconds,
+                "path": [list(cell) for cell in o.path]} for o in c.outcomes}}
+
+
+def _case_of(rec: dict[str, Any]) -> CaseResult:
+    outs = rec["outcomes"]
+    return CaseResult(
+        index=rec["index"], shape=(int(rec["shape"][0]), int(rec["shape"][1]),
+                                   int(rec["shape"][2])),
+        poses_apart=bool(rec["poses_apart"]),
+        outcomes=tuple(VariantOutcome(
+            variant=v, status=outs[v.value]["status"], reason=outs[v.value]["reason"],
+            J1=outs[v.value]["J1"], J2=outs[v.value]["J2"],
+            free_fraction=outs[v.value]["free_fraction"],
+            certified_clear=outs[v.value]["certified_clear"],
+            min_clearance_m=outs[v.value]["min_clearance_m"], seconds=outs[v.value]["seconds"],
+            path=tuple((int(a), int(b)) for a, b in outs[v.value]["path"])) for v in Variant))
+
+
+def _check_record(rec: dict[str, Any], n: int, path: str | Path, line: int) -> None:
+    """A record read back from the store is one this module wrote (else an input error)."""
+    i = rec.get("index")
+    if isinstance(i, bool) or not isinstance(i, int) or not 0 <= i < n:
+        raise InputError("index", i, f"must be a workcell index in [0, {n})", source=str(path),
+                         line=line)
+    try:
+        if rec["status"] == "ok":
+            _case_of(rec)
+        elif rec["status"] == "error":
+            if not isinstance(rec["error"], str):
+                raise TypeError("error")
+        else:
+            raise ValueError(rec["status"])
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise InputError("record", error_message(exc), "is not a workcell record of this "
+                         "version (remove the store to start afresh)", source=str(path),
+                         line=line) from None
 
 
 def campaign_json(c: Campaign) -> dict[str, Any]:
-    """The campaign as JSON: the table per variant, the cross-variant counts and checks, the cases.
+    """The campaign as JSON: the table per variant with Wilson 95 % intervals, the paired
+    counts with McNemar's exact test, the cross-variant counts and checks, the errors, the cases.
 
-    Checks (each must count 0; the corrected Property 8 and the certificate predict it): modified
-    fails where original succeeds; tight fails where modified succeeds; a variant's optimum
-    (J1, J2) exceeds a looser variant's; a found path not certified clear.
+    Rates are over the ``planned`` workcells (``n`` less those whose task raised, listed in
+    ``errors``). Checks (each must count 0; the corrected Property 8 and the certificate predict
+    it): modified fails where original succeeds; tight fails where modified succeeds; a variant's
+    optimum (J1, J2) exceeds a looser variant's; a found path not certified clear. Everything but
+    ``timings_s`` is a function of (n, seed, dt) and the code.
     """
     O, M, T = Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT
+    planned = len(c.cases)
     all_found = [x for x in c.cases if all(x.found(v) for v in Variant)]
     rows = []
     for v in Variant:
@@ -165,18 +397,27 @@ def campaign_json(c: Campaign) -> dict[str, Any]:
         rows.append({
             "variant": v.value,
             "found": len(found),
-            "success_rate": len(found) / c.n,
+            "success_rate": len(found) / planned if planned else None,
+            "success_rate_ci95": list(wilson_interval(len(found), planned)) if planned else None,
             "mean_free_fraction": _mean([o.free_fraction for o in outs]),
             "mean_J1_all_found": _mean([x.outcome(v).J1 for x in all_found]),
             "mean_J2_all_found": _mean([x.outcome(v).J2 for x in all_found]),
             "no_path_reasons": _count(o.reason for o in outs if o.reason is not None),
-            "mean_seconds": _mean([o.seconds for o in outs]),
         })
 
     def worse(a: Variant, b: Variant) -> int:      # a's optimum worse than the looser b's
         return sum(1 for x in all_found
                    if (x.outcome(a).J1, x.outcome(a).J2) > (x.outcome(b).J1, x.outcome(b).J2))
 
+    paired = []
+    for a, b in PAIRS:
+        only_b = sum(1 for x in c.cases if x.found(b) and not x.found(a))
+        only_a = sum(1 for x in c.cases if x.found(a) and not x.found(b))
+        both = sum(1 for x in c.cases if x.found(a) and x.found(b))
+        paired.append({"a": a.value, "b": b.value, "a_fails_b_succeeds": only_b,
+                       "a_succeeds_b_fails": only_a, "both_succeed": both,
+                       "both_fail": planned - only_a - only_b - both,
+                       "mcnemar_exact_p": mcnemar_exact_p(only_b, only_a)})
     checks = {
         "modified_fails_original_succeeds": sum(1 for x in c.cases
                                                 if x.found(O) and not x.found(M)),
@@ -191,7 +432,10 @@ def campaign_json(c: Campaign) -> dict[str, Any]:
         "seed": c.seed,
         "dt": c.dt,
         "kernel": c.kernel,
+        "planned": planned,
+        "errors": [{"index": e.index, "message": e.message} for e in c.errors],
         "table": rows,
+        "paired": paired,
         "all_found": len(all_found),
         "original_fails_modified_succeeds": sum(1 for x in c.cases
                                                 if x.found(M) and not x.found(O)),
@@ -207,50 +451,82 @@ def campaign_json(c: Campaign) -> dict[str, Any]:
                        "free_fraction": o.free_fraction, "certified_clear": o.certified_clear,
                        "min_clearance_m": o.min_clearance_m} for o in x.outcomes}}
                   for x in c.cases],
+        # The only part that depends on the machine and the run: times, never results.
+        "timings_s": {"mean_per_variant": {v.value: _mean([x.outcome(v).seconds
+                                                           for x in c.cases]) for v in Variant},
+                      **c.timings_s},
     }
 
 
 def format_campaign(doc: dict[str, Any]) -> str:
-    """The campaign's table and counts as plain text (what `cfmpa compare` prints)."""
+    """The campaign's table, paired counts and checks as plain text (what `cfmpa compare`
+    prints)."""
     lines = [f"campaign  {doc['n']} random workcells, seed {doc['seed']}, dt {doc['dt']} s, "
-             f"kernels {doc['kernel']}; mean grid {doc['mean_cells']:.0f} cells",
-             f"{'variant':<10}{'found':>7}{'success':>9}{'free':>9}{'mean J1':>10}{'mean J2':>10}"
-             f"   (J1, J2: mean over the {doc['all_found']} workcells all variants solve)"]
+             f"kernels {doc['kernel']}; mean grid {_num(doc['mean_cells'], 0)} cells",
+             f"{'variant':<10}{'found':>7}{'success':>9}  {'95% CI (Wilson)':<18}{'free':>8}"
+             f"{'mean J1':>9}{'mean J2':>9}   (J1, J2: mean over the {doc['all_found']} "
+             f"workcells all variants solve)"]
     for r in doc["table"]:
-        lines.append(f"{r['variant']:<10}{r['found']:>7}{r['success_rate']:>9.1%}"
-                     f"{r['mean_free_fraction']:>9.1%}{_num(r['mean_J1_all_found']):>10}"
-                     f"{_num(r['mean_J2_all_found']):>10}")
+        ci = r["success_rate_ci95"]
+        lines.append(f"{r['variant']:<10}{r['found']:>7}{_pct(r['success_rate']):>9}  "
+                     f"{'-' if ci is None else f'[{ci[0]:.1%}, {ci[1]:.1%}]':<18}"
+                     f"{_pct(r['mean_free_fraction'], 1):>8}{_num(r['mean_J1_all_found']):>9}"
+                     f"{_num(r['mean_J2_all_found']):>9}")
+    lines.append(f"{'paired (a vs b)':<22}{'a fails, b succeeds':>21}{'a succeeds, b fails':>21}"
+                 f"{'McNemar exact p':>17}")
+    for p in doc["paired"]:
+        lines.append(f"{p['a'] + ' vs ' + p['b']:<22}{p['a_fails_b_succeeds']:>21}"
+                     f"{p['a_succeeds_b_fails']:>21}{p['mcnemar_exact_p']:>17.3g}")
     lines.append(f"original fails, modified succeeds: {doc['original_fails_modified_succeeds']} "
-                 f"of {doc['n']}  (tight succeeds: {doc['original_fails_tight_succeeds']}; "
+                 f"of {doc['planned']}  (tight succeeds: {doc['original_fails_tight_succeeds']}; "
                  f"no variant succeeds: {doc['none_found']})")
+    errs = doc["errors"]
+    if errs:
+        lines.append(f"errors    {len(errs)} workcell(s) raised (not counted above): "
+                     + "; ".join(f"{e['index']}: {e['message']}" for e in errs[:5])
+                     + (" ..." if len(errs) > 5 else ""))
     bad = {k: v for k, v in doc["checks"].items() if v}
     lines.append("checks    " + ("all hold: " if not bad else "FAILED: ")
                  + ", ".join(f"{k} = {v}" for k, v in (bad or doc["checks"]).items()))
     return "\n".join(lines)
 
 
-def run_compare(n: int = 100, seed: int = 0, out: str | None = None) -> int:
-    """Run a campaign, print its table; write ``out``/compare.json when ``out`` is given.
+def run_compare(n: int = 100, seed: int = 0, out: str | None = None, *, dt: float = COMPARE_DT,
+                workers: int = 0, scheduler: str | None = None,
+                connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool | None = None,
+                _faults: Mapping[int, str] | None = None,
+                _after_record: Callable[[int], None] | None = None) -> int:
+    """Run a campaign (see ``run_campaign``), print its table; write ``out``/compare.json
+    (atomically) when ``out`` is given, with the store ``out``/compare.jsonl beside it.
 
-    Exit code 0 when every check of ``campaign_json`` counts 0, else 1.
+    Exit code 0 when every check of ``campaign_json`` counts 0 and no workcell raised, else 1.
     """
-    doc = campaign_json(run_campaign(n, seed))
+    c = run_campaign(n, seed, dt, workers=workers, scheduler=scheduler, out=out,
+                     connect_timeout=connect_timeout, progress=progress, stream=sys.stdout,
+                     _faults=_faults, _after_record=_after_record)
+    doc = campaign_json(c)
     print(format_campaign(doc))
     if out is not None:
-        from pathlib import Path
         path = write_bytes_atomic(Path(out) / "compare.json", dumps_json(doc).encode())
         print(f"wrote     {path}")
-    return 0 if doc["checks_ok"] else 1
+    t = c.timings_s
+    print(f"time      {t.get('run', 0.0):.1f} s: {c.n - c.reused} workcell(s) planned in "
+          f"{t.get('tasks', 0.0):.1f} s after {t.get('engine_start', 0.0):.1f} s of engine start")
+    return 0 if doc["checks_ok"] and not doc["errors"] else 1
 
 
-def _kernels() -> tuple[Any, Any, str]:
-    """(build, search, label): the fast kernels, quiet (their output is the reference's, which
-    their own tests check)."""
+def _warm() -> None:
+    """Import this module and load the compiled kernels (once per worker process)."""
+    plan_workcell(0, 0, MAX_DT)
+
+
+def _kernels() -> tuple[Any, Any]:
+    """(build, search): the fast kernels, quiet (their output is the reference's, which their own
+    tests check)."""
     from ..impl import kernels
     build, search = kernels("fast")
     return (lambda s, v, g: build(s, v, g, progress=False),
-            lambda dr, a, b: search(dr, a, b, progress=False),
-            "build_dr_fast + search_opt_path_fast")
+            lambda dr, a, b: search(dr, a, b, progress=False))
 
 
 def _draw_cell(rng: np.random.Generator, s: Scenario, g: Any, left_pose: list[float]
@@ -283,5 +559,9 @@ def _count(xs: Any) -> dict[str, int]:
     return dict(sorted(out.items()))
 
 
-def _num(x: float | None) -> str:
-    return "-" if x is None else f"{x:.1f}"
+def _num(x: float | None, digits: int = 1) -> str:
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
+def _pct(x: float | None, digits: int = 1) -> str:
+    return "-" if x is None else f"{x:.{digits}%}"

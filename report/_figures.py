@@ -30,6 +30,7 @@ from matplotlib.patches import Patch, Polygon as MplPolygon, Rectangle  # noqa: 
 from ..spec import Grid, Scenario, Variant, arm_corners, left_angles  # noqa: E402
 from ._findings import (EarlyArrivalData, InconsistencyData, NaiveHullData, Prop8Data,  # noqa: E402
                         right_angles_at)
+from ._stats import wilson_interval  # noqa: E402
 
 __all__ = [
     "Figure",
@@ -43,6 +44,7 @@ __all__ = [
     "prop8_figure",
     "early_arrival_figure",
     "compare_figure",
+    "campaign_rate_figure",
     "VARIANT_COLORS",
 ]
 
@@ -635,3 +637,43 @@ def compare_figure(fid: str, doc: Mapping[str, Any]) -> Figure:
     return _save(fig, fid, f"The seeded campaign: share of the {doc['n']} random workcells each "
                  f"variant solves, and the mean share of free cells.",
                  "Campaign results per variant")
+
+
+def campaign_rate_figure(fid: str, doc: Mapping[str, Any]) -> Figure:
+    """The campaign's success rate against n: per variant, the rate over the first k planned
+    workcells (index order) with its Wilson 95 % band, so a reader sees the estimate settle."""
+    cases = sorted(doc["cases"], key=lambda c: c["index"])
+    fig, ax = plt.subplots(figsize=(10, 3.8))
+    total = len(cases)
+    if total == 0:
+        ax.text(0.5, 0.5, "no workcell planned", ha="center", va="center",
+                transform=ax.transAxes)
+    k = np.arange(1, total + 1)
+    floor = 100.0
+    for v in Variant:
+        if total == 0:
+            break
+        found = np.cumsum([c["outcomes"][v.value]["status"] == "found" for c in cases])
+        band = np.array([wilson_interval(int(f), int(m)) for f, m in zip(found, k)]) * 100
+        rate = 100 * found / k
+        lo, hi = band[-1]
+        ax.fill_between(k, band[:, 0], band[:, 1], color=VARIANT_COLORS[v], alpha=0.14, lw=0)
+        ax.plot(k, rate, color=VARIANT_COLORS[v], ls=VARIANT_STYLES[v], lw=1.4,
+                label=f"{v.value}: {int(found[-1])}/{total} = {rate[-1]:.1f} % "
+                      f"(95 % CI {lo:.1f}-{hi:.1f} %)")
+        floor = min(floor, float(band[min(9, total - 1):, 0].min()))
+    if total >= 20:
+        ax.set_xscale("log")
+    ax.set_xlim(1, max(total, 2))
+    # The first few workcells' bands span most of [0, 100]: the axis starts near the tenth's.
+    ax.set_ylim(max(0.0, math.floor(floor / 5) * 5 - 5), 100.5)
+    ax.set_xlabel("workcells planned, in index order (k)")
+    ax.set_ylabel("success rate over the first k (%)")
+    ax.set_title(f"success rate against n, with Wilson 95 % bands (seed {doc['seed']}, "
+                 f"dt {doc['dt']} s)")
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    return _save(fig, fid, f"Success rate against the number of workcells: for each variant the "
+                 f"rate over the first k of the {total} planned workcells, with its Wilson 95 % "
+                 f"interval as a band; the bands narrow as about 1/sqrt(k).",
+                 "Campaign success rate against n with Wilson bands")

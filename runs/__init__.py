@@ -21,7 +21,10 @@ report         ``report.run_audit``                         ``report/_audit.py``
 =============  ==========================================  ======================
 """
 
+from ._batch import BATCH_JSON, batch_table, check_plan_folder, find_plan_folders, run_batch
 from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
+from ._engine import (CONNECT_TIMEOUT_S, RETRIES, Engine, ProgressBar, TaskLost,
+                      check_scheduler_address, error_message)
 from ._contracts import DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json, violation_json
 from ._plan import CERTIFICATE, PlanResult, plan, plan_json, versions, write_plan
 from ._selftest import (FAULTS, SAMPLE, WORKCELLS, Fault, SelftestRow, run_fault, run_selftest,
@@ -33,6 +36,9 @@ __all__ = [
     "contracts_json", "plan", "plan_json", "versions", "violation_json", "write_plan",
     # another planner's files
     "CheckReport", "check_outputs", "read_dr", "read_plan", "run_check",
+    "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
+    "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost",
+    "check_scheduler_address", "error_message",
     # seeded faults
     "FAULTS", "Fault", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault", "run_selftest",
     "selftest_rows", "selftest_table", "workcell",

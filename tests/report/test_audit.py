@@ -504,10 +504,10 @@ def _results(report):
 
 
 def _figure_refs(doc):
-    """Every figure report.json refers to (findings, scenarios, campaign)."""
+    """Every figure report.json refers to (findings, scenarios, the campaign's two)."""
     refs = [f["figure"] for f in doc["findings"] if f.get("figure")]
     refs += [f for s in doc["scenarios"] for f in s["figures"]]
-    return refs + ([doc["compare"]["figure"]] if doc["compare"].get("figure") else [])
+    return refs + [doc["compare"][k] for k in ("figure", "rate_figure") if doc["compare"].get(k)]
 
 
 def _golden(name: str, text: str) -> None:

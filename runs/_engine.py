@@ -1,0 +1,305 @@
+"""Many independent tasks on dask.distributed: `cfmpa compare` (one task per workcell) and
+`cfmpa check --batch` (one task per plan folder).
+
+Three ways to run, one interface (``Engine``): ``workers=0`` runs the tasks in this process, one
+after the other (tests, small runs); ``workers=K`` starts a local cluster of K worker processes
+with one thread each (the default; its dashboard address is printed); ``scheduler=ADDRESS``
+connects to a running cluster (``dask scheduler`` and ``dask worker ADDRESS``, each worker with
+cfmpa installed). A malformed address is refused before any connection, and a scheduler that
+does not answer within the connect timeout is an input error too: neither hangs.
+
+Results come back in completion order to one callback in the client (which records them);
+nothing depends on which worker ran what. A task that raises is retried (``RETRIES``), and a
+task whose worker dies is rescheduled by the scheduler (up to its ``allowed-failures``); a task
+that is lost all the same reaches the callback as a ``TaskLost``, so that it is recorded, never
+dropped. The tasks of cfmpa catch their own exceptions and return an error record, so a
+``TaskLost`` means the machinery failed, not the workcell.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import sys
+import time
+import uuid
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from types import TracebackType
+from typing import Any, TextIO
+from urllib.parse import urlsplit
+
+from ..errors import CfmpaError, InputError
+
+__all__ = ["CONNECT_TIMEOUT_S", "RETRIES", "SCHEMES", "Engine", "ProgressBar", "TaskLost",
+           "check_scheduler_address", "error_message"]
+
+#: Seconds to wait for a scheduler (and then for its first worker) before giving up.
+CONNECT_TIMEOUT_S = 10.0
+#: Retries of a task that raises on a worker (dask's ``retries=``).
+RETRIES = 2
+#: Address schemes of dask.distributed's communication layers that cfmpa accepts.
+SCHEMES = ("tcp", "tls", "ws", "wss")
+
+
+@dataclass(frozen=True)
+class TaskLost:
+    """A task that ended without a result (after the retries): what dask said."""
+
+    message: str
+
+
+def error_message(exc: BaseException) -> str:
+    """``Type: message`` of an exception, in one line (what an error record keeps)."""
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` as ``scheme://host:port`` (a bare ``host:port`` is tcp); InputError naming
+    --scheduler when it is not one."""
+    def bad(why: str) -> InputError:
+        return InputError("--scheduler", address, f"must be a Dask scheduler address such as "
+                          f"tcp://127.0.0.1:8786 ({why})")
+
+    if not isinstance(address, str) or not address.strip() or address != address.strip():
+        raise bad("empty or padded with spaces")
+    text = address if "://" in address else f"tcp://{address}"
+    parts = urlsplit(text)
+    if parts.scheme not in SCHEMES:
+        raise bad(f"the scheme must be one of {', '.join(SCHEMES)}")
+    if parts.path not in ("", "/") or parts.query or parts.fragment or parts.username:
+        raise bad("only scheme://host:port")
+    try:
+        port = parts.port
+    except ValueError:
+        raise bad("the port must be a number from 1 to 65535") from None
+    if not parts.hostname:
+        raise bad("no host")
+    if port is None or not 1 <= port <= 65535:
+        raise bad("no port" if port is None else "the port must be a number from 1 to 65535")
+    return f"{parts.scheme}://{parts.netloc}"
+
+
+class ProgressBar:
+    """``label done/total [####   ] rate/s, ETA`` redrawn in place on a stream (None: silent).
+
+    The rate is of the tasks computed in this run (``start`` counts those done before it, e.g.
+    reused from a store), so the estimate of the time left does not count reused work."""
+
+    _REDRAW_S = 0.2
+    _WIDTH = 28
+
+    def __init__(self, label: str, total: int, start: int = 0, stream: TextIO | None = None
+                 ) -> None:
+        self.label, self.total, self.start, self.done = label, max(total, 1), start, start
+        self.stream = stream
+        self._t0 = time.monotonic()
+        self._last = -math.inf
+
+    @classmethod
+    def for_terminal(cls, label: str, total: int, start: int = 0,
+                     progress: bool | None = None, stream: TextIO | None = None) -> ProgressBar:
+        """A bar on ``stream`` (default stderr) if ``progress`` is True, or None and the stream
+        is a terminal; silent otherwise (logs, pipes and tests stay clean)."""
+        out = sys.stderr if stream is None else stream
+        if progress is None:
+            isatty = getattr(out, "isatty", None)
+            progress = bool(isatty is not None and isatty())
+        return cls(label, total, start, out if progress else None)
+
+    def advance(self, units: int = 1) -> None:
+        self.done = min(self.done + units, self.total)
+        now = time.monotonic()
+        if self.stream is not None and (now - self._last >= self._REDRAW_S
+                                        or self.done == self.total):
+            self._last = now
+            self.stream.write("\r" + self.line(now))
+            self.stream.flush()
+
+    def line(self, now: float | None = None) -> str:
+        elapsed = (time.monotonic() if now is None else now) - self._t0
+        computed = self.done - self.start
+        rate = computed / elapsed if elapsed > 0 and computed > 0 else 0.0
+        left = "-" if rate == 0 else _duration((self.total - self.done) / rate)
+        filled = self._WIDTH * self.done // self.total
+        bar = "#" * filled + " " * (self._WIDTH - filled)
+        return (f"{self.label} {self.done}/{self.total} [{bar}] {rate:.2f}/s, "
+                f"{_duration(elapsed)} elapsed, ETA {left}  ")
+
+    def close(self) -> None:
+        if self.stream is not None:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.stream = None
+
+
+def _duration(seconds: float) -> str:
+    s = int(round(seconds))
+    h, rest = divmod(s, 3600)
+    return f"{h}h{rest // 60:02d}m" if h else f"{rest // 60}m{rest % 60:02d}s"
+
+
+class Engine:
+    """Run tasks serially (``workers=0``), on a local cluster (``workers=K``) or on the cluster of
+    ``scheduler``. Use as a context manager: the cluster starts on entry and closes on exit (also
+    on Ctrl-C); ``info`` says where the tasks run (printed on entry to ``stream``). ``warm``, if
+    given, runs once on every worker at the start (imports, compiled kernels), so that
+    ``timings_s["tasks"]`` measures the tasks, not the workers' first loads."""
+
+    def __init__(self, workers: int = 0, scheduler: str | None = None, *,
+                 connect_timeout: float = CONNECT_TIMEOUT_S, stream: TextIO | None = None,
+                 warm: Callable[[], Any] | None = None) -> None:
+        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
+            raise InputError("--workers", workers, "must be an integer >= 0 (0: in this process)")
+        if not (isinstance(connect_timeout, (int, float)) and not isinstance(connect_timeout, bool)
+                and math.isfinite(connect_timeout) and connect_timeout > 0):
+            raise InputError("--connect-timeout", connect_timeout, "must be a number of seconds > 0")
+        self.workers = workers
+        self.scheduler = None if scheduler is None else check_scheduler_address(scheduler)
+        self.connect_timeout = float(connect_timeout)
+        self.stream = stream
+        self.warm = warm
+        self.info = "in this process, one task after the other"
+        #: Seconds to start (connect, warm the workers) and to run the tasks (submit to last).
+        self.timings_s: dict[str, float] = {"engine_start": 0.0, "tasks": 0.0}
+        self.dashboard: str | None = None
+        self._client: Any = None
+        self._cluster: Any = None
+
+    @property
+    def serial(self) -> bool:
+        return self.scheduler is None and self.workers == 0
+
+    def __enter__(self) -> Engine:
+        t0 = time.perf_counter()
+        try:
+            if not self.serial:
+                self._start()
+            if self.stream is not None:   # the dashboard's address as soon as it serves
+                print(f"engine    {self.info}", file=self.stream, flush=True)
+            if self.warm is not None:
+                # Imports and the kernels' cache load on every worker at once, before the
+                # first task: the task times are then the tasks' own.
+                self._warm()
+        except BaseException:
+            self.close()
+            raise
+        self.timings_s["engine_start"] = time.perf_counter() - t0
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+    def _start(self) -> None:
+        from dask.distributed import Client, LocalCluster
+
+        if self.scheduler is not None:
+            try:
+                self._client = Client(self.scheduler, timeout=self.connect_timeout,
+                                      set_as_default=False)
+            except (OSError, TimeoutError) as exc:
+                raise InputError("--scheduler", self.scheduler, f"did not answer within "
+                                 f"{self.connect_timeout:g} s ({error_message(exc)[:200]})"
+                                 ) from None
+            try:
+                self._client.wait_for_workers(1, timeout=self.connect_timeout)
+            except (OSError, TimeoutError):
+                raise InputError("--scheduler", self.scheduler, f"has no worker after "
+                                 f"{self.connect_timeout:g} s (start one with `dask worker "
+                                 f"{self.scheduler}`)") from None
+            n = len(self._client.nthreads())
+            self.dashboard = self._client.dashboard_link
+            self.info = (f"Dask scheduler {self.scheduler}, {n} worker(s) now; dashboard "
+                         f"{self.dashboard}")
+            return
+        # Loopback only (scheduler, workers and dashboard); one thread per worker process: the
+        # kernels are single-threaded and the GIL would serialise threads anyway.
+        with warnings.catch_warnings():
+            # 8787 taken (another cluster): dask serves the dashboard on a free port instead,
+            # and the address printed below is the one it took.
+            warnings.filterwarnings("ignore", message="Port 8787 is already in use")
+            self._cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
+                                         processes=True, host="127.0.0.1",
+                                         dashboard_address="127.0.0.1:8787",
+                                         silence_logs=logging.CRITICAL)
+        self._client = Client(self._cluster, set_as_default=False)
+        self.dashboard = self._client.dashboard_link
+        self.info = (f"local Dask cluster, {self.workers} worker process(es) x 1 thread; "
+                     f"dashboard {self.dashboard}")
+
+    def _warm(self) -> None:
+        assert self.warm is not None
+        if self.serial:
+            self.warm()
+            return
+        try:
+            # One task pinned to each worker, in its task thread (client.run would block the
+            # worker's event loop, and its heartbeats, for as long as the imports take).
+            client = self._client
+            tag = uuid.uuid4().hex[:8]
+            futures = [client.submit(self.warm, key=f"warm-{tag}-{k}", workers=[address],
+                                     allow_other_workers=False, pure=False)
+                       for k, address in enumerate(client.nthreads())]
+            client.gather(futures)
+        except Exception as exc:
+            raise CfmpaError(f"a Dask worker cannot run cfmpa's tasks ({error_message(exc)}); "
+                             f"is this version of cfmpa installed where the workers run?"
+                             ) from None
+
+    def close(self) -> None:
+        client, cluster = self._client, self._cluster
+        self._client = self._cluster = None
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+    def run(self, fn: Callable[..., Any], argsets: Sequence[tuple[Any, ...]],
+            on_done: Callable[[int, Any], None], *, name: str = "task",
+            progress: ProgressBar | None = None, retries: int = RETRIES) -> None:
+        """Call ``fn(*argsets[i])`` for every i; ``on_done(i, result)`` in the client as each
+        finishes (in completion order), with a ``TaskLost`` for a task that ended without one.
+        ``fn`` must be importable by the workers (a module-level function of cfmpa)."""
+        bar = progress or ProgressBar(name, len(argsets))
+        t0 = time.perf_counter()
+        try:
+            if self.serial:
+                for i, args in enumerate(argsets):
+                    try:
+                        result: Any = fn(*args)
+                    except Exception as exc:
+                        result = TaskLost(error_message(exc))
+                    on_done(i, result)
+                    bar.advance()
+                return
+            self._run_dask(fn, argsets, on_done, name, bar, retries)
+        finally:
+            self.timings_s["tasks"] += time.perf_counter() - t0
+            bar.close()
+
+    def _run_dask(self, fn: Callable[..., Any], argsets: Sequence[tuple[Any, ...]],
+                  on_done: Callable[[int, Any], None], name: str, bar: ProgressBar,
+                  retries: int) -> None:
+        from dask.distributed import as_completed
+
+        client = self._client
+        assert client is not None, "Engine.run outside its with block"
+        run_id = uuid.uuid4().hex[:8]   # keys unique per run: another run's results never mix
+        futures = {client.submit(fn, *args, key=f"{name}-{run_id}-{i}", retries=retries,
+                                 pure=False): i for i, args in enumerate(argsets)}
+        try:
+            for fut in as_completed(futures, loop=client.loop):
+                i = futures[fut]
+                try:
+                    result = fut.result()
+                except Exception as exc:   # the task's worker died too often, or it raised
+                    result = TaskLost(error_message(exc))
+                on_done(i, result)
+                fut.release()
+                bar.advance()
+        finally:
+            client.cancel([f for f in futures if not f.done()])
+
