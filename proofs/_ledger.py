@@ -30,8 +30,10 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "The proofs reason over real numbers; the implementation computes in IEEE doubles, and "
         "declares a cell free only when the polygons' distance exceeds eps = 1e-9 m.",
         "Rounding errors of the polygon computations are of the order 1e-15 m at metre scale, "
-        "six orders below eps; the containment check allows 1e-12 m of float slack and reports "
-        "the worst slack found.",
+        "six orders below eps. What this still covers: the cells a found path does not use. "
+        "Every (layer, cell) a found path occupies is re-decided in arb ball arithmetic "
+        "(plan.json's exact_gaps), and the containment of the variants' regions is decided "
+        "exactly on the computed doubles, so neither rests on rounding.",
         "Sep.distance_monotone, Scenario.*.containment"),
     Assumption(
         "A3.trigonometry",

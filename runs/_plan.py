@@ -27,8 +27,9 @@ from ..impl import build_dr_fast, kernel_name, search_opt_path_fast
 from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
 from ..spec import Certificate, certificate_json, certify, require_clear
 from ..spec import SearchResult, SearchStatus
+from ..spec import ExactGaps, exact_path_gaps
 from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
-                         checked_search, contracts_json)
+                         checked_search, contracts_json, violation_json)
 
 R = TypeVar("R")
 
@@ -51,6 +52,8 @@ class PlanResult:
     runs: tuple[TripleRun, ...] = ()
     kernel: str = "custom"
     settings: Settings = field(default_factory=Settings)
+    #: The path's (layer, cell) pairs re-decided in ball arithmetic (None without a path).
+    exact: ExactGaps | None = None
 
     @property
     def checked(self) -> int:
@@ -68,6 +71,8 @@ class PlanResult:
         cert = self.certificate
         if cert is not None and not cert.clear:
             out.append(_certificate_violation(cert))
+        if self.exact is not None and not self.exact.ok:
+            out.append(_exact_violation(self.exact))
         return out
 
 
@@ -119,18 +124,28 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
         t["contracts_search"] = time.perf_counter() - t0 - t["search"]
     runs += search_runs
     cert = None
+    exact = None
     if result.status is SearchStatus.FOUND:
         t0 = time.perf_counter()
         cert = certify(s, g, result.path)
         t["certificate"] = time.perf_counter() - t0
         if stop:
             require_clear(cert, name=CERTIFICATE)
+        t0 = time.perf_counter()
+        exact = exact_path_gaps(s, v, g, result.path)
+        t["exact_gaps"] = time.perf_counter() - t0
+        if stop and not exact.ok:
+            raise _exact_violation(exact)
     record = contracts_json(settings, runs,
                             _certificate_violation(cert) if cert and not cert.clear else None,
                             certificate_checked=True)
+    if exact is not None and not exact.ok:
+        # Before the certificate's own violation, which stays the last (the safety result).
+        at = len(record["violations"]) - (1 if cert is not None and not cert.clear else 0)
+        record["violations"].insert(at, violation_json(_exact_violation(exact)))
     return PlanResult(scenario=s, variant=v, grid=g, dr=dr, search=result, certificate=cert,
                       contracts=record, timings_s=t, runs=tuple(runs), kernel=kernel,
-                      settings=settings)
+                      settings=settings, exact=exact)
 
 
 #: A workcell with a 4 x 14 x 14 grid: calling the fast kernels on it loads (or compiles) every
@@ -168,6 +183,18 @@ def _certificate_violation(cert: Certificate) -> ContractViolation:
     except ContractViolation as exc:
         return exc
     raise AssertionError("require_clear accepted a certificate that is not clear")
+
+
+#: The name of the exact re-decision in violations (like the certificate, not a triple).
+EXACT = "exact re-decision of the path's cells"
+
+
+def _exact_violation(e: ExactGaps) -> ContractViolation:
+    first = e.undecided[0]
+    return ContractViolation(EXACT, "exact.path_cells: a cell the path occupies is not proved "
+                             "free in ball arithmetic (its float decision rests on rounding)",
+                             {"undecided": len(e.undecided), "layer": first.layer,
+                              "cell": first.cell, "gap_lower_m": first.gap_lower_m})
 
 
 def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[..., R]:
@@ -209,6 +236,7 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None) -> dict[str, Any]:
         "dr_sha256": hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest(),
         "kernel": p.kernel,
         "clearance": certificate_json(p.certificate) if p.certificate is not None else None,
+        "exact_gaps": p.exact.as_json() if p.exact is not None else None,
         "contracts": p.contracts,
         "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
         "versions": versions(),

@@ -6,6 +6,7 @@ The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 from ._grid import (EPS, Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
                     make_grid, rest_is_goal, right_box)
 from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
+from ._exact import ExactCell, ExactGaps, exact_path_gaps
 from ._kinematics import arm_corners, joints, link_corners
 from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                      Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
@@ -33,4 +34,6 @@ __all__ = [
     "dr_cell_failures", "dr_shape_failures", "grid_failures", "path_cells", "search_failures",
     "search_triple",
     "Certificate", "ContactDetail", "certificate_json", "certify", "require_clear",
+    # the path's cells re-decided in ball arithmetic (docs/model.md §7)
+    "ExactCell", "ExactGaps", "exact_path_gaps",
 ]

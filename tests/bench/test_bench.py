@@ -20,7 +20,7 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     assert proc.returncode == 0, proc.stderr
     res = json.loads((tmp_path / "results.json").read_text())
     assert set(res) == {"meta", "builtdr", "search", "shapely", "scaling", "plan", "prove",
-                        "contracts", "one_degree", "targets"}
+                        "contracts", "one_degree", "monitor", "targets"}
     for v in Variant:
         assert set(res["builtdr"][v.value]) == {"reference", "fast", "fast_regions_given"}
         assert set(res["search"][v.value]) == {"reference", "fast"}
@@ -45,5 +45,10 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     assert c["ratios"]["full_over_off"] > 0 and c["ratios"]["sampled_over_off"] > 0
     assert set(c["cli"]) == {"off", "sampled"} and "error" not in str(c["cli"])
     assert TIMING <= set(res["one_degree"]["plan_fast_in_process_sampled"])
+    m = res["monitor"]
+    assert "error" not in m, m
+    if "skipped" not in m:
+        for key in ("log", "log_tenth"):
+            assert {"samples", "samples_per_s", "peak_rss_mb", "status"} <= set(m[key])
     assert all({"target", "limit", "measured", "met"} <= set(t) for t in res["targets"])
     assert "targets:" in proc.stdout and "results.json" in proc.stdout

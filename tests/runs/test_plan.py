@@ -13,7 +13,7 @@ import factory
 from cfmpa.files import dumps_json
 from cfmpa.errors import CertificateViolation, ContractViolation
 from cfmpa.impl import build_dr, search_opt_path
-from cfmpa.runs._plan import CERTIFICATE, plan, plan_json, write_plan
+from cfmpa.runs._plan import CERTIFICATE, EXACT, plan, plan_json, write_plan
 from cfmpa.runs._selftest import FAULTS, workcell
 from cfmpa.spec import make_grid
 
@@ -132,8 +132,8 @@ def test_a_contact_is_a_violation_in_every_mode(mode):
     assert values["distance_m"] == 0.0 and values["path segment"] == "resting at the last cell"
     assert values["cells"] == [list(p.search.path[-1])] * 2
     assert len(values["left angles_rad"]) == len(values["right angles_rad"]) == 2
-    if mode == "off":                   # only the certificate: off checks no triple
-        assert [v["triple"] for v in rec["violations"]] == [CERTIFICATE]
+    if mode == "off":   # off checks no triple: only the exact re-decision and the certificate
+        assert [v["triple"] for v in rec["violations"]] == [EXACT, CERTIFICATE]
     # stop=True: off raises the contact itself; sampled stops earlier, at post.is_path
     with pytest.raises(CertificateViolation if mode == "off" else ContractViolation,
                        match="touch" if mode == "off" else "post.is_path"):
