@@ -295,6 +295,9 @@ def monitor_section(cfg: Config, tmp: Path, base: dict[str, Any], have_cli: bool
             entry.update(status=doc["status"], outside=doc["outside"], stream_s=stream,
                          samples_per_s=n / stream, cli_samples_per_s=n / run["median_s"],
                          peak_rss_mb=run["peak_rss_mb"])
+            cpu = doc["timings_s"].get("monitor_cpu")
+            if cpu:     # the stream's own CPU seconds: its rate on a machine shared by others
+                entry.update(stream_cpu_s=cpu, cpu_samples_per_s=n / cpu)
         out[key] = entry
         log.unlink()
     if "peak_rss_mb" in out["log"] and "peak_rss_mb" in out["log_tenth"]:

@@ -70,8 +70,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
     s = load_scenario(resolve(args.scenario))
     build, search = kernels(args.kernel)
     p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample,
-             stop=False, build=build, search=search, kernel=args.kernel)
-    dr_path, plan_path = write_plan(p, args.out)
+             stop=False, build=build, search=search, kernel=args.kernel,
+             witness=args.witness is not None)
+    dr_path, plan_path = write_plan(p, args.out, witness=args.witness)
     violations = p.violations
     g, r, t = p.grid, p.search, p.timings_s
     print(f"scenario  {s.name} ({args.scenario})")
@@ -86,7 +87,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         print(_clearance_line(p.certificate))
     print(f"contracts {p.settings.mode.value}: {p.checked} checks, {len(violations)} violations")
     print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()))
-    print(f"wrote     {dr_path}, {plan_path}")
+    print(f"wrote     {dr_path}, {plan_path}" + (f", {args.witness}" if args.witness else ""))
     for v in violations:
         print(f"violation {v}", file=sys.stderr)
     if violations:
@@ -154,7 +155,8 @@ def cmd_prove(args: argparse.Namespace) -> int:
     if args.only and args.audit is not None:
         # A report a reviewer trusts is of a whole run: a selection would show the rest missing.
         raise InputError("--audit", args.audit, "needs every obligation; run it without --only")
-    code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only)
+    code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
+                     repin=args.repin)
     if args.audit is None:
         return code
     from .report import run_audit
@@ -197,6 +199,33 @@ def cmd_compare(args: argparse.Namespace) -> int:
     workers, scheduler = _engine(args)
     return run_compare(n=args.n, seed=args.seed, out=args.out, dt=args.dt, workers=workers,
                        scheduler=scheduler, connect_timeout=args.connect_timeout)
+
+
+def cmd_certify(args: argparse.Namespace) -> int:
+    """Certify any trajectory file: proved clearance, tolerance tube (0 clear, 1 not, 2 input)."""
+    from .runs import run_certify
+
+    return run_certify(resolve(args.scenario), args.traj, json_out=args.json,
+                       allow_speed=args.allow_speed)
+
+
+def cmd_monitor(args: argparse.Namespace) -> int:
+    """Stream a measured joint log against the certified tube (0 inside, 1 outside, 2 input)."""
+    from .runs import run_monitor
+
+    return run_monitor(resolve(args.scenario), args.traj, args.log, json_out=args.json,
+                       allow_speed=args.allow_speed)
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """Write a simulated measured log of a trajectory (lag, noise, seed, excursions)."""
+    from .runs import parse_excursion, run_simulate
+
+    return run_simulate(resolve(args.scenario), args.traj, args.out, lag=args.lag,
+                        noise=args.noise, seed=args.seed,
+                        excursions=[parse_excursion(e) for e in args.excursion],
+                        period=args.period, samples=args.samples, tail=args.tail,
+                        allow_speed=args.allow_speed)
 
 
 def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
@@ -263,6 +292,9 @@ def _parser() -> argparse.ArgumentParser:
                     help="cells checked by sampled contracts (default: the mode's own)")
     pl.add_argument("--kernel", choices=["fast", "reference"], default="fast",
                     help="fast (default; bit-identical to the reference) or reference")
+    pl.add_argument("--witness", default=None, metavar="FILE",
+                    help="also write the search's witness of its answer (npz, docs/model.md "
+                         "§11); plan.json gets its witness_sha256")
     pl.set_defaults(func=cmd_plan)
 
     c = sub.add_parser("check", help="check another planner's dr.npy and plan.json (or a "
@@ -289,18 +321,25 @@ def _parser() -> argparse.ArgumentParser:
     pr = sub.add_parser("prove", help="discharge every obligation (make prove)")
     pr.add_argument("--out", default="build/proofs", help="results folder (default build/proofs)")
     pr.add_argument("--scenarios", default=None,
-                    help="scenario folder to prove (default: the bundled scenarios)")
+                    help="a folder of your workcells (*.toml) to prove: four checks per file, "
+                         "ids from the file names (default: the bundled workcells)")
     pr.add_argument("--only", action="append", default=None,
                     help="an obligation id, prefix or glob (repeatable)")
     pr.add_argument("--audit", metavar="DIR", default=None,
                     help="then write the audit report to DIR")
+    pr.add_argument("--repin", action="store_true",
+                    help="rewrite proofs/obligations.lock with the statements run and print "
+                         "what changed (review the diff), instead of failing on a change")
     pr.set_defaults(func=cmd_prove)
 
     au = sub.add_parser("audit", help="write report.html and report.json")
-    au.add_argument("scenarios", nargs="*", help="scenario names or files (default: all bundled)")
+    au.add_argument("scenarios", nargs="*",
+                    help="scenario names or files (default: all bundled); the report shows the "
+                         "per-scenario obligations of exactly these workcells")
     au.add_argument("--out", required=True, help="output folder")
     au.add_argument("--proofs", default=None,
-                    help="results.json of a prove run to report (default: prove afresh)")
+                    help="results.json of a prove run to report (default: prove afresh); it "
+                         "must cover the given workcells' checks, others' rows are left out")
     au.add_argument("--compare-n", type=_positive, default=100,
                     help="workcells in the campaign (0 skips it; default 100)")
     au.set_defaults(func=cmd_audit)
@@ -319,6 +358,47 @@ def _parser() -> argparse.ArgumentParser:
                          "same settings resumes from it)")
     _engine_arguments(co)
     co.set_defaults(func=cmd_compare)
+
+    ce = sub.add_parser("certify", help="certify any trajectory file: proved clearance and "
+                                        "tolerance tube")
+    ce.add_argument("scenario", help="scenario (the geometry): a bundled name or a TOML file")
+    ce.add_argument("--traj", required=True, metavar="FILE",
+                    help="trajectory: CSV t,left1,left2,right1,right2 or the same columns as "
+                         "JSON (docs/model.md §12)")
+    ce.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
+    ce.add_argument("--allow-speed", action="store_true",
+                    help="certify even when a joint speed exceeds the scenario's omega")
+    ce.set_defaults(func=cmd_certify)
+
+    mo = sub.add_parser("monitor", help="check a measured joint log against the certified tube")
+    mo.add_argument("scenario", help="scenario: a bundled name or a TOML file")
+    mo.add_argument("--traj", required=True, metavar="FILE", help="the planned trajectory")
+    mo.add_argument("--log", required=True, metavar="LOG",
+                    help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
+    mo.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
+    mo.add_argument("--allow-speed", action="store_true",
+                    help="accept a trajectory whose joint speeds exceed omega")
+    mo.set_defaults(func=cmd_monitor)
+
+    si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")
+    si.add_argument("scenario", help="scenario: a bundled name or a TOML file")
+    si.add_argument("--traj", required=True, metavar="FILE", help="the planned trajectory")
+    si.add_argument("--out", required=True, metavar="LOG", help="the log file to write (CSV)")
+    si.add_argument("--lag", type=float, default=0.0, help="tracking lag in s (default 0)")
+    si.add_argument("--noise", type=float, default=0.0,
+                    help="bounded uniform noise per joint in rad (default 0)")
+    si.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    si.add_argument("--excursion", action="append", default=[], metavar="T:JOINT:RAD[:DURATION]",
+                    help="add RAD to JOINT from T for DURATION s (default 0.05; repeatable)")
+    si.add_argument("--period", type=float, default=None,
+                    help="sample period in s (default 0.001)")
+    si.add_argument("--samples", type=int, default=None,
+                    help="this many evenly spaced samples instead of --period")
+    si.add_argument("--tail", type=float, default=0.0,
+                    help="keep sampling this many s after the trajectory ends (default 0)")
+    si.add_argument("--allow-speed", action="store_true",
+                    help="accept a trajectory whose joint speeds exceed omega")
+    si.set_defaults(func=cmd_simulate)
     return p
 
 

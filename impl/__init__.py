@@ -3,6 +3,7 @@
 from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
                        contained_exactly, containment_slack, left_regions, left_spacing,
                        right_regions)
+from ._builtdr_loops import build_dr_loops, builtdr_loop_nest
 from ._fast_builtdr import build_dr_fast
 from ._fast_search import search_opt_path_fast
 from ._kernels import KERNELS, kernel_name, kernels
@@ -12,7 +13,7 @@ from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin
 
 __all__ = [
     "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "RightRegions", "build_dr",
-    "build_dr_fast", "check_containment", "contained_exactly", "containment_slack", "convex_hull",
+    "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly", "containment_slack", "convex_hull",
     "kernel_name", "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
     "naive_hull", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
     "swept_region",

@@ -16,9 +16,14 @@ are computed, and the tie-break is a property of the labels, not of the order of
   over the goal states of that bucket, the least move on ties, as the reference does.
 
 So the tie-break is the one ``search_opt_path``'s docstring states on the returned path.
+``with_witness`` gives the reference's witness too (the same arrays): the DAG steps' labels are
+written as they are computed, and the capped step's buckets run on until every reachable state
+is settled.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
@@ -27,7 +32,7 @@ from numba import njit
 from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                            Cell, SearchResult, check_search_inputs)
 from ._progress import progress_bar
-from ._search import INF, J2_MASK, SHIFT, WAIT, _check_size, _unwind
+from ._search import INF, J2_MASK, SHIFT, WAIT, WitnessLabels, _check_size, _unwind, hold_waits
 
 __all__ = ["search_opt_path_fast"]
 
@@ -38,21 +43,29 @@ _GAP = np.abs(_DI[:, None] - _DI[None, :]) + np.abs(_DJ[:, None] - _DJ[None, :])
 
 
 def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
-                         progress: bool | None = None) -> SearchResult:
-    """The same result as ``search_opt_path`` (least (J1, J2), its path, or why none)."""
+                         progress: bool | None = None, with_witness: bool = False
+                         ) -> SearchResult:
+    """The same result as ``search_opt_path`` (least (J1, J2), its path, or why none), and with
+    ``with_witness`` the same witness."""
     N, m, n, start, goal = check_search_inputs(dr, start, goal)
     free = np.ascontiguousarray(np.asarray(dr) == 0)
-    if not free[0, start[0], start[1]]:
-        return SearchResult.no_path(REASON_START_BLOCKED)
-    if not free[N, goal[0], goal[1]]:
-        return SearchResult.no_path(REASON_GOAL_BLOCKED)
+    reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
+              REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
+    if reason is not None and not with_witness:
+        return SearchResult.no_path(reason)
     _check_size(N, m, n)
+    labels = WitnessLabels(N, m, n) if with_witness else None
+    if reason == REASON_START_BLOCKED:
+        return replace(SearchResult.no_path(reason), witness=labels.witness(found=False))
     dag_pred = np.zeros((N, 9, m, n), dtype=np.int8)   # read only at reachable states
     keys = np.full((9, m, n), INF, dtype=np.int64)
     spare = np.full((9, m, n), INF, dtype=np.int64)
     keys[WAIT, start[0], start[1]] = 0                 # step 0: at start, "arrived" by waiting
     with progress_bar("search", N + 1, int(free.size), progress) as bar:
         for s in range(1, N + 1):
+            if labels is not None:                     # labels only within s - 1 moves
+                labels.put(s - 1, keys, (max(0, start[0] - s + 1), min(m, start[0] + s),
+                                         max(0, start[1] - s + 1), min(n, start[1] + s)))
             _dag_step(free[s], keys, spare, dag_pred[s - 1], start[0], start[1], s,
                       _DI, _DJ, _NORM, _GAP, SHIFT, INF)
             keys, spare = spare, keys
@@ -62,12 +75,18 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
         from_static = np.zeros(9 * M, dtype=np.bool_)
         goal_flat = goal[0] * n + goal[1]
         key, last = _static_phase(free[N].reshape(M), n, keys.reshape(9 * M), pred, from_static,
-                                  goal_flat, _DI, _DJ, _NORM, _GAP, SHIFT, INF, WAIT)
+                                  goal_flat, _DI, _DJ, _NORM, _GAP, SHIFT, INF, WAIT,
+                                  labels is not None)
         bar.advance()
     if key < 0:
-        return SearchResult.no_path(REASON_UNREACHABLE)
-    path = _unwind(goal, int(last), start, pred, from_static, dag_pred.reshape(N, 3, 3, m, n))
-    return SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+        result = SearchResult.no_path(reason or REASON_UNREACHABLE)
+    else:
+        path = _unwind(goal, int(last), start, pred, from_static, dag_pred.reshape(N, 3, 3, m, n))
+        result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+    if labels is None:
+        return result
+    labels.put(N, hold_waits(keys))
+    return replace(result, witness=labels.witness(found=key >= 0))
 
 
 # ---------------------------------------------------------------- compiled kernels (numba) ----
@@ -115,10 +134,12 @@ def _grow(buf, count, value):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shift, inf, wait
-                  ):  # pragma: no cover - compiled; its results are tested against search_opt_path
+def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shift, inf, wait,
+                  complete):  # pragma: no cover - compiled; tested against search_opt_path
     """Dial's buckets over J1 at the capped step N; returns (finish key, last move), or (-1, -1)
-    when the goal is unreachable. State u = move * M + cell; keys start as the DAG's labels."""
+    when the goal is unreachable. State u = move * M + cell; keys start as the DAG's labels.
+    ``complete``: go on past the goal's bucket until every reachable state is settled (settled
+    states are never changed, so the answer is the same)."""
     M = free.shape[0]
     m = M // n
     done = np.zeros(keys.shape[0], dtype=np.bool_)
@@ -132,6 +153,7 @@ def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shi
     size = np.zeros(3, dtype=np.int64)
     frontier = np.empty(1024, dtype=np.int64)
     b = 0 if initial.shape[0] == 0 else init_j1[0]
+    found_key, found_last = inf, -1
     while nxt < initial.shape[0] or size.sum() > 0:
         if size.sum() == 0 and init_j1[nxt] > b:
             b = init_j1[nxt]                           # skip empty buckets
@@ -151,13 +173,16 @@ def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shi
                 frontier = _grow(frontier, count, u)
                 count += 1
         size[slot] = 0
-        best, last = inf, -1
-        for d in range(9):                             # the least move on equal finishes
-            u = d * M + goal
-            if done[u] and keys[u] + NORM[d] < best:
-                best, last = keys[u] + NORM[d], d
-        if last >= 0:
-            return best, last
+        if found_last < 0:
+            best, last = inf, -1
+            for d in range(9):                         # the least move on equal finishes
+                u = d * M + goal
+                if done[u] and keys[u] + NORM[d] < best:
+                    best, last = keys[u] + NORM[d], d
+            if last >= 0:
+                found_key, found_last = best, last
+                if not complete:
+                    return found_key, found_last
         for f in range(count):
             u = frontier[f]
             p, c = u // M, u % M
@@ -182,4 +207,6 @@ def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shi
                 elif cand == keys[v] and from_static[v] and p < pred[v]:
                     pred[v] = p                         # equal keys: the least previous move
         b += 1
+    if found_last >= 0:
+        return found_key, found_last
     return -1, -1

@@ -8,6 +8,7 @@ expanded as vectorised frontiers.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -15,9 +16,9 @@ import numpy.typing as npt
 
 from ..errors import InputError
 from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                           Cell, SearchResult, check_search_inputs)
+                           Cell, SearchResult, Witness, check_search_inputs)
 
-__all__ = ["search_opt_path"]
+__all__ = ["WitnessLabels", "hold_waits", "search_opt_path"]
 
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
@@ -33,7 +34,8 @@ WAIT = MOVES.index((0, 0))
 _STEP_J1 = np.add.outer(np.abs(np.arange(-1, 2)), np.abs(np.arange(-1, 2))).astype(np.int64)
 
 
-def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell) -> SearchResult:
+def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
+                    with_witness: bool = False) -> SearchResult:
     """The least (J1, J2), lexicographically, over all valid paths of any length (exact), or why none.
 
     Exactness: this is a shortest path over states (step s capped at N, cell, previous move) with
@@ -56,21 +58,78 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell) -> Sea
     the least previous move.)
     Reasons, checked in this order: start blocked in layer 0, goal blocked in the rest layer,
     unreachable.
+
+    ``with_witness``: the result also carries its certificate (``SearchResult.witness``,
+    docs/model.md §11): the exact (J1, J2) label of every state when a path is found, else the
+    set of states reachable from the start. The labels of steps < N are the DAG's; the capped
+    step's Dial search then runs until every reachable state is settled (it stops at the goal
+    otherwise), and a wait at step N gets the label of the state it holds plus |p|_1 (waits
+    are left out of the search, being never better). The path and costs are the same either way.
     """
     N, m, n, start, goal = check_search_inputs(dr, start, goal)
     free = np.asarray(dr) == 0
-    if not free[0, start[0], start[1]]:
-        return SearchResult.no_path(REASON_START_BLOCKED)
-    if not free[N, goal[0], goal[1]]:
-        return SearchResult.no_path(REASON_GOAL_BLOCKED)
+    reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
+              REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
+    if reason is not None and not with_witness:
+        return SearchResult.no_path(reason)
     _check_size(N, m, n)
-    keys, dag_pred = _dag_phase(free, start)
-    found = _static_phase(free[N], keys, goal)
+    labels = WitnessLabels(N, m, n) if with_witness else None
+    if reason == REASON_START_BLOCKED:
+        return replace(SearchResult.no_path(reason), witness=labels.witness(found=False))
+    keys, dag_pred = _dag_phase(free, start, labels)
+    found = _static_phase(free[N], keys, goal, labels)
     if found is None:
-        return SearchResult.no_path(REASON_UNREACHABLE)
-    key, last, static_pred, static_from = found
-    path = _unwind(goal, last, start, static_pred, static_from, dag_pred)
-    return SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+        result = SearchResult.no_path(reason or REASON_UNREACHABLE)
+    else:
+        key, last, static_pred, static_from = found
+        path = _unwind(goal, last, start, static_pred, static_from, dag_pred)
+        result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+    if labels is None:
+        return result
+    return replace(result, witness=labels.witness(found=found is not None))
+
+
+class WitnessLabels:
+    """A search's labels, step by step, as the witness's arrays j1, j2 (N + 1, 9, m, n).
+
+    The type is uint16 when every label of the DAG steps fits (J1 <= 2 s, J2 <= 4 s at step s,
+    so when 4 N + 4 < 65535), else uint32; the capped step's labels widen it when they do not
+    fit. The type's largest value marks a state without a label.
+    """
+
+    def __init__(self, N: int, m: int, n: int) -> None:
+        dtype = np.uint16 if 4 * N + 4 < np.iinfo(np.uint16).max else np.uint32
+        self.j1 = np.full((N + 1, 9, m, n), np.iinfo(dtype).max, dtype=dtype)
+        self.j2 = np.full((N + 1, 9, m, n), np.iinfo(dtype).max, dtype=dtype)
+
+    def put(self, s: int, keys: IntArray, box: tuple[int, int, int, int] | None = None) -> None:
+        """Step s's keys (9, m, n), INF for no label; only rows r0:r1, columns c0:c1 of
+        ``box`` = (r0, r1, c0, c1) when given (no label elsewhere)."""
+        r0, r1, c0, c1 = box or (0, keys.shape[1], 0, keys.shape[2])
+        k = keys[:, r0:r1, c0:c1]
+        reached = k < INF
+        none = np.iinfo(self.j1.dtype).max
+        finite = k[reached]
+        if finite.size and max(int(finite.max() >> SHIFT), int((finite & J2_MASK).max())) >= none:
+            self.j1, self.j2 = self.j1.astype(np.uint32), self.j2.astype(np.uint32)
+            none = np.iinfo(np.uint32).max
+        self.j1[s, :, r0:r1, c0:c1] = np.where(reached, k >> SHIFT, none)
+        self.j2[s, :, r0:r1, c0:c1] = np.where(reached, k & J2_MASK, none)
+
+    def witness(self, *, found: bool) -> Witness:
+        """The labels, or (no path) the set of labelled states: those reachable from the start."""
+        if found:
+            return Witness.of_labels(self.j1, self.j2)
+        return Witness.of_reachable(self.j1 != np.iinfo(self.j1.dtype).max)
+
+
+def hold_waits(keys: IntArray) -> IntArray:
+    """The capped step's keys (9, m, n) with each wait's key lowered to the least key of a
+    state at the same cell plus |p|_1 (a wait at step N after move p costs (0, |p|_1))."""
+    norm = _STEP_J1.reshape(9, 1, 1)
+    via = np.min(np.where(keys < INF, keys + norm, INF), axis=0)
+    keys[WAIT] = np.minimum(keys[WAIT], via)
+    return keys
 
 
 def _check_size(N: int, m: int, n: int) -> None:
@@ -81,21 +140,26 @@ def _check_size(N: int, m: int, n: int) -> None:
         raise InputError("dr", (N + 1, m, n), "is too large for the search's int64 cost keys")
 
 
-def _dag_phase(free: BoolArray, start: Cell) -> tuple[IntArray, list[npt.NDArray[np.int8]]]:
+def _dag_phase(free: BoolArray, start: Cell, labels: WitnessLabels | None = None
+               ) -> tuple[IntArray, list[npt.NDArray[np.int8]]]:
     """Keys of the states at step N (shape (3, 3, m, n), move index (di+1, dj+1)), and per step
-    s = 1..N the previous move (index into MOVES) of each state's optimal predecessor."""
+    s = 1..N the previous move (index into MOVES) of each state's optimal predecessor. The keys
+    of steps 0..N-1 go to ``labels`` when given."""
     N = free.shape[0] - 1
     m, n = free.shape[1:]
     keys = np.full((3, 3, m, n), INF, dtype=np.int64)
     keys[1, 1, start[0], start[1]] = 0  # step 0: at start, "arrived" by the rest move (0, 0)
     preds: list[npt.NDArray[np.int8]] = []
     for s in range(1, N + 1):
+        if labels is not None:
+            labels.put(s - 1, keys.reshape(9, m, n))
         keys, pred = _step(keys, np.where(free[s], np.int64(0), INF))
         preds.append(pred)
     return keys, preds
 
 
-def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
+def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell,
+                  labels: WitnessLabels | None = None
                   ) -> tuple[int, int, npt.NDArray[np.int8], BoolArray] | None:
     """Dial's algorithm over the states (cell, previous move) at the capped step N.
 
@@ -103,7 +167,9 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
     state's predecessor is itself at step N) or None when the goal is unreachable. Buckets hold
     J1. Waits are left out: at steps >= N a wait after move p then a move d costs |p| + |d| in J2,
     never less than turning at once, |d - p|; every other move costs J1 >= 1, so a bucket's
-    states are final once the buckets before it are expanded.
+    states are final once the buckets before it are expanded. With ``labels`` it goes on past
+    the goal until every reachable state is settled (settled states keep their key and
+    predecessor, so the answer is the same) and gives the final keys, waits held, to step N.
     """
     m, n = free_rest.shape
     M = m * n
@@ -120,6 +186,7 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
     buckets: dict[int, list[IntArray]] = {}
     _push(buckets, np.flatnonzero(keys < INF), keys)
     b = 0
+    answer = None
     while buckets:
         chunk = buckets.pop(b, None)
         b += 1
@@ -131,11 +198,13 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
         if u.size == 0:
             continue
         done[u] = True
-        if done[goal_states].any():
+        if answer is None and done[goal_states].any():
             # Stopping after move d adds |d|_1 to J2 (the low bits of the key).
             finish = np.where(done[goal_states], keys[goal_states] + norm, INF)
             last = int(np.argmin(finish))  # smallest move on ties
-            return int(finish[last]), last, pred, from_static
+            answer = int(finish[last]), last, pred, from_static
+            if labels is None:
+                return answer
         # Expand every move but the wait from the settled frontier.
         cells = u % M
         prev = u // M
@@ -151,7 +220,10 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell
         improved = _improve(keys, pred, from_static, done, np.concatenate(cand_u),
                             np.concatenate(cand_k), np.concatenate(cand_p))
         _push(buckets, improved, keys)
-    return None
+    if labels is not None:
+        N = labels.j1.shape[0] - 1
+        labels.put(N, hold_waits(keys.reshape(9, m, n)))
+    return answer
 
 
 def _improve(keys: IntArray, pred: npt.NDArray[np.int8], from_static: BoolArray,

@@ -13,7 +13,8 @@ from typing import TextIO
 
 from ..errors import InputError
 from ._ledger import ASSUMPTIONS, Assumption
-from ._obl_scenario import scenario_files
+from ._obl_scenario import CHECKS as SCENARIO_CHECKS
+from ._obl_scenario import scenario_check_id, scenario_files, scenario_obligations
 from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proof, VCResult,
                           Verdict, Z3Query, discharge)
 from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
@@ -22,6 +23,7 @@ from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_I
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
+    "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
     "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "discharge",
     "expected_ids",
@@ -31,7 +33,8 @@ __all__ = [
 
 
 def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path | None = None,
-              only: Iterable[str] | None = None, stream: TextIO | None = None) -> int:
+              only: Iterable[str] | None = None, stream: TextIO | None = None,
+              repin: bool = False) -> int:
     """Discharge the obligations (all, or those ``only`` selects), print the summary, write
     ``out_dir/results.json``; 0 iff every verdict is the pinned one and no id is missing, extra
     or repeated, 1 otherwise. Raises InputError (exit 2) for a ``--scenarios`` that is not a
@@ -52,7 +55,7 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
     obligations = collect_obligations(sdir, picks)
     expected = [i for i in every if selected(i, picks)]
     run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir),
-                          record=run_record(sdir))
+                          record=run_record(sdir), repin=repin)
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
 

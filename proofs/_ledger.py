@@ -34,39 +34,65 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "Every (layer, cell) a found path occupies is re-decided in arb ball arithmetic "
         "(plan.json's exact_gaps), and the containment of the variants' regions is decided "
         "exactly on the computed doubles, so neither rests on rounding.",
-        "Sep.distance_monotone, Scenario.*.containment"),
+        "Sep.distance_monotone, Scenario.*.containment, Safety.* (A11)"),
     Assumption(
         "A3.trigonometry",
-        "sin and cos enter Z3 as real unknowns with: c^2 + s^2 = 1; cos x >= 1 - x^2/2 for "
-        "every real x; cos even and non-increasing on [0, pi]; sin >= 0 on [0, pi]; cos >= 0 on "
-        "[0, pi/2]; rigid motions preserve distances and segments.",
+        "sin and cos enter Z3 as real unknowns (in Safety.*, the uninterpreted functions Cos, "
+        "Sin) with: c^2 + s^2 = 1; cos and sin of a sum and of a difference (cos(x + y) = cos x "
+        "cos y - sin x sin y, sin(x + y) = sin x cos y + cos x sin y, and for x - y); cos x >= "
+        "1 - x^2/2 for every real x; cos even and non-increasing on [0, pi]; sin >= 0 on [0, pi]; "
+        "cos >= 0 on [0, pi/2] (each used at named points, with 3.14 < pi). That rigid motions "
+        "preserve distances and chord points is not assumed: Safety.region_soundness proves it "
+        "from the sum and difference rules, Lemma.sweep_margin from C^2 + S^2 = 1 (its "
+        "rotation and frame VCs).",
         "Textbook facts; the second is reduced by Margin.cos_bound (sympy) to the mean value "
         "theorem, which is assumed.",
-        "Margin.arc_chord, Margin.cos_bound, Lemma.sweep_margin"),
+        "Margin.arc_chord, Margin.cos_bound, Lemma.sweep_margin, Safety.region_soundness"),
     Assumption(
         "A4.solvers",
         "Z3 (its unsat answers, without proof certificates) and sympy (simplify, solve) are "
         "sound; Python's Fraction arithmetic is exact.",
         "Widely used, heavily tested tools; every Z3 proof also passes a vacuity check, and "
-        "negative tests show each encoding fails when a premise is removed. The SMT-LIB of "
-        "every query is saved with its hash and is replayable in Z3 (the tests replay it); it "
-        "uses Z3's extensions (lambda terms, arrays indexed by several sorts) and sets no logic, "
-        "so another solver may reject it. sympy and data checks run under a wall-clock limit.",
+        "negative tests show each encoding fails when a premise is removed. Every VC is also "
+        "written in standard SMT-LIB 2.6 (a logic set, lambdas beta-reduced, arrays curried; "
+        "the text whose hash proofs/obligations.lock pins) and replayed in cvc5: results.json "
+        "says per VC which solvers confirm it (Z3, cvc5, or an exact sympy SOS certificate), "
+        "and a cvc5 answer contradicting Z3's fails the run; the VCs only Z3 confirms are "
+        "listed with cvc5's reason (mostly nonlinear arithmetic and quantified models). sympy "
+        "and data checks run under a wall-clock limit.",
         "every Z3 and sympy obligation"),
     Assumption(
         "A5.while_model",
-        "The while-language programs (BuiltDR's loop nest; searchoptpath's top level) match "
-        "cfmpa.impl's Python code.",
-        "The programs are transcribed loop for loop from the code; the run-time contracts "
-        "(docs/model.md §7) check the Python code against the same triples on real scenarios.",
+        "The while-language programs (BuiltDR's loop nest; searchoptpath's top level) are "
+        "faithful models of cfmpa.impl's Python code. They are models, not transcriptions: "
+        "impl.build_dr has one loop over the layers, vectorised over the cells (numpy), and "
+        "impl.build_dr_fast is compiled; impl.search_opt_path has no loop at its top level (two "
+        "early exits, then the search).",
+        "BuiltDR's program is extracted from the syntax tree of its loop form "
+        "(cfmpa.impl.builtdr_loop_nest, Algorithm 1 as written; proofs/_extract.py), with its "
+        "invariants generated, so the assumption there is that Python runs that subset (counted "
+        "range loops, if/else, stores) as the while-language means it; the loop form's agreement "
+        "with build_dr and build_dr_fast is checked on data (bit for bit, in the tests), not "
+        "proved. searchoptpath's top level is written by hand: the two early exits (start "
+        "blocked in layer 0, goal blocked in the rest layer) and the call, the search by its "
+        "contract (A6); the model has no loop to match. The "
+        "run-time contracts (docs/model.md §7) check the Python code against the same triples "
+        "on real scenarios.",
         "Thm1.*, Thm3.*, Thm2.searchoptpath, Thm4.searchoptpath, Prop8.prestrength_thm4"),
     Assumption(
         "A6.search_contract",
         "The search that searchoptpath calls returns null iff no valid path exists, and "
-        "otherwise a valid path of least (J1, J2) (Definition 5).",
-        "Checked at run time in contract mode 'full' against an independent search (docs/model.md §7) "
-        "and by the spec's own Dijkstra oracle in the tests.",
-        "Thm2.searchoptpath, Thm4.searchoptpath, Prop8.prestrength_thm4"),
+        "otherwise a valid path of least (J1, J2) (Definition 5). Assumed only for runs that "
+        "do not check it: in contract mode 'full' and in `cfmpa check` the answer comes with a "
+        "witness that spec.check_witness verifies (docs/model.md §11), and the run records "
+        "that the checker ran and held (post.optimal); its acceptance implies the contract "
+        "(Witness.labels_sound, Witness.reachable_sound), so there it is not assumed.",
+        "The searches return their exact labels (or reachable sets) as witnesses; the tests "
+        "check that these pass the checker and agree with the spec's opt_path on random D_R, "
+        "and that corrupted witnesses are rejected. What such runs still trust is the "
+        "checker's code (small, numpy, sharing nothing with impl/).",
+        "Thm2.searchoptpath, Thm4.searchoptpath, Prop8.prestrength_thm4 (runs in sampled or "
+        "off mode)"),
     Assumption(
         "A7.choice_and_wellfoundedness",
         "optpath is Hilbert's choice (as in the paper's HOL4 model), and (J1, J2) are natural "
@@ -99,6 +125,29 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "R a (chord <= arc), so a configuration in the uncovered sliver is within SNAP g R of "
         "one that the lemma's delta already covers; the triangle inequality adds the two. "
         "That sweep_margin adds at least this much is checked per scenario; the chord <= arc "
-        "bound itself is assumed (as A3's facts).",
+        "bound itself is assumed (as A3's facts). Safety.region_soundness assumes neither: it "
+        "derives the bound from A3's cos x >= 1 - x^2/2 and reads sweep_margin's own formula.",
         "Scenario.*.margin_side, Lemma.sweep_margin, Scenario.*.containment"),
+    Assumption(
+        "A11.safety_scope",
+        "The end-to-end theorem (Safety.*) assumes only A2, A3 and A4: that the polygons and "
+        "distances impl computes in doubles are the construction Safety.region_soundness "
+        "proves sound, up to rounding (lattice indices by impl.lattice_range's formula, "
+        "rectangles grown by impl.sweep_margin, their hull by impl.convex_hull, the "
+        "subordinate's regions built at t_i = 0 and turned by t_i, reach by hypot, a cell free "
+        "iff the distance exceeds eps); A3's trigonometric facts; the solvers. It is a theorem "
+        "about A1's model (the links are docs/model.md §2's rectangles). Its premises "
+        "are not assumed but stated: D_R meets Theorem 1/3's postcondition (proved of "
+        "BuiltDR's program, Thm1/Thm3.builtdr, under A5; checked on the cells at run time) and "
+        "the path is valid under the fixed is_path (checked on every found path).",
+        "Everything else in it is proved: the box rules contain the PTP motion and the "
+        "subordinate's moves, the margin is derived from Margin.arc_chord (re-proved there) and "
+        "compared with sweep_margin's formula, read from the code by running it on Z3 terms and "
+        "checked against its floats on samples; the lattice model is checked against "
+        "lattice_range on samples. Lemmas enter by substitution into proved VCs; "
+        "Safety.region_soundness enters the compositions as its statement at the points used, "
+        "the predicates linkL, linkR and mem naming what it is about (a point of a link of "
+        "§2 at a configuration, of the polygon built for a box); norm chains are proved for "
+        "every function standing for |v|^2, so for |v|^2.",
+        "Safety.*"),
 )

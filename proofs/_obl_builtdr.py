@@ -1,8 +1,10 @@
 """Theorem 1 and Theorem 3: BuiltDR's loop nest in the while-language, proved by WP and Z3.
 
-The program mirrors ``cfmpa.impl.build_dr``: compute the left region of every layer, the right
-region of every cell, then P[k, i, j] = (Inter(SL[k], SR[i, j]) -> 1 | 0) for every cell of
-every layer, then the rest layer. Regions are values of an uninterpreted sort and the
+The program is not written here: it is extracted (``proofs/_extract.py``) from the syntax tree of
+``cfmpa.impl.builtdr_loop_nest``, BuiltDR in the paper's loop form: the left region of every
+layer, the right region of every cell, then P[k, i, j] = (Inter(SL[k], SR[i, j]) -> 1 | 0) for
+every cell of every layer, then the rest layer; its loop invariants are generated from it. Only
+the pre- and postcondition are written here. Regions are values of an uninterpreted sort and the
 intersection test an uninterpreted predicate, so the proof holds for any region function: the
 original and the modified algorithm differ only in which one (``regionL_original`` vs
 ``regionL_modified``), and ``tight`` also in its rest layer (the principal at rest at its goal).
@@ -10,17 +12,61 @@ original and the modified algorithm differ only in which one (``regionL_original
 
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass
 
 import z3
 
+from ..impl import builtdr_loop_nest
 from ..spec.z3defs import REGION, Z3Dims, blocked_exact, inter
+from ._extract import extract
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
-from ._while import Cmd, For, If, Seq, Store, verification_conditions
+from ._while import Cmd, verification_conditions
 
-__all__ = ["BuiltDRModel", "builtdr_model", "builtdr_obligations"]
+__all__ = ["PLANTED_BUGS", "BuiltDRModel", "builtdr_model", "builtdr_obligations",
+           "builtdr_source"]
 
 GROUP = "BuiltDR (Theorems 1, 3)"
+
+#: Known defects planted in the loop form's source text, for the negative tests: name ->
+#: (the variants it applies to, the (old, new) edits of the source).
+PLANTED_BUGS: dict[str, tuple[tuple[str, ...], tuple[tuple[str, str], ...]]] = {
+    # j runs to n - 1 in the motion layers.
+    "inner_bound": (("original", "modified", "tight"), (
+        ("for j in range(0, n):\n                if inter(SL[k]",
+         "for j in range(0, n - 1):\n                if inter(SL[k]"),)),
+    # A blocked motion cell is stored as free.
+    "store_value": (("original", "tight"), (("P[k, i, j] = 1", "P[k, i, j] = 0"),)),
+    # The rest layer reads layer 0's region instead of layer N - 1's.
+    "rest_layer": (("original", "modified"), (("else SL[N - 1]", "else SL[0]"),)),
+    # The tight rest layer built from layer N - 1 (the paper's) instead of the principal at rest.
+    "tight_rest": (("tight",), (('region_rest() if variant == "tight" else SL[N - 1]',
+                                 "SL[N - 1]"),)),
+    # The rest layer's rows stop at m - 1.
+    "rest_rows": (("original",), (
+        ("for i in range(0, m):\n        for j in range(0, n):\n"
+         "            if inter(region_rest()",
+         "for i in range(0, m - 1):\n        for j in range(0, n):\n"
+         "            if inter(region_rest()"),)),
+    # The motion layers start at 1.
+    "layer_from_1": (("original",), (
+        ("for k in range(0, N):\n        for i", "for k in range(1, N):\n        for i"),)),
+}
+
+#: A defect of the proof rather than of the program: C.j's invariant forgets the finished layers.
+WEAK_INVARIANT = "weak_invariant"
+
+
+def builtdr_source(bug: str | None = None) -> str:
+    """The loop form's source text, with ``bug``'s edits applied (each must match)."""
+    text = inspect.getsource(builtdr_loop_nest)
+    if bug is None or bug == WEAK_INVARIANT:
+        return text
+    for old, new in PLANTED_BUGS[bug][1]:
+        if old not in text:
+            raise ValueError(f"planted bug {bug}: {old!r} is not in the loop form")
+        text = text.replace(old, new)
+    return text
 
 
 @dataclass(frozen=True)
@@ -34,18 +80,16 @@ class BuiltDRModel:
     P: z3.ArrayRef
 
 
-def builtdr_model(variant: str, *, bug: str | None = None) -> BuiltDRModel:
-    """BuiltDR for ``variant`` (original, modified, tight). ``bug`` plants a known defect for
-    the negative tests: ``inner_bound`` (j runs to n - 1), ``store_value`` (always stores 0),
-    ``weak_invariant`` (the inner invariant forgets the finished layers), ``rest_layer``
-    (the rest layer reads layer 0)."""
+def builtdr_model(variant: str, *, bug: str | None = None, source: str | None = None
+                  ) -> BuiltDRModel:
+    """BuiltDR for ``variant`` (original, modified, tight), extracted from the loop form (or
+    from ``source``, a function's text). ``bug`` plants a known defect: a key of
+    ``PLANTED_BUGS`` (an edit of the source) or ``weak_invariant`` (C.j's generated invariant
+    forgets the finished layers)."""
     d = Z3Dims.named()
-    N, m, n = d.N, d.m, d.n
+    N = d.N
     ints = z3.IntSort()
-    k, i, j = z3.Ints("k i j")
     P = z3.Array("P", ints, ints, ints, ints)
-    SL = z3.Array("SL", ints, REGION)
-    SR = z3.Array("SR", ints, ints, REGION)
     regionL = z3.Function(f"regionL_{variant}", ints, REGION)
     regionR = z3.Function("regionR", ints, ints, REGION)
     if variant == "tight":
@@ -60,79 +104,29 @@ def builtdr_model(variant: str, *, bug: str | None = None) -> BuiltDRModel:
     def spec_rest(_: z3.ArithRef, ii: z3.ArithRef, jj: z3.ArithRef) -> z3.BoolRef:
         return inter(rest_region, regionR(ii, jj))
 
-    q1, q2, q3 = z3.Ints("q1 q2 q3")
-
-    def sl_done(upto: z3.ArithRef) -> z3.BoolRef:
-        return z3.ForAll([q1], z3.Implies(z3.And(0 <= q1, q1 < upto), SL[q1] == regionL(q1)))
-
-    def sr_done(rows: z3.ArithRef, cols: z3.ArithRef | None = None,
-                row: z3.ArithRef | None = None) -> z3.BoolRef:
-        full = z3.ForAll([q1, q2], z3.Implies(z3.And(0 <= q1, q1 < rows, 0 <= q2, q2 < n),
-                                              SR[q1, q2] == regionR(q1, q2)))
-        if cols is None:
-            return full
-        part = z3.ForAll([q2], z3.Implies(z3.And(0 <= q2, q2 < cols),
-                                          SR[row, q2] == regionR(row, q2)))
-        return z3.And(full, part)
-
-    def layers_done(upto: z3.ArithRef) -> z3.BoolRef:
-        return z3.ForAll([q1, q2, q3], z3.Implies(
-            z3.And(0 <= q1, q1 < upto, 0 <= q2, q2 < m, 0 <= q3, q3 < n),
-            P[q1, q2, q3] == z3.If(spec_motion(q1, q2, q3), 1, 0)))
-
-    def rows_done(layer: z3.ArithRef, rows: z3.ArithRef, spec: object) -> z3.BoolRef:
-        return z3.ForAll([q2, q3], z3.Implies(z3.And(0 <= q2, q2 < rows, 0 <= q3, q3 < n),
-                                              P[layer, q2, q3] == z3.If(spec(layer, q2, q3), 1, 0)))
-
-    def cols_done(layer: z3.ArithRef, row: z3.ArithRef, cols: z3.ArithRef,
-                  spec: object) -> z3.BoolRef:
-        return z3.ForAll([q3], z3.Implies(z3.And(0 <= q3, q3 < cols),
-                                          P[layer, row, q3] == z3.If(spec(layer, row, q3), 1, 0)))
-
     sizes = d.sane()
-    ctx = z3.And(sizes, sl_done(N), sr_done(m))
-    j_hi = n - 1 if bug == "inner_bound" else n
-    one = z3.IntVal(0) if bug == "store_value" else z3.IntVal(1)
-    rest_read = regionL(0) if (bug == "rest_layer" and variant != "tight") else None
-
-    def mark(layer: z3.ArithRef, region: z3.ExprRef) -> Cmd:
-        return If(inter(region, SR[i, j]), Store(P, (layer, i, j), one),
-                  Store(P, (layer, i, j), z3.IntVal(0)))
-
-    inner_layers = z3.BoolVal(True) if bug == "weak_invariant" else layers_done(k)
-    program = Seq((
-        # Phase A: the principal's region at every layer.
-        For("A.k", k, z3.IntVal(0), N, z3.And(sizes, sl_done(k)),
-            Store(SL, (k,), regionL(k))),
-        # Phase B: the subordinate's region at every cell.
-        For("B.i", i, z3.IntVal(0), m, z3.And(sizes, sl_done(N), sr_done(i)),
-            For("B.j", j, z3.IntVal(0), n,
-                z3.And(sizes, 0 <= i, i < m, sl_done(N), sr_done(i, j, i)),
-                Store(SR, (i, j), regionR(i, j)))),
-        # Phase C: the motion layers.
-        For("C.k", k, z3.IntVal(0), N, z3.And(ctx, layers_done(k)),
-            For("C.i", i, z3.IntVal(0), m,
-                z3.And(ctx, 0 <= k, k < N, layers_done(k), rows_done(k, i, spec_motion)),
-                For("C.j", j, z3.IntVal(0), j_hi,
-                    z3.And(ctx, 0 <= k, k < N, 0 <= i, i < m, inner_layers,
-                           rows_done(k, i, spec_motion), cols_done(k, i, j, spec_motion)),
-                    mark(k, SL[k])))),
-        # Phase D: the rest layer R = P[N].
-        For("D.i", i, z3.IntVal(0), m, z3.And(ctx, layers_done(N), rows_done(N, i, spec_rest)),
-            For("D.j", j, z3.IntVal(0), n,
-                z3.And(ctx, 0 <= i, i < m, layers_done(N), rows_done(N, i, spec_rest),
-                       cols_done(N, i, j, spec_rest)),
-                mark(N, rest_read if rest_read is not None
-                     else (rest_region if variant == "tight" else SL[N - 1])))),
-    ))
+    text = source if source is not None else builtdr_source(bug)
+    forget = {"C.j"} if bug == WEAK_INVARIANT else set()
+    program = extract(variant=variant, pre=sizes, dims=d, source=text, forget=forget).program
     post = blocked_exact(P, d, motion=spec_motion, rest=spec_rest)
     return BuiltDRModel(program, sizes, post, d, P)
 
 
-def _query(variant: str, kind: str, bug: str | None = None) -> Z3Query:
-    model = builtdr_model(variant, bug=bug)
-    return Z3Query(verification_conditions(f"BuiltDR.{variant}", model.pre, model.program,
-                                           model.post, termination=kind == "termination"))
+def _query(variant: str, kind: str, bug: str | None = None, *, source: str | None = None
+           ) -> Z3Query:
+    model = builtdr_model(variant, bug=bug, source=source)
+    from ._while import smoke_tests
+
+    vcs = verification_conditions(f"BuiltDR.{variant}", model.pre, model.program,
+                                  model.post, termination=kind == "termination")
+    # The smoke tests go with the correctness proof (the termination proof's program is the
+    # same, with the counters' bounds as its only invariants); small sizes pinned, where Z3
+    # finds the models at once.
+    d = model.dims
+    small = tuple((x, z3.IntVal(2)) for x in (d.N, d.m, d.n))
+    smoke = (() if kind == "termination"
+             else smoke_tests(f"BuiltDR.{variant}", model.pre, model.program, witness=small))
+    return Z3Query(vcs, smoke=smoke)
 
 
 def _box_nesting() -> Z3Query:
@@ -169,8 +163,8 @@ def builtdr_obligations() -> list[Obligation]:
     termination of BuiltDR."""
     P = Verdict.PROVED
     Z = Method.Z3
-    term = ("BuiltDR terminates (for any N, m, n): each of its 7 loops has the variant "
-            "hi - counter, >= 0 while the loop runs (from the guard) and lowered by every "
+    term = ("BuiltDR terminates (for any N, m, n): each of its 8 loops (A.k .. D.j) has the "
+            "variant hi - counter, >= 0 while the loop runs (from the guard) and lowered by every "
             "iteration, the invariant lo <= counter <= hi being inductive (VCs by WP). The "
             "termination is syntactic: every loop is a For loop whose body cannot change its "
             "counter or bounds (checked when the program is built), so the counter is bounded "
@@ -185,7 +179,9 @@ def builtdr_obligations() -> list[Obligation]:
         statement = (f"{{N >= 1, m, n >= 1}} BuiltDR ({variant}) {{for all k < N, i < m, j < n: "
                      f"P[k,i,j] = (SLarm_k ∩ SRarm_ij = Φ -> 0 | 1) with SLarm_k = "
                      f"regionL_{variant}(k), and the rest layer P[N,i,j] likewise with {rest}}}: "
-                     "WP of the loop nest with invariants; Inter uninterpreted. Thm1.builtdr, "
+                     "WP of the while program extracted from the loop form "
+                     "(cfmpa.impl.builtdr_loop_nest, Algorithm 1 as written), with loop "
+                     "invariants generated from it; Inter uninterpreted. Thm1.builtdr, "
                      "Thm3.builtdr and Thm3.builtdr_tight are the same proof over a different "
                      "opaque region function; what distinguishes the variants is the box "
                      "nesting (Thm3.box_nesting) and the per-scenario containment check "
@@ -193,7 +189,7 @@ def builtdr_obligations() -> list[Obligation]:
         out.append(Obligation(f"{ident}.builtdr{suffix}", GROUP, ref, statement, Z, P,
                               lambda v=variant: _query(v, "correctness")))
         out.append(Obligation(f"{ident}.termination{suffix}", GROUP, ref, term, Z, P,
-                              lambda v=variant: _query(v, "termination")))
+                              lambda v=variant: _query(v, "termination"), label="syntactic"))
     out.append(Obligation(
         "Thm3.box_nesting", GROUP, "Section IV.A (modified box), docs/model.md §4 (tight box)",
         "Per joint, for symbolic start, goal, omega > 0, dt > 0, layer k >= 0 and Tf with "

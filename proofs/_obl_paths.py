@@ -18,14 +18,17 @@ from ..spec.z3defs import (REGION, Blocked, Z3Dims, Z3PathVar, blocked_exact, bo
                             costs, free_sound, in_grid, inter, inter_definition, is_optimal,
                             is_path_fixed, is_path_paper, layer_value, lex_le, member, position,
                             z3_path)
-from ._obligation import VC, Method, Obligation, Verdict, Z3Query
-from ._while import Assign, Assume, Havoc, If, Seq, verification_conditions
+from ._obligation import VC, Method, Obligation, Smoke, Verdict, Z3Query
+from ._while import Assign, Assume, Havoc, If, Seq, smoke_tests, verification_conditions
 
 __all__ = ["path_obligations", "prop8_obligations", "search_top_level"]
 
 GROUP_PROPS = "Paths (Props 1-7, Def 4)"
 GROUP_THM = "searchoptpath (Theorems 2, 4)"
 GROUP_P8 = "Property 8 (corrected chain)"
+
+#: The label of the obligations about searchoptpath's top level: its inner search is assumed.
+SEARCH_ASSUMED = "wrapper proved, search assumed"
 
 Cell = tuple[z3.ArithRef, z3.ArithRef]
 
@@ -382,6 +385,12 @@ def _search_post(st: _Setting, found: z3.BoolRef, R: Z3PathVar, no_path: z3.Bool
 
 
 def _search_vcs(variant: str, *, conservative: bool, printed: bool) -> tuple[VC, ...]:
+    return _search(variant, conservative=conservative, printed=printed)[0]
+
+
+def _search(variant: str, *, conservative: bool, printed: bool
+            ) -> tuple[tuple[VC, ...], tuple[Smoke, ...]]:
+    """The VCs of {pre} searchoptpath {post}, and the smoke tests of the program."""
     st = _setting()
     found = z3.Bool("found")
     R = z3_path("R")
@@ -393,11 +402,27 @@ def _search_vcs(variant: str, *, conservative: bool, printed: bool) -> tuple[VC,
         pre_p = blocked_exact(st.P, st.d, motion=motion, rest=rest)
     pre = z3.And(st.d.sane(), in_grid(st.d, st.start), in_grid(st.d, st.goal), pre_p)
     post = _search_post(st, found, R, no_path, variant, printed)
-    return verification_conditions(f"searchoptpath.{variant}", pre, program, post)
+    name = f"searchoptpath.{variant}"
+    small = ((st.d.N, z3.IntVal(1)), (st.d.m, z3.IntVal(1)), (st.d.n, z3.IntVal(2)))
+    return (verification_conditions(name, pre, program, post),
+            smoke_tests(name, pre, program, witness=small, lemmas=(("no valid path", no_path),),
+                        lemma_witness=_no_path_witness(st)))
+
+
+def _no_path_witness(st: _Setting) -> tuple[tuple[z3.ExprRef, z3.ExprRef], ...]:
+    """A D_R in which the search must report no path (for the smoke test of its contract's
+    'not found' case): one cell, start = goal, N = 3, free at steps 0 and 2 and in the rest
+    layer (layer N-1's copy), blocked at step 1, where every list is at that cell."""
+    k, i, j = z3.Ints("nw!k nw!i nw!j")
+    zero, three = z3.IntVal(0), z3.IntVal(3)
+    return ((st.d.N, three), (st.d.m, z3.IntVal(1)), (st.d.n, z3.IntVal(1)),
+            (st.start[0], zero), (st.start[1], zero), (st.goal[0], zero), (st.goal[1], zero),
+            (st.P, z3.Lambda([k, i, j], z3.If(k == 1, z3.IntVal(1), zero))))
 
 
 def _thm(variant: str) -> Z3Query:
-    return Z3Query(_search_vcs(variant, conservative=False, printed=True))
+    vcs, smoke = _search(variant, conservative=False, printed=True)
+    return Z3Query(vcs, smoke=smoke)
 
 
 def theorem_obligations() -> list[Obligation]:
@@ -406,21 +431,26 @@ def theorem_obligations() -> list[Obligation]:
             "searchoptpath {{no path reported iff no valid path; else the result is an optimal "
             "valid path, collision-free at every step k >= 0 (no common point of SLarm and "
             "SRarm at the cell held), and the paper's postcondition: P[k] = 0 along it for k < N, "
-            "P[N-1] = 0 for N <= k < LENGTH}}: WP of the top level, the search by its contract.")
+            "P[N-1] = 0 for N <= k < LENGTH}}: WP of the top level, the search by its contract. "
+            "Only the wrapper is proved: the search itself is assumed to meet its contract "
+            "(ledger A6) until it is certified.")
     tight = ("{P = Thm3.builtdr_tight's postcondition (tight regions regionL_tight(k) for k < N; "
              "the rest layer P[N] from regionRest_tight, the principal at rest at its goal, an "
              "opaque region independent of layer N-1)} searchoptpath {no path reported iff no "
              "valid path; else the result is an optimal valid path, collision-free at every "
              "step k >= 0 against regionL_tight(k) for k < N and regionRest_tight from N on, "
              "with P[k] = 0 along it for k < N and P[N] = 0 for every k >= N}: WP of the top "
-             "level, the search by its contract. The tight variant's search safety.")
+             "level, the search by its contract. The tight variant's search safety. Only the "
+             "wrapper is proved: the search itself is assumed to meet its contract (ledger A6).")
     return [
         Obligation("Thm2.searchoptpath", GROUP_THM, "Theorem 2",
-                   text.format(n=1, v="original"), Z, P, lambda: _thm("original")),
+                   text.format(n=1, v="original"), Z, P, lambda: _thm("original"),
+                   label=SEARCH_ASSUMED),
         Obligation("Thm4.searchoptpath", GROUP_THM, "Theorem 4",
-                   text.format(n=3, v="modified"), Z, P, lambda: _thm("modified")),
+                   text.format(n=3, v="modified"), Z, P, lambda: _thm("modified"),
+                   label=SEARCH_ASSUMED),
         Obligation("Thm4.searchoptpath_tight", GROUP_THM, "Theorem 4, tight variant (docs/model.md §4)",
-                   tight, Z, P, lambda: _thm("tight")),
+                   tight, Z, P, lambda: _thm("tight"), label=SEARCH_ASSUMED),
     ]
 
 
@@ -543,7 +573,7 @@ def _all_blocked() -> z3.ExprRef:
 def _prestrength() -> Z3Query:
     """Theorem 4 from Theorem 2 by precondition strengthening, with the right premise."""
     st = _setting()
-    generic = _search_vcs("X", conservative=True, printed=False)
+    generic, generic_smoke = _search("X", conservative=True, printed=False)
     main_x = generic[0]
     m_m, r_m, _ = _regions("modified")
     exact = blocked_exact(st.P, st.d, motion=m_m, rest=r_m)
@@ -559,7 +589,7 @@ def _prestrength() -> Z3Query:
                        ("strengthen: pre4 ⇒ weak", z3.Implies(pre4, weak)),
                        ("Theorem 2 (generic) at X := S': weak ⇒ wp", z3.Implies(weak, wp))),
               wp, key_premise="strengthen: pre4 ⇒ weak")
-    return Z3Query((strengthen, main_x, *generic[1:], rule))
+    return Z3Query((strengthen, main_x, *generic[1:], rule), smoke=generic_smoke)
 
 
 def prop8_obligations() -> list[Obligation]:
@@ -597,5 +627,5 @@ def prop8_obligations() -> list[Obligation]:
                    "4's precondition implies that precondition at X := S'; by the rule "
                    "(P' ⇒ P, {P} C {Q} give {P'} C {Q}) Theorem 4's safety follows. (The paper "
                    "derives it from Property 8, which runs the other way and is not valid.)",
-                   Z, P, _prestrength),
+                   Z, P, _prestrength, label=SEARCH_ASSUMED),
     ]

@@ -10,22 +10,21 @@ found and unique.
 The two readings of a number in the file. *Binary*: the IEEE double the code computes with,
 as the exact rational it is (``Fraction(float)``), e.g. dt = 0.02 is
 0.0200000000000000004163...; this is the reading the planner's safety rests on. *Decimal*: the
-number as written, e.g. dt = 1/50. The decimal text is recovered by re-reading the TOML with
-tomllib and taking ``repr`` of each float, the shortest decimal that rounds to the same double:
-it equals the text as written whenever that text has at most 17 significant digits and no
-superfluous ones (0.020 reads as 0.02, the same number).
+number as written, e.g. dt = 1/50. The decimal reading comes from the double itself,
+``Fraction(repr(x))``, the shortest decimal that rounds to the same double: it equals the text
+as written whenever that text has at most 17 significant digits and no superfluous ones (0.020
+reads as 0.02, the same number). Both readings are the spec's own (``Grid.READINGS``,
+``Grid.time_readings``, ``Grid.spacing_readings``, spec/_counts.py), the ones the loader builds
+the grid with and the contracts check.
 """
 
 from __future__ import annotations
 
-import tomllib
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from fractions import Fraction
-from math import ceil
 from pathlib import Path
 
-from ..spec import Scenario, load_scenario, make_grid
+from ..spec import Grid, Scenario, decimal, load_scenario, make_grid
 from ._obligation import CheckOutcome, CheckQuery, Method, Obligation, Verdict, check_source
 
 __all__ = ["CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations"]
@@ -47,81 +46,48 @@ def scenario_check_id(stem: str, check: str) -> str:
     return f"Scenario.{stem}.{check}"
 
 
-@dataclass(frozen=True)
-class _Decimal:
-    """The numbers the checks need, in the decimal reading (the text of the file)."""
-
-    dt: Fraction
-    start: tuple[Fraction, Fraction]
-    goal: tuple[Fraction, Fraction]
-    omega_l: tuple[Fraction, Fraction]
-    omega_r: tuple[Fraction, Fraction]
-    limits: tuple[tuple[Fraction, Fraction], tuple[Fraction, Fraction]]
-
-
-def _dec(x: float) -> Fraction:
-    return Fraction(repr(float(x)))
-
-
-def _decimal(path: Path) -> _Decimal:
-    with path.open("rb") as fh:
-        doc = tomllib.load(fh)
-    left, right = doc["left"], doc["right"]
-    pair = lambda v: (_dec(v[0]), _dec(v[1]))  # noqa: E731
-    return _Decimal(dt=_dec(doc["dt"]), start=pair(left["start"]), goal=pair(left["goal"]),
-                    omega_l=pair(left["omega"]), omega_r=pair(right["omega"]),
-                    limits=(pair(right["limits"][0]), pair(right["limits"][1])))
-
-
 def _fmt(x: Fraction) -> str:
     return f"{float(x):.17g}" if x.denominator > 10**6 else str(x)
 
 
-def _time_grid(s: Scenario, d: _Decimal) -> CheckOutcome:
+def _time_grid(s: Scenario) -> CheckOutcome:
     g = make_grid(s)
-    L = s.left
-    # Binary: Tf from the doubles as exact rationals, independently of the grid code.
-    tf = max(abs(Fraction(L.goal[q]) - Fraction(L.start[q])) / Fraction(L.omega[q])
-             for q in range(2))
-    dt = Fraction(s.dt)
-    covers = g.N * dt >= tf
-    least = g.N == 1 or (g.N - 1) * dt < tf
-    # Decimal: the same motion as written; the code's N must cover it too.
-    tf_d = max(abs(d.goal[q] - d.start[q]) / d.omega_l[q] for q in range(2))
-    n_d = max(1, ceil(tf_d / d.dt))
-    covers_d = g.N * d.dt >= tf_d
-    boundary = " (exactly on the boundary: N dt = Tf)" if n_d * d.dt == tf_d else ""
-    detail = (f"binary (the doubles): N = {g.N}, dt = {_fmt(dt)}, N dt = {_fmt(g.N * dt)} >= "
-              f"Tf = {_fmt(tf)}: {covers}; N is the least such: {least}. decimal (as written): "
-              f"dt = {d.dt}, Tf = {tf_d}, least N = {n_d}{boundary}; the code's N = {g.N} "
-              f"covers it (N dt >= Tf): {covers_d}")
-    ok = covers and least and covers_d
+    parts, covers_all, least_somewhere = [], True, g.N == 1
+    for r, (dt, tf) in Grid.time_readings(s).items():
+        covers = g.N * dt >= tf
+        short = (g.N - 1) * dt < tf        # N - 1 would not cover Tf in this reading
+        covers_all = covers_all and covers
+        least_somewhere = least_somewhere or short
+        edge = " (exactly on the boundary: N dt = Tf)" if g.N * dt == tf else ""
+        parts.append(f"{r}: dt = {_fmt(dt)}, Tf = {_fmt(tf)}, N dt = {_fmt(g.N * dt)} >= Tf: "
+                     f"{covers}{edge}; (N - 1) dt < Tf: {short}")
+    ok = covers_all and least_somewhere
+    detail = (f"N = {g.N}; " + "; ".join(parts) + f"; N is the least N >= 1 covering Tf in both "
+              f"readings: {ok}")
     return CheckOutcome(ok, detail, None if ok else detail)
 
 
-def _cspace_grid(s: Scenario, d: _Decimal) -> CheckOutcome:
+def _cspace_grid(s: Scenario) -> CheckOutcome:
     g = make_grid(s)
-    R = s.right
-    dt = Fraction(s.dt)
     parts, ok = [], True
     for q, m in enumerate((g.m, g.n)):
-        lo, hi = Fraction(R.limits[q][0]), Fraction(R.limits[q][1])
-        step = Fraction(R.omega[q]) * dt
-        exact_h = (hi - lo) / (m - 1)
+        readings = Grid.spacing_readings(s, q)
+        step_b = readings["binary"][1]
         stored = Fraction(g.h[q])            # the float the planner computes angles with
-        step_d = d.omega_r[q] * d.dt
-        h_d = (d.limits[q][1] - d.limits[q][0]) / (m - 1)
-        edge = " (on the boundary)" if h_d == step_d else ""
-        good = exact_h <= step and stored <= step and h_d <= step_d
+        good = stored <= step_b
+        words = [f"float h = {g.h[q]!r} <= omega dt = {_fmt(step_b)} (binary): {stored <= step_b}"]
+        for r, (span, step) in readings.items():
+            h = span / (m - 1)
+            edge = " (on the boundary)" if h == step else ""
+            good = good and h <= step
+            words.append(f"{r}: h = {_fmt(h)} <= omega dt = {_fmt(step)}{edge}: {h <= step}")
         ok = ok and good
-        parts.append(f"joint {q + 1}: m = {m}; binary: h = {_fmt(exact_h)} (float {g.h[q]!r}) "
-                     f"<= omega dt = {_fmt(step)}; decimal: h = {_fmt(h_d)} <= omega dt = "
-                     f"{_fmt(step_d)}{edge}: {good}")
+        parts.append(f"joint {q + 1}: m = {m}; " + "; ".join(words))
     detail = "; ".join(parts)
     return CheckOutcome(ok, detail, None if ok else detail)
 
 
-def _margin_side(s: Scenario, d: _Decimal) -> CheckOutcome:
+def _margin_side(s: Scenario) -> CheckOutcome:
     """The margin lemma's side conditions on the spacings the regions use, and its snap slack."""
     # The impl's own margin, its snap slack and the spacing its left regions use.
     from ..impl import SNAP, left_spacing, link_reach, sweep_margin
@@ -147,13 +113,13 @@ def _margin_side(s: Scenario, d: _Decimal) -> CheckOutcome:
             ok = ok and good
             parts.append(f"{side} link {link + 1}: sweep_margin = {float(got):.6e} m >= delta + "
                          f"SNAP slack = {float(need):.6e} m: {good}")
-    parts.append(f"decimal spacings (omega dt as written): left "
-                 f"{[_fmt(w * d.dt) for w in d.omega_l]}")
+    dec = [_fmt(decimal(w) * decimal(s.dt)) for w in s.left.omega]
+    parts.append(f"decimal spacings (omega dt as written): left {dec}")
     detail = "; ".join(parts)
     return CheckOutcome(ok, detail, None if ok else detail)
 
 
-def _containment(s: Scenario, d: _Decimal) -> CheckOutcome:
+def _containment(s: Scenario) -> CheckOutcome:
     from ..impl import check_containment   # only the data checks need impl
     rep = check_containment(s)
     # The digest of the polygons checked, so that a change in the regions shows as "changed".
@@ -162,32 +128,34 @@ def _containment(s: Scenario, d: _Decimal) -> CheckOutcome:
     return CheckOutcome(rep.ok, detail, None if rep.ok else detail)
 
 
-def _query(path: Path, check: Callable[[Scenario, _Decimal], CheckOutcome], what: str
+def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
            ) -> CheckQuery:
     s = load_scenario(path)
-    dec = _decimal(path)
-    src = check_source(check, _decimal, _dec)
+    src = check_source(check, Grid.time_readings, Grid.spacing_readings, decimal, make_grid)
     if check is _containment:
         from ..impl import check_containment, contained_exactly, containment_slack
         src += "\n" + check_source(check_containment, contained_exactly, containment_slack)
     content = f"scenario {path.name} sha256 {s.sha256}\ncheck {what}\n\n{src}\n"
-    return CheckQuery(lambda: check(s, dec), content)
+    return CheckQuery(lambda: check(s), content)
 
 
 _READINGS = ("binary = the doubles the code computes with, as exact rationals; decimal = the "
-             "numbers as written in the file (re-read with tomllib, repr of each float)")
+             "numbers as written in the file (Fraction(repr(x)) of each double)")
 
 
-def scenario_obligations(scenarios_dir: str | Path) -> list[Obligation]:
-    """Four data checks per scenario file found."""
+def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[Obligation]:
+    """Four data checks per scenario file: those of a folder (sorted), or the files given (the
+    workcells a report is about, in the order given)."""
+    files = (scenario_files(scenarios) if isinstance(scenarios, (str, Path))
+             else [Path(f) for f in scenarios])
     out = []
     P, D = Verdict.PROVED, Method.DATA
-    for f in scenario_files(scenarios_dir):
+    for f in files:
         group = f"Scenario {f.stem}"
         out += [
             Obligation(scenario_check_id(f.stem, "time_grid"), group, "docs/model.md §2 (time grid)",
-                       f"{f.name}: in the binary reading N dt >= Tf and N is the least such; in "
-                       f"the decimal reading the code's N also covers Tf ({_READINGS}). The "
+                       f"{f.name}: N dt >= Tf in both readings, and N is the least N >= 1 that "
+                       f"covers Tf in both ({_READINGS}). The "
                        "readings can differ on a boundary: default's Tf = 1.2 = 60 * 0.02 and "
                        "limited-joints' Tf = 1.625 = 65 * 0.025 are exact multiples of dt in "
                        "decimal.",

@@ -6,10 +6,20 @@ answer a readable counterexample. A Z3 ``unknown`` is reported as UNKNOWN, never
 every Z3 proof first shows its hypotheses satisfiable (else it FAILS as vacuous). Every solver
 call has a timeout; sympy and data checks, which have none of their own, run under a wall-clock
 limit (SIGALRM in the main thread, a watcher thread elsewhere) and end UNKNOWN past it.
+
+Beyond the verdict, a Z3 obligation's proof records for each VC: its depth (``_depth``: the
+weakest reasoning that proves it, propositional, ground or full; the obligation is as deep as its
+deepest VC), the hash of its statement in standard SMT-LIB 2.6 (``_smtlib``, what
+proofs/obligations.lock pins), and which solvers confirm it: Z3, cvc5 replaying the standard
+text (``_cvc5``; a cvc5 answer contradicting Z3's makes the obligation FAILED), or a
+sum-of-squares certificate checked exactly by sympy (``_sos``) where cvc5 does not decide. The
+while-programs' smoke tests (``Z3Query.smoke``, from ``_while.smoke_tests``) must not be shown
+unsatisfiable: an Assume, a branch or a loop that no state reaches makes the obligation FAILED.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import inspect
@@ -31,13 +41,17 @@ __all__ = [
     "Method",
     "Obligation",
     "Proof",
+    "Smoke",
+    "SmokeResult",
     "VC",
     "VCResult",
     "Verdict",
     "Z3Query",
     "check_source",
     "discharge",
+    "discharge_pending",
     "render_query",
+    "standard_smtlib",
 ]
 
 #: Per solver call. Every Solver gets it; no obligation here needs more than a few seconds.
@@ -101,6 +115,9 @@ class VC:
     witness: tuple[tuple[z3.ExprRef, z3.ExprRef], ...] = ()
     kind: str = "correctness"
     counter_witness: tuple[tuple[z3.ExprRef, z3.ExprRef], ...] = ()
+    #: A sum-of-squares certificate of the goal from the hypotheses (``_sos.Certificate``),
+    #: checked by sympy where cvc5 does not decide the VC.
+    certificate: Any = None
 
     def without(self, premise: str) -> VC:
         """This VC with one hypothesis removed (for negative tests)."""
@@ -112,12 +129,31 @@ class VC:
 
 
 @dataclass(frozen=True)
+class Smoke:
+    """A smoke test of a while-program (``_while.smoke_tests``): a point of the program that
+    some state must reach, i.e. ``hypotheses ∧ ¬goal`` satisfiable (the goal says the point is
+    never reached). ``witness`` pins constants to help Z3 find the model."""
+
+    name: str
+    hypotheses: tuple[tuple[str, z3.BoolRef], ...]
+    goal: z3.BoolRef
+    witness: tuple[tuple[z3.ExprRef, z3.ExprRef], ...] = ()
+    #: Closed facts about a model fixed by ``lemma_witness`` (a substitution of concrete
+    #: values), e.g. "no path exists" of a small D_R: each is proved valid once substituted,
+    #: then replaced by true in the substituted test, whose model Z3 can then find. (name, fact)
+    lemmas: tuple[tuple[str, z3.BoolRef], ...] = ()
+    lemma_witness: tuple[tuple[z3.ExprRef, z3.ExprRef], ...] = ()
+
+
+@dataclass(frozen=True)
 class Z3Query:
-    """What a Z3 obligation hands the solver: its VCs, and how to print a counterexample."""
+    """What a Z3 obligation hands the solver: its VCs, how to print a counterexample, and the
+    smoke tests of the programs the VCs come from."""
 
     vcs: tuple[VC, ...]
     render: Callable[[z3.ModelRef], str] | None = None
     note: str = ""
+    smoke: tuple[Smoke, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -161,15 +197,36 @@ class Obligation:
     expected: Verdict
     build: Callable[[], Query] = field(repr=False, compare=False)
     timeout_ms: int = DEFAULT_TIMEOUT_MS
+    #: What the proof does not cover, in a few words (e.g. "wrapper proved, search assumed"),
+    #: shown next to the verdict.
+    label: str = ""
 
 
 @dataclass(frozen=True)
 class VCResult:
-    """The solver's two answers for one VC: vacuity (want sat) and the proof (want unsat)."""
+    """One VC's answers: vacuity (want sat) and the proof (want unsat; sat for a refutation),
+    its depth when proved, its statement's hash (standard SMT-LIB 2.6, or Z3's text when it
+    has no standard rendering), cvc5's answer on the standard text and the confirming solvers."""
 
     name: str
     vacuity: str
     answer: str
+    depth: str | None = None
+    sha256: str = ""
+    cvc5: str = ""                 # unsat | sat | unknown | "" (not replayed)
+    cvc5_reason: str = ""
+    solvers: tuple[str, ...] = ()
+    note: str = ""                 # why a second solver does not confirm it, if it does not
+
+
+@dataclass(frozen=True)
+class SmokeResult:
+    """A smoke test's answer: sat (the point is reached), unsat (vacuous) or unknown, with how
+    it was decided."""
+
+    name: str
+    answer: str
+    how: str = ""
 
 
 @dataclass(frozen=True)
@@ -189,26 +246,119 @@ class Proof:
     smtlib: str
     sha256: str
     vcs: tuple[VCResult, ...] = ()
+    depth: str | None = None            # the deepest VC's level (proved Z3 obligations)
+    label: str = ""
+    smoke: tuple[SmokeResult, ...] = ()
+    pins: dict[str, str] = field(default_factory=dict)   # what obligations.lock pins
+    standard: str = ""                  # every VC in standard SMT-LIB 2.6 (Z3 obligations)
+    cvc5_seconds: float = 0.0
 
     @property
     def as_expected(self) -> bool:
         return self.verdict is self.expected
 
+    @property
+    def solvers(self) -> tuple[str, ...]:
+        """The solvers that confirm every VC (Z3 obligations; empty for the others)."""
+        if not self.vcs:
+            return ()
+        common = set(self.vcs[0].solvers)
+        for v in self.vcs[1:]:
+            common &= set(v.solvers)
+        return tuple(s for s in self.vcs[0].solvers if s in common)
+
 
 # --- discharging --------------------------------------------------------------------------------
 
 def discharge(ob: Obligation) -> Proof:
-    """Run one obligation to a verdict; any exception is a FAILED verdict that says why."""
+    """Run one obligation to a verdict (cvc5's replay included, waited for); any exception is
+    a FAILED verdict that says why."""
+    from ._cvc5 import Cvc5Pool
+
+    with Cvc5Pool() as pool:
+        return discharge_pending(ob, pool).settle()
+
+
+#: Per smoke-test check (with the pins, the ground abstraction, without the pins).
+SMOKE_TIMEOUT_MS = 1_500
+
+
+@dataclass
+class _Pending:
+    """An obligation discharged by Z3, its cvc5 replays still running (``settle`` waits)."""
+
+    ob: Obligation
+    text: str
+    seconds: float
+    fields: dict[str, Any]
+    futures: list[Any]            # per VC: a Future of a Cvc5Answer, or None
+    certificates: list[Any]       # per VC: the VC if it carries a certificate, else None
+
+    def settle(self) -> Proof:
+        """Wait for cvc5; record per VC the solvers that confirm it (Z3, cvc5, or an SOS
+        certificate where cvc5 did not); a cvc5 answer contradicting Z3's FAILS it."""
+        from ._sos import check_certificate
+
+        f = dict(self.fields)
+        results = list(f.get("vcs", ()))
+        disagree = []
+        cvc5_s = 0.0
+        own = 0.0      # time spent here (certificates), not waiting for cvc5
+        for n, (r, fut) in enumerate(zip(results, self.futures)):
+            solvers = list(r.solvers)
+            note = r.note
+            cvc5, reason = r.cvc5, r.cvc5_reason
+            if fut is not None:
+                a = fut.result()
+                cvc5, reason, cvc5_s = a.answer, a.reason, cvc5_s + a.seconds
+                if r.answer in ("unsat", "sat") and cvc5 in ("unsat", "sat"):
+                    if cvc5 == r.answer:
+                        solvers.append("cvc5")
+                    else:
+                        disagree.append(f"{r.name} (Z3 {r.answer}, cvc5 {cvc5})")
+                if cvc5 == "unknown":
+                    note = f"cvc5 unknown ({reason})"
+            vc = self.certificates[n]
+            if "cvc5" not in solvers and r.answer == "unsat" and vc is not None:
+                t0 = time.perf_counter()
+                ok, detail = check_certificate(vc)
+                own += time.perf_counter() - t0
+                if ok:
+                    solvers.append("sympy-sos")
+                    note = (note + "; " if note else "") + f"confirmed by {detail}"
+                else:
+                    note = (note + "; " if note else "") + f"not confirmed: {detail}"
+            results[n] = dataclasses.replace(r, cvc5=cvc5, cvc5_reason=reason,
+                                             solvers=tuple(solvers), note=note)
+        if disagree and f["verdict"] is not Verdict.FAILED:
+            f["verdict"] = Verdict.FAILED
+            f["reason"] = "the solvers disagree: " + ", ".join(disagree)
+        f["vcs"] = tuple(results)
+        return Proof(id=self.ob.id, group=self.ob.group, method=self.ob.method,
+                     expected=self.ob.expected, seconds=self.seconds + own, smtlib=self.text,
+                     sha256=hashlib.sha256(self.text.encode()).hexdigest(),
+                     label=self.ob.label, cvc5_seconds=round(cvc5_s, 3), **f)
+
+
+def discharge_pending(ob: Obligation, pool: Any,
+                      skip: dict[str, str] | None = None) -> _Pending:
+    """Run one obligation with Z3 (or sympy, or the data check), handing each VC's standard
+    SMT-LIB to ``pool`` (a ``_cvc5.Cvc5Pool``) for the replay, except the statements in
+    ``skip`` (hash -> why: cvc5 did not decide them when they were pinned); ``settle()`` gives
+    the Proof. Any exception is a FAILED verdict that says why."""
     t0 = time.perf_counter()
     text = ""
+    futures: list[Any] = []
+    certs: list[Any] = []
     try:
         query = ob.build()
         text = render_query(ob, query)
         if isinstance(query, Z3Query):
-            fields = _run_z3(ob, query)
+            fields, futures, certs = _run_z3(ob, query, pool, skip or {})
         else:
             outcome = _guarded(query.run, ob.timeout_ms)
             fields = _check_fields(ob, outcome)
+            fields["pins"] = {"source": _source_hash(ob, query)}
             # The result is part of the hashed text: new data or a changed computation that
             # gives another N, h or slack is reported "changed", not "same".
             text += _outcome_text(outcome)
@@ -216,10 +366,36 @@ def discharge(ob: Obligation) -> Proof:
         tb = traceback.format_exception_only(type(exc), exc)[-1].strip()
         fields = dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
                       reason_unknown=None, reason=f"exception: {tb}", vcs=())
-    seconds = time.perf_counter() - t0
-    return Proof(id=ob.id, group=ob.group, method=ob.method, expected=ob.expected,
-                 seconds=seconds, smtlib=text, sha256=hashlib.sha256(text.encode()).hexdigest(),
-                 **fields)
+        futures, certs = [], []
+    return _Pending(ob, text, time.perf_counter() - t0, fields, futures, certs)
+
+
+def _source_hash(ob: Obligation, q: CheckQuery) -> str:
+    """What the lock pins of a sympy or data check: its canonical text, which holds the
+    check's source. A per-scenario check's first line names the scenario file and its hash
+    (data, not statement): left out, so the pin is the check's, whatever the workcell."""
+    content = q.content
+    if ob.id.startswith("Scenario.") and content.startswith("scenario "):
+        content = content.split("\n", 1)[1] if "\n" in content else ""
+    return hashlib.sha256(content.encode()).hexdigest()
+
+
+def standard_smtlib(vc: VC) -> tuple[str | None, str, str]:
+    """(text, sha256, note) of the VC's proof check in standard SMT-LIB 2.6 (``_smtlib``); with
+    no standard rendering, (None, the hash of Z3's own text, why)."""
+    from ._smtlib import NotStandard, smtlib_query
+
+    hyps = [h for _, h in vc.hypotheses]
+    try:
+        q = smtlib_query(hyps, vc.goal)
+        return q.text, q.sha256, ""
+    except NotStandard as exc:
+        s = z3.Solver()
+        s.add(hyps)
+        s.add(z3.Not(vc.goal))
+        z3text = "z3 dialect\n" + s.sexpr()
+        return (None, hashlib.sha256(z3text.encode()).hexdigest(),
+                f"no standard SMT-LIB rendering ({exc})")
 
 
 def _solver(timeout_ms: int, ctx: z3.Context | None = None) -> z3.Solver:
@@ -236,15 +412,100 @@ def _stats(s: z3.Solver, into: dict[str, float]) -> None:
         into[key] = into.get(key, 0) + st.get_key_value(key)
 
 
-def _run_z3(ob: Obligation, q: Z3Query) -> dict[str, Any]:
+def _smoke(sm: Smoke, stats: dict[str, float], ctx: z3.Context | None = None) -> SmokeResult:
+    """Decide a smoke test: sat (a state reaches the point: a model, with the pins or
+    without), unsat (none does: shown on the test itself, or on its ground abstraction, which
+    over-approximates it, so its unsat is the test's), or unknown (neither shown)."""
+    from ._depth import _unsat
+    from ._smtlib import Mode, NotStandard, smtlib_query
+
+    ctx = ctx or z3.Context()
+    s = _solver(SMOKE_TIMEOUT_MS, ctx)
+    s.add([h.translate(ctx) for _, h in sm.hypotheses])
+    s.add(z3.Not(sm.goal.translate(ctx)))
+    if sm.lemmas and sm.lemma_witness:
+        found = _smoke_by_lemmas(sm, stats, ctx)
+        if found is not None:
+            return found
+    pins = [c.translate(ctx) == v.translate(ctx) for c, v in sm.witness]
+    pinned = None
+    if pins:
+        pinned = s.check(*pins)
+        _stats(s, stats)
+        if pinned == z3.sat:
+            return SmokeResult(sm.name, "sat", "a model, with the pinned constants")
+    # The pins only help find a model: unsat with them says nothing.
+    try:
+        text = smtlib_query([h for _, h in sm.hypotheses], sm.goal, Mode.GROUND).text
+        if _unsat(text, SMOKE_TIMEOUT_MS, ctx):
+            return SmokeResult(sm.name, "unsat", "its ground abstraction is unsat")
+    except NotStandard:
+        pass
+    if pinned == z3.unknown:
+        # Z3 gave up on the pinned test already; without the pins it would not do better.
+        return SmokeResult(sm.name, "unknown", "undecided (unknown with the pinned constants); "
+                           "its ground abstraction has a model")
+    r = s.check()
+    _stats(s, stats)
+    if r == z3.sat:
+        return SmokeResult(sm.name, "sat", "a model")
+    if r == z3.unsat:
+        return SmokeResult(sm.name, "unsat", "unsat")
+    return SmokeResult(sm.name, "unknown", f"undecided ({s.reason_unknown()}); its ground "
+                       "abstraction has a model")
+
+
+def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> SmokeResult | None:
+    """A model of the smoke test with ``lemma_witness`` substituted, its lemmas proved valid
+    there and replaced by true (a closed fact proved valid is true in every model, so the test
+    and the test with it replaced by true have the same models); None if that does not work."""
+    sig = [(c, v) for c, v in sm.lemma_witness]
+    f = z3.substitute(z3.And(*[h for _, h in sm.hypotheses], z3.Not(sm.goal)), *sig)
+    used = []
+    for lname, lemma in sm.lemmas:
+        closed = z3.substitute(lemma, *sig)
+        if z3.eq(z3.substitute(f, (closed, z3.BoolVal(True))), f):
+            continue                    # not in this test
+        s = _solver(SMOKE_TIMEOUT_MS, ctx)
+        s.add(z3.Not(closed.translate(ctx)))
+        r = s.check()
+        _stats(s, stats)
+        if r != z3.unsat:
+            return None
+        f = z3.substitute(f, (closed, z3.BoolVal(True)))
+        used.append(lname)
+    s = _solver(SMOKE_TIMEOUT_MS, ctx)
+    s.add(f.translate(ctx))
+    r = s.check()
+    _stats(s, stats)
+    if r != z3.sat:
+        return None
+    return SmokeResult(sm.name, "sat", "a model of the pinned test"
+                       + (f", with {'; '.join(used)} proved of it" if used else ""))
+
+
+def _short_text(f: z3.ExprRef, width: int = 50) -> str:
+    text = " ".join(str(f).split())
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
+            ) -> tuple[dict[str, Any], list[Any], list[Any]]:
+    from ._depth import deepest, vc_depth
+
     if not q.vcs:
-        return dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
-                    reason_unknown=None, reason="no verification conditions", vcs=())
+        return (dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
+                     reason_unknown=None, reason="no verification conditions", vcs=()), [], [])
     stats: dict[str, float] = {}
     results: list[VCResult] = []
+    futures: list[Any] = []
+    certs: list[Any] = []
+    pins: dict[str, str] = {}
+    standard: list[str] = []
     vacuous: list[str] = []
     unknowns: list[str] = []
     refuted: list[tuple[str, str]] = []
+    want = "sat" if ob.expected is Verdict.REFUTED_AS_EXPECTED else "unsat"
     for vc in q.vcs:
         # Each check runs in a fresh Z3 context, so its answer does not depend on what ran
         # before it in this process (the run order, or a selection with ``only``).
@@ -272,12 +533,40 @@ def _run_z3(ob: Obligation, q: Z3Query) -> dict[str, Any]:
             refuted.append((vc.name, text))
         elif ans == z3.unknown:
             unknowns.append(f"{vc.name}: {s.reason_unknown()}")
-        results.append(VCResult(vc.name, str(vac), str(ans)))
+        # The statement in standard SMT-LIB: pinned by its hash, replayed by cvc5.
+        std, sha, note = standard_smtlib(vc)
+        key = vc.name if vc.name not in pins else f"{vc.name}#{len(pins) + 1}"
+        pins[key] = sha
+        if std is not None:
+            standard += [f"; VC {vc.name}: proof check (expect {want})",
+                         std.replace("(exit)\n", "(reset)\n")]
+        depth = None
+        if ans == z3.unsat and ob.expected is Verdict.PROVED:
+            depth = vc_depth([h for _, h in vc.hypotheses], vc.goal, ctx=ctx)
+        replay = std is not None and ans != z3.unknown and sha not in skip
+        futures.append(pool.submit(std) if replay else None)
+        certs.append(vc if vc.certificate is not None else None)
+        cvc5 = why = ""
+        if sha in skip:
+            cvc5, why = "skipped", skip[sha]
+            note = f"cvc5 undecided when pinned ({why}); not re-run"
+        results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
+                                cvc5=cvc5, cvc5_reason=why,
+                                solvers=("z3",) if str(ans) == want else (), note=note))
+    # One context for the smoke tests of an obligation (each has its own solver).
+    sctx = z3.Context() if q.smoke else None
+    smoke = [_smoke(sm, stats, sctx) for sm in q.smoke]
+    dead = [r.name for r in smoke if r.answer == "unsat"]
+    undecided = [r.name for r in smoke if r.answer == "unknown"]
     cex = "\n".join(f"[{name}]\n{text}" if len(q.vcs) > 1 else text for name, text in refuted)
     cex_or_none = cex or None
     unknown_text = "; ".join(unknowns) or None
     if vacuous:
         verdict, reason = Verdict.FAILED, "vacuous: hypotheses unsatisfiable in " + ", ".join(vacuous)
+    elif dead:
+        verdict = Verdict.FAILED
+        reason = ("vacuous program: no state reaches " + "; ".join(dead)
+                  + " (smoke tests unsat)")
     elif refuted:
         if ob.expected is Verdict.REFUTED_AS_EXPECTED:
             verdict, reason = Verdict.REFUTED_AS_EXPECTED, "counterexample found (sat)"
@@ -288,9 +577,17 @@ def _run_z3(ob: Obligation, q: Z3Query) -> dict[str, Any]:
         verdict, reason = Verdict.UNKNOWN, "solver answered unknown"
     else:
         verdict, reason = Verdict.PROVED, f"{len(q.vcs)} VC(s) unsat, hypotheses satisfiable"
-    return dict(verdict=verdict, statistics=dict(sorted(stats.items())),
-                counterexample=cex_or_none, reason_unknown=unknown_text, reason=reason,
-                vcs=tuple(results))
+    if q.smoke and not dead:
+        reason += (f"; {len(smoke) - len(undecided)} of {len(smoke)} smoke tests reached"
+                   + (f", {len(undecided)} undecided ({'; '.join(undecided)})"
+                      if undecided else ""))
+    depth_all = (deepest([r.depth for r in results if r.depth is not None])
+                 if verdict is Verdict.PROVED else None)
+    return (dict(verdict=verdict, statistics=dict(sorted(stats.items())),
+                 counterexample=cex_or_none, reason_unknown=unknown_text, reason=reason,
+                 vcs=tuple(results), depth=depth_all, smoke=tuple(smoke), pins=pins,
+                 standard="\n".join(standard) + ("\n(exit)\n" if standard else "")),
+            futures, certs)
 
 
 class _CheckTimeout(Exception):

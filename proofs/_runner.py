@@ -33,8 +33,13 @@ from ._obl_builtdr import builtdr_obligations
 from ._obl_geometry import geometry_obligations
 from ._obl_margin import margin_obligations
 from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
+from ._obl_witness import witness_obligations
+from ._obl_tolerance import tolerance_obligations
+from ._obl_safety import safety_obligations
 from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
-from ._obligation import Method, Obligation, Proof, Verdict, discharge
+from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending
+from ._pins import LOCK, Mismatch, check_pins, cvc5_skips, load_lock
+from ._pins import repin as repin_lock
 
 __all__ = [
     "BUNDLED_DIR",
@@ -71,9 +76,15 @@ EXPECTED_VERDICTS: dict[str, Verdict] = {
     "Def4.is_path_printed": _R, "Def4.is_path_printed_off_grid": _R,
     "Def4.is_path_fixed_safe": _P,
     "Thm2.searchoptpath": _P, "Thm4.searchoptpath": _P, "Thm4.searchoptpath_tight": _P,
+    "Witness.labels_sound": _P, "Witness.reachable_sound": _P,
     "Prop8.printed": _R, "Prop8.intersection_monotone": _P, "Prop8.subset_monotone": _P,
     "Prop8.valid_transfer": _P, "Prop8.path_exists": _P, "Prop8.optimal_cost": _P,
     "Prop8.prestrength_thm4": _P,
+    "Tolerance.tube": _P,
+    "Safety.original.principal_in_layer_box": _P, "Safety.modified.principal_in_layer_box": _P,
+    "Safety.tight.principal_in_layer_box": _P, "Safety.subordinate_in_cell_box": _P,
+    "Safety.region_soundness": _P, "Safety.separation": _P, "Safety.original.composition": _P,
+    "Safety.modified.composition": _P, "Safety.tight.composition": _P,
 }
 
 #: The obligations every run must produce, besides the per-scenario ones.
@@ -112,15 +123,17 @@ def collect_obligations(scenarios_dir: str | Path = BUNDLED_DIR,
                         only: Iterable[str] | None = None) -> tuple[Obligation, ...]:
     """Every obligation (cheap: queries are built when discharged), optionally filtered."""
     obs = (geometry_obligations() + margin_obligations() + builtdr_obligations()
-           + path_obligations() + theorem_obligations() + prop8_obligations()
+           + path_obligations() + theorem_obligations() + witness_obligations()
+           + prop8_obligations()
+           + tolerance_obligations() + safety_obligations()
            + scenario_obligations(scenarios_dir))
     return tuple(o for o in obs if selected(o.id, only))
 
 
 def expected_ids(scenarios_dir: str | Path = BUNDLED_DIR) -> tuple[str, ...]:
-    """The ids a full run must produce: FIXED_IDS, then len(CHECKS) per scenario: for the bundled
-    folder the pinned BUNDLED_SCENARIOS (whatever files are there), for any other folder one
-    set per file found in it (``scenarios_note`` says so)."""
+    """The ids a full run must produce: FIXED_IDS, then len(CHECKS) per workcell: for the bundled
+    folder the pinned BUNDLED_SCENARIOS (whatever files are there), for a user's folder one set
+    per file in it, its workcells being the ones to prove (``scenarios_note`` says so)."""
     if is_bundled(scenarios_dir):
         stems = list(BUNDLED_SCENARIOS)
     else:
@@ -129,16 +142,17 @@ def expected_ids(scenarios_dir: str | Path = BUNDLED_DIR) -> tuple[str, ...]:
 
 
 def scenarios_note(scenarios_dir: str | Path) -> str:
-    """What the run expects from the scenario folder, in words (printed at the top)."""
+    """What the run proves of the scenario folder, in one plain line (printed at the top): the
+    workcells and the ids expected of them (the bundled set is the default)."""
+    def ids(stems: Sequence[str]) -> str:
+        return ", ".join(scenario_check_id(s, "{" + ",".join(CHECKS) + "}")
+                         for s in stems) or "(none)"
+
     if is_bundled(scenarios_dir):
-        return (f"scenarios: the bundled folder; expecting {len(CHECKS)} checks for each of "
-                + ", ".join(BUNDLED_SCENARIOS))
-    files = scenario_files(scenarios_dir)
-    return (f"scenarios: {scenarios_dir} is not the bundled folder ({BUNDLED_DIR}); expecting "
-            f"from its {len(files)} file(s) the ids "
-            + (", ".join(scenario_check_id(f.stem, "{" + ",".join(CHECKS) + "}") for f in files)
-               or "(none)")
-            + "; the bundled scenarios' checks are not run")
+        return (f"scenarios: the {len(BUNDLED_SCENARIOS)} bundled workcells, expecting "
+                + ids(BUNDLED_SCENARIOS))
+    stems = [f.stem for f in scenario_files(scenarios_dir)]
+    return f"scenarios: the {len(stems)} workcell(s) in {scenarios_dir}, expecting {ids(stems)}"
 
 
 def selected(ident: str, only: Iterable[str] | None) -> bool:
@@ -168,12 +182,14 @@ class ProveRun:
     duplicate_ids: tuple[str, ...] = ()      # produced more than once
     scenarios_note: str = ""
     record: dict[str, Any] = field(default_factory=dict)   # results.json's "run" (run_record)
+    pin_mismatch: tuple[Mismatch, ...] = ()  # statement not the one obligations.lock pins
+    repinned: tuple[str, ...] | None = None  # --repin: what it changed in the lock
 
     @property
     def ok(self) -> bool:
         return (all(p.as_expected for p in self.proofs) and not self.missing_ids
                 and not self.unexpected_ids and not self.verdict_mismatch
-                and not self.duplicate_ids)
+                and not self.duplicate_ids and not self.pin_mismatch)
 
 
 def compare_ids(ids: Sequence[str], expected: Sequence[str]
@@ -201,21 +217,40 @@ def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
 
 def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                     expected: Sequence[str], *, note: str = "",
-                    record: dict[str, Any] | None = None) -> ProveRun:
+                    record: dict[str, Any] | None = None, lock: str | Path | None = None,
+                    repin: bool = False) -> ProveRun:
     """Discharge each obligation, save its query and the results, compare with the last run;
-    every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``."""
+    every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``,
+    and every statement against the lock (``lock``, default proofs/obligations.lock), which
+    ``repin`` rewrites first (for the obligations run; after a whole run, dropping the rest).
+    cvc5 replays each VC in the background while Z3 goes on (``_cvc5.Cvc5Pool``)."""
+    from ._cvc5 import Cvc5Pool
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     previous = _load_previous(out / "results.json")
+    lock_path = Path(lock) if lock is not None else LOCK
+    # cvc5 replays the statements it decided when they were pinned (--repin: every one).
+    skip = {} if repin else cvc5_skips(load_lock(lock_path))
     t0 = time.perf_counter()
-    proofs = tuple(discharge(o) for o in obligations)
+    with Cvc5Pool() as pool:
+        pending = [discharge_pending(o, pool, skip) for o in obligations]
+        proofs = tuple(p.settle() for p in pending)
     seconds = time.perf_counter() - t0
+    repinned = None
+    if repin:
+        ran = {p.id for p in proofs}
+        complete = set(FIXED_IDS) <= set(expected) <= ran
+        repinned = tuple(repin_lock(proofs, lock_path, complete=complete))
+    pins = tuple(check_pins(proofs, load_lock(lock_path)))
     changes = {}
     for p in proofs:
         old = previous.get(p.id)
         changes[p.id] = "new" if old is None else ("same" if old.get("sha256") == p.sha256
                                                   else "changed")
         _write_atomic(out / _query_file(p), p.smtlib)
+        if p.standard:
+            _write_atomic(out / f"{p.id}.std.smt2", p.standard)
     ids = [p.id for p in proofs]
     exp = list(expected)
     mismatch = []
@@ -229,7 +264,8 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                    missing_ids=missing, unexpected_ids=unexpected,
                    seconds=seconds, verdict_mismatch=tuple(mismatch),
                    duplicate_ids=tuple(sorted(repeated)),
-                   scenarios_note=note, record=dict(record or {}))
+                   scenarios_note=note, record=dict(record or {}), pin_mismatch=pins,
+                   repinned=repinned)
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run
 
@@ -290,7 +326,12 @@ def _proof_json(p: Proof, ob: Obligation, change: str) -> dict[str, Any]:
         "file": _query_file(p), "change": change, "statistics": p.statistics,
         "counterexample": p.counterexample, "reason": p.reason,
         "reason_unknown": p.reason_unknown,
-        "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer} for v in p.vcs],
+        "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer, "depth": v.depth,
+                 "sha256": v.sha256, "solvers": list(v.solvers), "cvc5": v.cvc5,
+                 "cvc5_reason": v.cvc5_reason, "note": v.note} for v in p.vcs],
+        "depth": p.depth, "label": p.label, "solvers": list(p.solvers),
+        "smoke": [{"name": s.name, "answer": s.answer, "how": s.how} for s in p.smoke],
+        "cvc5_seconds": p.cvc5_seconds,
     }
 
 
@@ -309,12 +350,51 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
         "verdict_mismatch": list(run.verdict_mismatch), "duplicate_ids": list(run.duplicate_ids),
         "scenarios_note": run.scenarios_note,
         "removed_since_last_run": list(run.removed),
+        "depth": depth_table(run.proofs), "second_solver": solver_table(run.proofs),
+        "pins": {"mismatch": [{"id": i, "what": w} for i, w in run.pin_mismatch],
+                 "repinned": None if run.repinned is None else list(run.repinned)},
         "obligations": entries + carried,
         "assumptions": [{"id": a.id, "what": a.what, "why": a.why, "used_by": a.used_by}
                         for a in run.assumptions],
         "seconds": round(run.seconds, 3),
     }
     return json.dumps(doc, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
+
+
+def depth_table(proofs: Iterable[Proof]) -> dict[str, Any]:
+    """Counts per depth level (_depth.LEVELS) of the proved Z3 obligations and of their VCs."""
+    from ._depth import LEVELS
+
+    obs = dict.fromkeys(LEVELS, 0)
+    vcs = dict.fromkeys(LEVELS, 0)
+    for p in proofs:
+        if p.depth is not None:
+            obs[p.depth] += 1
+            for v in p.vcs:
+                if v.depth is not None:
+                    vcs[v.depth] += 1
+    return {"obligations": obs, "vcs": vcs}
+
+
+def solver_table(proofs: Iterable[Proof]) -> dict[str, Any]:
+    """Which solvers confirm the VCs that Z3 decided as wanted: Z3 and cvc5, Z3 and a sympy
+    SOS certificate, Z3 only (each with its reason)."""
+    from ._cvc5 import cvc5_version
+
+    both = sos = 0
+    only: list[dict[str, str]] = []
+    for p in proofs:
+        for v in p.vcs:
+            if "z3" not in v.solvers:
+                continue
+            if "cvc5" in v.solvers:
+                both += 1
+            elif "sympy-sos" in v.solvers:
+                sos += 1
+            else:
+                only.append({"id": p.id, "vc": v.name, "why": v.note or "not replayed"})
+    return {"cvc5": cvc5_version(), "z3_and_cvc5": both, "z3_and_sos": sos,
+            "z3_only": len(only), "z3_only_vcs": only}
 
 
 def render_report(run: ProveRun) -> str:
@@ -333,6 +413,17 @@ def render_report(run: ProveRun) -> str:
         lines.append(row(g, _counts(ps)))
     lines.append("-" * (width + 2 + sum(len(h) + 2 for h in heads)))
     lines.append(row("Total", _counts(run.proofs)))
+    dt = depth_table(run.proofs)
+    lines += ["", "Depth of the proved Z3 obligations (an obligation is as deep as its deepest "
+              "VC): " + ", ".join(f"{n} {lv}" for lv, n in dt["obligations"].items())
+              + "; their VCs: " + ", ".join(f"{n} {lv}" for lv, n in dt["vcs"].items()),
+              "Propositional obligations (proved by their Boolean skeleton alone): "
+              f"{dt['obligations']['propositional']}"]
+    st = solver_table(run.proofs)
+    lines += [f"Second solver (cvc5 {st['cvc5'] or 'not installed'}) on the standard SMT-LIB: "
+              f"{st['z3_and_cvc5']} VCs confirmed by Z3 and cvc5, {st['z3_and_sos']} by Z3 and "
+              f"an SOS certificate (sympy), {st['z3_only']} by Z3 only"]
+    lines += [f"    Z3 only: {o['id']} / {o['vc']}: {o['why']}" for o in st["z3_only_vcs"]]
     lines += ["", "Obligations", ""]
     idw = max([len(p.id) for p in run.proofs] + [10])
     for p in run.proofs:
@@ -342,8 +433,14 @@ def render_report(run: ProveRun) -> str:
         # The verdict is "proved" either way; the line says how: a data check is not a proof.
         shown = ("checked on data" if p.method is Method.DATA and p.verdict is Verdict.PROVED
                  else p.verdict.value)
+        how = ""
+        if p.method is Method.Z3 and p.verdict in (Verdict.PROVED, Verdict.REFUTED_AS_EXPECTED):
+            how = "  " + ", ".join(x for x in (p.depth, "+".join(p.solvers) or "z3",
+                                               p.label) if x)
+        elif p.label:
+            how = f"  {p.label}"
         lines.append(f"{p.id:<{idw}}  {shown:<20} {p.seconds:7.2f}s  "
-                     f"[{run.changes[p.id]}]{flag}")
+                     f"[{run.changes[p.id]}]{how}{flag}")
         if p.verdict in (Verdict.UNKNOWN, Verdict.FAILED) or not p.as_expected:
             lines.append(f"{'':<{idw}}  reason: {p.reason}"
                          + (f" ({p.reason_unknown})" if p.reason_unknown else ""))
@@ -362,6 +459,12 @@ def render_report(run: ProveRun) -> str:
                      + ", ".join(run.verdict_mismatch))
     if run.duplicate_ids:
         lines.append("DUPLICATE obligation ids: " + ", ".join(run.duplicate_ids))
+    if run.repinned is not None:
+        lines.append("Re-pinned proofs/obligations.lock: " + (
+            "no change" if not run.repinned else f"{len(run.repinned)} change(s)"))
+        lines += [f"    {ln}" for ln in run.repinned]
+    for ident, what in run.pin_mismatch:
+        lines.append(f"STATEMENT NOT PINNED: {ident}: {what} (review, then cfmpa prove --repin)")
     lines += ["", "Assumptions (not proved)", ""]
     for a in run.assumptions:
         lines += [f"{a.id}: {a.what}", f"    why: {a.why}", f"    used by: {a.used_by}"]

@@ -101,12 +101,21 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
     paths = _scenario_paths(scenarios, sdir)
     loaded = [load_scenario(p) for p in paths]          # input errors before any work
+    stems: dict[str, Path] = {}
+    for p in paths:   # per-scenario obligation ids carry the stem, so it must be unique
+        if p.stem in stems:
+            raise InputError("scenarios", str(p), f"has the same stem {p.stem!r} as "
+                             f"{stems[p.stem]}: their obligation ids would clash; rename one")
+        stems[p.stem] = p
     if isinstance(compare_n, bool) or not isinstance(compare_n, int) or compare_n < 0:
         raise InputError("compare_n", compare_n, "must be an integer >= 0 (0: no campaign)")
     plans = _Plans(contracts)
     figures: dict[str, F.Figure] = {}
 
-    proofs = load_proofs(proofs_json, sdir, expected_ids)
+    # The user's workcells are the ones to prove: given files bring their own per-scenario
+    # obligations (the bundled set, by default, its pinned ones).
+    proofs = load_proofs(proofs_json, sdir, expected_ids,
+                         files=paths if scenarios else None)
     doc = {
         "format": FORMAT,
         "provenance": provenance(argv, loaded),
@@ -462,10 +471,14 @@ def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, 
     if mine != theirs:
         problems.append(f"proved at commit {theirs}, report at {mine}")
     hashes = run.get("scenarios") or {}
+    shown = {".".join(i["id"].split(".")[1:-1]) for i in ob["items"]
+             if i["id"].startswith("Scenario.")}
     for s in prov["scenarios"]:
         name = Path(s["path"]).name
         if name in hashes and hashes[name] != s["sha256"]:
             problems.append(f"{name} changed since the prove run")
+        elif name not in hashes and Path(name).stem in shown:
+            problems.append(f"results.json records no hash for {name}, whose checks are shown")
     if ob["not_run"]:
         problems.append(f"{len(ob['not_run'])} results carried over from an earlier run "
                         f"(e.g. {ob['not_run'][0]})")

@@ -8,6 +8,11 @@ Where the obligations come from (decided here, printed in the report):
 Either way the ids are checked here against ``cfmpa.proofs.expected_ids`` (or the list the caller
 gives): none missing, none extra, none twice; what a results.json says of its own ids is not taken
 on trust.
+
+When the report is about given workcell files (``files``), the per-scenario obligations are
+exactly those files' (``audited_ids``: the scenario-independent ids, then four per file): a
+fresh run discharges them, and a results.json must cover them; its rows for other workcells are
+left out of the report and named in the note.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ __all__ = [
     "ObligationRow",
     "ProofData",
     "SUMMARY_COLUMNS",
+    "audited_ids",
     "check_ids",
     "load_proofs",
     "summary_table",
@@ -61,6 +67,10 @@ class ObligationRow:
     reason: str
     sha256: str
     change: str | None = None      # new | changed | same | not run, against the previous prove run
+    depth: str | None = None       # propositional | ground | full (proved Z3 obligations)
+    solvers: tuple[str, ...] = ()  # the solvers confirming every VC (Z3 obligations)
+    label: str = ""                # what the proof does not cover, in a few words
+    z3_only: tuple[str, ...] = ()  # "VC: why" for each VC only Z3 confirms
 
     @property
     def as_expected(self) -> bool:
@@ -71,7 +81,9 @@ class ObligationRow:
                 "statement": self.statement, "method": self.method, "verdict": self.verdict,
                 "expected": self.expected, "as_expected": self.as_expected,
                 "seconds": self.seconds, "counterexample": self.counterexample,
-                "reason": self.reason, "sha256": self.sha256, "change": self.change}
+                "reason": self.reason, "sha256": self.sha256, "change": self.change,
+                "depth": self.depth, "solvers": list(self.solvers), "label": self.label,
+                "z3_only": list(self.z3_only)}
 
 
 @dataclass(frozen=True)
@@ -91,18 +103,47 @@ class ProofData:
 
 
 def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
-                expected: Sequence[str] | None = None) -> ProofData:
+                expected: Sequence[str] | None = None,
+                files: Sequence[str | Path] | None = None) -> ProofData:
     """Obligations and ledger from ``proofs_json``, else from a fresh run (module docstring).
 
-    ``expected``: the ids the data must hold (None: ``expected_ids(scenarios_dir)``, every
-    obligation; a prove run restricted with ``--only`` is then reported with ids missing).
+    ``expected``: the ids the data must hold (None: ``audited_ids(files)`` when ``files`` is
+    given, else ``expected_ids(scenarios_dir)``, every obligation; a prove run restricted with
+    ``--only`` is then reported with ids missing). ``files``: the workcells the report is about,
+    whose per-scenario obligations are then the ones shown (a given ``expected`` overrides).
     """
-    from ..proofs import expected_ids
+    from ..proofs import FIXED_IDS, collect_obligations, expected_ids, scenario_obligations
 
-    want = tuple(expected) if expected is not None else expected_ids(Path(scenarios_dir))
+    if files is None or expected is not None:   # the caller's ids, or the folder's
+        want = tuple(expected) if expected is not None else expected_ids(Path(scenarios_dir))
+        if proofs_json is not None:
+            return _from_file(Path(proofs_json), want)
+        return _fresh(list(collect_obligations(scenarios_dir)), want)
+    paths = [Path(f) for f in files]
+    want = audited_ids(paths)
     if proofs_json is not None:
-        return _from_file(Path(proofs_json), want)
-    return _fresh(Path(scenarios_dir), want)
+        return _from_file(Path(proofs_json), want, keep={p.stem for p in paths})
+    fixed = [o for o in collect_obligations(scenarios_dir) if o.id in FIXED_IDS]
+    return _fresh(fixed + scenario_obligations(paths), want)
+
+
+def audited_ids(files: Sequence[str | Path]) -> tuple[str, ...]:
+    """The ids a report on ``files`` must show: the scenario-independent ones, then the four
+    per-scenario checks of each file (by its stem), in the order given."""
+    from ..proofs import FIXED_IDS, SCENARIO_CHECKS, scenario_check_id
+
+    return FIXED_IDS + tuple(scenario_check_id(Path(f).stem, c) for f in files
+                             for c in SCENARIO_CHECKS)
+
+
+def _scenario_stem(ident: str) -> str | None:
+    """The workcell stem of a per-scenario id (Scenario.<stem>.<check>), else None."""
+    from ..proofs import SCENARIO_CHECKS
+
+    parts = ident.split(".")
+    if len(parts) >= 3 and parts[0] == "Scenario" and parts[-1] in SCENARIO_CHECKS:
+        return ".".join(parts[1:-1])
+    return None
 
 
 def check_ids(ids: Sequence[str], expected: Sequence[str]) -> tuple[tuple[str, ...],
@@ -147,7 +188,7 @@ def _column(r: ObligationRow) -> str:
 
 # --- from results.json ------------------------------------------------------------------------
 
-def _from_file(path: Path, expected: Sequence[str]) -> ProofData:
+def _from_file(path: Path, expected: Sequence[str], keep: set[str] | None = None) -> ProofData:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
@@ -160,12 +201,20 @@ def _from_file(path: Path, expected: Sequence[str]) -> ProofData:
     if not isinstance(items, list):
         raise InputError("proofs_json", str(path), "has no 'obligations' list")
     rows = tuple(_row_from_json(item, k, path) for k, item in enumerate(items))
+    left_out: list[str] = []
+    if keep is not None:   # other workcells' checks are not this report's
+        left_out = sorted({stem for r in rows if (stem := _scenario_stem(r.id)) is not None
+                           and stem not in keep})
+        rows = tuple(r for r in rows if _scenario_stem(r.id) in keep or _scenario_stem(r.id)
+                     is None)
     ledger_doc = doc.get("assumptions")
     ledger = _ledger_entries(ledger_doc) if isinstance(ledger_doc, list) else ()
     missing, unexpected = check_ids([r.id for r in rows], expected)
     run = doc.get("run") if isinstance(doc.get("run"), dict) else None
     return ProofData(available=True, source=f"read from {path}",
-                     note="the results the prove run recorded, not re-run for this report",
+                     note="the results the prove run recorded, not re-run for this report"
+                     + (f"; left out, as not the workcells reported on: the checks of "
+                        f"{', '.join(left_out)}" if left_out else ""),
                      rows=rows, ledger=ledger, ledger_available=isinstance(ledger_doc, list),
                      missing_ids=missing, unexpected_ids=unexpected, run=run,
                      not_run=tuple(r.id for r in rows if r.change == "not run"))
@@ -186,22 +235,36 @@ def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
         expected=str(item.get("expected", "proved")),
         seconds=float(seconds) if isinstance(seconds, (int, float)) else None,
         counterexample=item.get("counterexample"), reason=str(item.get("reason", "")),
-        sha256=str(item.get("sha256", "")), change=item.get("change"))
+        sha256=str(item.get("sha256", "")), change=item.get("change"),
+        depth=item.get("depth") if isinstance(item.get("depth"), str) else None,
+        solvers=tuple(str(s) for s in item.get("solvers") or ()),
+        label=str(item.get("label") or ""), z3_only=_z3_only(item.get("vcs")))
+
+
+def _z3_only(vcs: Any) -> tuple[str, ...]:
+    """'VC: why' for each VC of a results.json entry that Z3 alone confirms."""
+    out = []
+    for v in vcs if isinstance(vcs, list) else ():
+        if isinstance(v, dict) and list(v.get("solvers") or ()) == ["z3"]:
+            out.append(f"{v.get('name')}: {v.get('note') or 'no second solver confirmed it'}")
+    return tuple(out)
 
 
 # --- a fresh run --------------------------------------------------------------------------------
 
-def _fresh(scenarios_dir: Path, expected: Sequence[str]) -> ProofData:
-    from ..proofs import ASSUMPTIONS, collect_obligations, discharge
+def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
+    from ..proofs import ASSUMPTIONS, discharge
 
     rows = []
-    for ob in collect_obligations(scenarios_dir):
+    for ob in obligations:
         p = discharge(ob)
         rows.append(ObligationRow(
             id=ob.id, group=ob.group, paper_ref=ob.paper_ref, statement=ob.statement,
             method=p.method.value, verdict=p.verdict.value, expected=p.expected.value,
             seconds=float(p.seconds), counterexample=p.counterexample, reason=p.reason,
-            sha256=p.sha256))
+            sha256=p.sha256, depth=p.depth, solvers=p.solvers, label=p.label,
+            z3_only=tuple(f"{v.name}: {v.note or 'no second solver confirmed it'}"
+                          for v in p.vcs if v.solvers == ("z3",))))
     missing, unexpected = check_ids([r.id for r in rows], expected)
     return ProofData(available=True, source="a fresh run of the prove machinery for this report",
                      note=f"{len(rows)} obligations discharged in this process, "

@@ -25,20 +25,29 @@ from ._batch import BATCH_JSON, batch_table, check_plan_folder, find_plan_folder
 from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
 from ._engine import (CONNECT_TIMEOUT_S, RETRIES, Engine, ProgressBar, TaskLost,
                       check_scheduler_address, error_message)
-from ._contracts import DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json, violation_json
+from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json,
+                         optimality_failures, violation_json)
 from ._plan import CERTIFICATE, PlanResult, plan, plan_json, versions, write_plan
+from ._trajectory_runs import (BLOCK_ROWS, Excursion, MonitorResult, certify_json, log_csv,
+                               monitor_json, monitor_log, parse_excursion, run_certify,
+                               run_monitor, run_simulate, simulate_log)
 from ._selftest import (FAULTS, SAMPLE, WORKCELLS, Fault, SelftestRow, run_fault, run_selftest,
                         selftest_rows, selftest_table, workcell)
 
 __all__ = [
     # a plan under contracts (docs/model.md §7, §9)
     "CERTIFICATE", "DEFAULT_SAMPLE", "Mode", "PlanResult", "Settings", "TripleRun",
-    "contracts_json", "plan", "plan_json", "versions", "violation_json", "write_plan",
+    "contracts_json", "optimality_failures", "plan", "plan_json", "versions", "violation_json",
+    "write_plan",
     # another planner's files
     "CheckReport", "check_outputs", "read_dr", "read_plan", "run_check",
     "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
     "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost",
     "check_scheduler_address", "error_message",
+    # any planner's trajectory (docs/model.md §12)
+    "BLOCK_ROWS", "Excursion", "MonitorResult", "certify_json", "log_csv", "monitor_json",
+    "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",
+    "simulate_log",
     # seeded faults
     "FAULTS", "Fault", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault", "run_selftest",
     "selftest_rows", "selftest_table", "workcell",

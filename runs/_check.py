@@ -2,10 +2,12 @@
 
 The outputs are docs/model.md §9's dr.npy and plan.json. Checked, all in full: D_R's shape and dtype
 and Theorem 1/3's postcondition for the plan's variant at every cell (the spec's own regions);
-the path by is_path; J1 and J2 as reported; optimality against opt_path (the spec's independent
-search); the continuous-time certificate. Also, when plan.json states them: the scenario's
-hash, the grid, the angles of the path's cells, and dr_sha256 against the dr file's bytes (a
-mismatch means the two files are not from the same run).
+the path by is_path; J1 and J2 as reported; optimality (or that no path exists) through a
+witness verified by ``spec.check_witness`` (docs/model.md §11): the ``--witness`` file, else one
+computed by the fast search, so that what is trusted is the spec's checker; the continuous-time
+certificate. Also, when plan.json states them: the scenario's hash, the grid, the angles of the
+path's cells, dr_sha256 against the dr file's bytes (a mismatch means the two files are not from
+the same run) and witness_sha256 against the witness file's.
 Exit 0 when everything holds, 1 with a listing of what failed, 2 when an input cannot be read
 (missing file, not .npy, bad JSON, missing or mistyped keys), as ``file: error: ...``.
 """
@@ -27,7 +29,7 @@ from ..errors import MISSING, ContractViolation, InputError
 from ..spec import Grid, Scenario, Variant, load_scenario, make_grid
 from ..spec import certify, require_clear
 from ..spec import SearchResult, SearchStatus
-from ..spec import cost_failures, search_triple
+from ..spec import Witness, cost_failures, load_witness, search_triple
 from ._contracts import Mode, Settings, TripleRun, builtdr_post, search_post, search_pre
 from ._plan import CERTIFICATE
 
@@ -48,6 +50,7 @@ class PlanDoc:
     grid: dict[str, Any] | None
     angles: tuple[tuple[float, float], ...] | None
     dr_sha256: str | None = None
+    witness_sha256: str | None = None
 
 
 @dataclass(frozen=True)
@@ -84,28 +87,36 @@ class CheckReport:
         return "\n".join(out)
 
 
-def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | Path) -> int:
-    """Check the outputs, print the listing; 0 all hold, 1 some failed, 2 unreadable input."""
+def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | Path,
+              witness_path: str | Path | None = None) -> int:
+    """Check the outputs, print the listing; 0 all hold, 1 some failed, 2 unreadable input.
+    ``witness_path``: a witness file (`cfmpa plan --witness`) to verify instead of computing one."""
     try:
         s = load_scenario(scenario_path)
         dr = read_dr(dr_path)
         dr_sha = _file_sha256(dr_path)
         doc = read_plan(plan_path)
+        witness = witness_sha = None
+        if witness_path is not None:
+            witness = load_witness(witness_path)
+            witness_sha = _file_sha256(witness_path, "witness")
     except InputError as exc:
         print(exc.render(), file=sys.stderr)
         return 2
     print(f"check     {Path(dr_path)} and {Path(plan_path)} against {s.name} ({scenario_path}), "
-          f"variant {doc.variant.value}")
-    report = check_outputs(s, dr, doc, dr_sha256=dr_sha)
+          f"variant {doc.variant.value}"
+          + ("" if witness_path is None else f", witness {Path(witness_path)}"))
+    report = check_outputs(s, dr, doc, dr_sha256=dr_sha, witness=witness,
+                           witness_sha256=witness_sha)
     print(report.text())
     return 0 if report.ok else 1
 
 
-def _file_sha256(path: str | Path) -> str:
+def _file_sha256(path: str | Path, field: str = "dr") -> str:
     try:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
     except OSError as exc:
-        raise InputError("dr", MISSING, f"cannot be read ({exc.strerror or exc})",
+        raise InputError(field, MISSING, f"cannot be read ({exc.strerror or exc})",
                          source=str(path)) from None
 
 
@@ -176,6 +187,9 @@ def read_plan(path: str | Path) -> PlanDoc:
     dr_sha = doc.get("dr_sha256")
     if dr_sha is not None and not isinstance(dr_sha, str):
         raise bad("dr_sha256", dr_sha, "must be a string")
+    witness_sha = doc.get("witness_sha256")
+    if witness_sha is not None and not isinstance(witness_sha, str):
+        raise bad("witness_sha256", witness_sha, "must be a string")
     grid = doc.get("grid")
     if grid is not None and not isinstance(grid, dict):
         raise bad("grid", grid, "must be an object")
@@ -186,21 +200,27 @@ def read_plan(path: str | Path) -> PlanDoc:
                 for a in angles):
             raise bad("angles", _short(angles), "must be a list of [t1, t2] number pairs")
         angles = tuple((float(a[0]), float(a[1])) for a in angles)
-    return PlanDoc(variant, result, sha, grid, angles, dr_sha)
+    return PlanDoc(variant, result, sha, grid, angles, dr_sha, witness_sha)
 
 
 def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc, *,
-                  dr_sha256: str | None = None) -> CheckReport:
+                  dr_sha256: str | None = None, witness: Witness | None = None,
+                  witness_sha256: str | None = None) -> CheckReport:
     """Every check of this module on already-read outputs (see the module docstring).
 
     ``dr_sha256`` is the hash of the dr file's bytes, checked against plan.json's when both
-    are known."""
+    are known; likewise ``witness_sha256``, the witness file's. ``witness`` is verified for
+    post.optimal; without it the fast search computes one."""
     g = make_grid(s)
     lines: list[CheckLine] = []
     if doc.dr_sha256 is not None and dr_sha256 is not None:
         lines.append(_line(doc.dr_sha256 == dr_sha256, "plan.json dr_sha256 is the dr file's "
                            "(the two files are from one run)",
                            (("plan's", doc.dr_sha256), ("file's", dr_sha256))))
+    if doc.witness_sha256 is not None and witness_sha256 is not None:
+        lines.append(_line(doc.witness_sha256 == witness_sha256, "plan.json witness_sha256 is "
+                           "the witness file's", (("plan's", doc.witness_sha256),
+                                                  ("file's", witness_sha256))))
     if doc.sha256 is not None and s.sha256:
         lines.append(_line(doc.sha256 == s.sha256, "plan.json scenario_sha256 is the scenario "
                            "file's", (("plan's", doc.sha256), ("file's", s.sha256))))
@@ -214,7 +234,7 @@ def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc, *,
     shape_ok = not any(f.condition == "post.shape" for f in post.failures)
     if shape_ok:
         lines += _run_lines(search_pre(doc.variant, g, dr, start, goal, post))
-        lines += _run_lines(search_post(doc.variant, dr, start, goal, r, full))
+        lines += _run_lines(search_post(doc.variant, dr, start, goal, r, full, witness=witness))
     else:
         # J1 and J2 are the path's alone: a bad D_R does not excuse misreported costs.
         costs = cost_failures(r)

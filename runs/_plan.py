@@ -9,11 +9,12 @@ violations (they are the evidence); `cfmpa plan` then exits 1.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import platform
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -23,17 +24,18 @@ import numpy.typing as npt
 from .. import __version__
 from ..files import dumps_json, npy_bytes, write_bytes_atomic
 from ..errors import ContractViolation
-from ..impl import build_dr_fast, kernel_name, search_opt_path_fast
+from ..impl import build_dr_fast, kernel_name, search_opt_path, search_opt_path_fast
 from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
 from ..spec import Certificate, certificate_json, certify, require_clear
 from ..spec import SearchResult, SearchStatus
+from ..spec import executed_trajectory, tolerance_rad, trajectory_csv
 from ..spec import ExactGaps, exact_path_gaps
 from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
                          checked_search, contracts_json, violation_json)
 
 R = TypeVar("R")
 
-__all__ = ["CERTIFICATE", "PlanResult", "plan", "plan_json", "write_plan", "versions"]
+__all__ = ["CERTIFICATE", "TRAJ_CSV", "PlanResult", "plan", "plan_json", "write_plan", "versions"]
 
 
 @dataclass(frozen=True)
@@ -88,7 +90,7 @@ def versions() -> dict[str, str]:
 def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
          sample: int | None = None, stop: bool = True, grid: Grid | None = None,
          build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast,
-         kernel: str | None = None) -> PlanResult:
+         kernel: str | None = None, witness: bool = False) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
 
     ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
@@ -104,12 +106,19 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     "custom" for anything else). With the fast kernels, the first run in a process first calls
     them on a tiny input, so that timings_s.kernel_load holds numba's compile or cache-load time
     and build_dr / search hold the work alone (kernel_load is 0.0 once they are loaded).
+    ``witness`` (and ``full`` contracts) ask the search for its certificate
+    (``SearchResult.witness``, docs/model.md §11; a search that makes none gets the fast
+    search's), which ``write_plan`` can write and ``full`` verifies; timings_s.search then
+    includes making it. The result keeps it only when ``witness`` asked for it.
     """
     v = Variant(variant)
     settings = Settings.of(contracts, seed, sample)
     g = grid or make_grid(s)
     enforce = settings.mode is not Mode.OFF
     kernel = kernel or kernel_name(build, search)
+    if (witness or settings.mode is Mode.FULL) and search in (search_opt_path,
+                                                              search_opt_path_fast):
+        search = functools.partial(search, with_witness=True)
     t: dict[str, float] = {}
     if kernel == "fast":
         t["kernel_load"] = _load_fast_kernels()
@@ -123,6 +132,11 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     if enforce:
         t["contracts_search"] = time.perf_counter() - t0 - t["search"]
     runs += search_runs
+    if witness and result.witness is None:
+        made = search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, with_witness=True)
+        result = replace(result, witness=made.witness)
+    elif not witness and result.witness is not None:
+        result = replace(result, witness=None)    # checked; not kept (it is N + 1 grids large)
     cert = None
     exact = None
     if result.status is SearchStatus.FOUND:
@@ -208,8 +222,12 @@ def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[...,
     return run
 
 
-def plan_json(p: PlanResult, dr_bytes: bytes | None = None) -> dict[str, Any]:
+def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
+              witness_bytes: bytes | None = None) -> dict[str, Any]:
     """The plan.json document of docs/model.md §9 (keys are stable: add, never rename).
+
+    ``witness_sha256`` (only when ``witness_bytes``, the witness file's, are given) is their
+    sha256, so that `cfmpa check --witness` can tell a witness file of another run.
 
     ``dr_sha256`` is the sha256 of dr.npy's bytes (``dr_bytes``, by default ``npy_bytes(p.dr)``,
     what write_plan writes), so that a dr.npy from another run is detectable. In ``clearance``,
@@ -236,18 +254,42 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None) -> dict[str, Any]:
         "dr_sha256": hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest(),
         "kernel": p.kernel,
         "clearance": certificate_json(p.certificate) if p.certificate is not None else None,
+        "tolerance_rad": (tolerance_rad(p.scenario, p.certificate)
+                          if p.certificate is not None else None),
         "exact_gaps": p.exact.as_json() if p.exact is not None else None,
         "contracts": p.contracts,
         "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
         "versions": versions(),
-    }
+    } | ({} if witness_bytes is None else
+         {"witness_sha256": hashlib.sha256(witness_bytes).hexdigest()})
 
 
-def write_plan(p: PlanResult, out: str | Path) -> tuple[Path, Path]:
+#: The executed motion of a found path, beside plan.json (docs/model.md §9, §12).
+TRAJ_CSV = "traj.csv"
+
+
+def write_plan(p: PlanResult, out: str | Path, *,
+               witness: str | Path | None = None) -> tuple[Path, Path]:
     """Write DIR/dr.npy and DIR/plan.json, each atomically (temporary name, then rename);
-    plan.json's dr_sha256 is the hash of the very bytes written to dr.npy."""
+    plan.json's dr_sha256 is the hash of the very bytes written to dr.npy. For a found path
+    also DIR/traj.csv, its executed motion (one row per step, `cfmpa certify` reads it); with
+    no path a traj.csv left by an earlier run is deleted. ``witness``: also write the search's
+    witness there (npz, ``spec.Witness``; plan() with witness=True makes it), its hash in
+    plan.json as ``witness_sha256``."""
     out = Path(out)
     data = npy_bytes(p.dr)
+    proof = None
+    if witness is not None:
+        if p.search.witness is None:
+            raise ValueError("write_plan(witness=...) needs a plan made with witness=True")
+        proof = p.search.witness.npz_bytes()
+        write_bytes_atomic(witness, proof)
     dr_path = write_bytes_atomic(out / "dr.npy", data)
-    plan_path = write_bytes_atomic(out / "plan.json", dumps_json(plan_json(p, data)).encode())
+    if p.search.status is SearchStatus.FOUND:
+        traj = executed_trajectory(p.scenario, p.grid, p.search.path)
+        write_bytes_atomic(out / TRAJ_CSV, trajectory_csv(traj).encode())
+    else:
+        (out / TRAJ_CSV).unlink(missing_ok=True)
+    plan_path = write_bytes_atomic(out / "plan.json",
+                                   dumps_json(plan_json(p, data, proof)).encode())
     return dr_path, plan_path

@@ -1,7 +1,9 @@
 """Mutation self-check: evidence that the contracts can fail. Each fault is seeded into BuiltDR,
 the grid or searchoptpath, the planner runs under contracts, and we record what caught it.
 
-Every fault must be caught in ``full`` mode; the table also records what ``sampled`` catches (with
+Every fault must be caught in ``full`` mode (optimality there through a witness that the spec's
+checker verifies: the forged witness fault hands it a false one); the table also records what
+``sampled`` catches (with
 a SAMPLE-cell sample, about 1% of the small grids used here; the default 4096 cells are 0.06% of
 the default grid). Runs use ``stop=False``, so every postcondition that fails is listed, not
 only the first. Each construction asserts its own defining property with direct computations
@@ -28,7 +30,7 @@ import numpy.typing as npt
 from ..errors import CertificateViolation, CfmpaError, ContractViolation
 from ..impl import build_dr, search_opt_path
 from ..spec import Grid, Scenario, Variant, exact_tf, make_grid, parse_scenario
-from ..spec import J1, J2, SearchResult, SearchStatus, is_path_paper, opt_path
+from ..spec import J1, J2, MOVES, SearchResult, SearchStatus, Witness, is_path_paper, opt_path
 from ._contracts import Mode
 from ._plan import plan
 
@@ -195,6 +197,29 @@ def _non_optimal(s: Scenario, v: Variant, g: Grid) -> Mutant:
                   "reported")
 
 
+def _forged_witness(s: Scenario, v: Variant, g: Grid) -> Mutant:
+    """The non-optimal path with a forged witness: the optimum's labels, with every goal state's
+    label raised so that the least goal label (plus the stop term) is the path's cost."""
+    worse_search = _non_optimal(s, v, g).search
+
+    def search(dr: DR, start: Cell, goal: Cell) -> SearchResult:
+        worse = worse_search(dr, start, goal)
+        best = search_opt_path(dr, start, goal, with_witness=True)
+        j1, j2 = best.witness.j1.copy(), best.witness.j2.copy()
+        N, (gi, gj) = dr.shape[0] - 1, goal
+        stop = np.abs(np.asarray(MOVES)).sum(axis=1)
+        j1[N, :, gi, gj] = worse.J1
+        j2[N, :, gi, gj] = np.maximum(worse.J2 - stop, 0)
+        least = min((int(a), int(b) + int(c)) for a, b, c in zip(j1[N, :, gi, gj],
+                                                                  j2[N, :, gi, gj], stop))
+        _require(least == (worse.J1, worse.J2) and least > (best.J1, best.J2),
+                 "the forged goal labels do not claim the worse path's cost")
+        return replace(worse, witness=Witness.of_labels(j1, j2))
+
+    return Mutant(search=search, detail="the non-optimal path, the optimum's labels raised at "
+                  "the goal to its cost; true costs reported")
+
+
 def _jump(s: Scenario, v: Variant, g: Grid) -> Mutant:
     """The optimal path with one cell dropped where that leaves a step of 2 in a coordinate."""
     def search(dr: DR, start: Cell, goal: Cell) -> SearchResult:
@@ -253,6 +278,7 @@ FAULTS: tuple[Fault, ...] = (
     Fault("N rounded down", "small", Variant.MODIFIED, _n_rounded_down),
     Fault("cell grid coarser than omega dt", "small", Variant.MODIFIED, _coarse_grid),
     Fault("non-optimal path", "small", Variant.MODIFIED, _non_optimal),
+    Fault("forged witness", "small", Variant.MODIFIED, _forged_witness),
     Fault("path with a jump", "small", Variant.MODIFIED, _jump),
     Fault("path ends early at a goal swept later", "early-arrival", Variant.MODIFIED,
           _early_arrival),
@@ -325,7 +351,7 @@ def selftest_table(rows: tuple[SelftestRow, ...], *, sample: int = SAMPLE, seed:
     out.append("")
     out += [f"{r.fault}: {r.detail} [{r.workcell}]" for r in rows]
     out.append(f"sampled: {sample} random cells (seed {seed}) plus the cells the path occupies; "
-               "full: every cell, and optimality by opt_path")
+               "full: every cell, and optimality through a witness verified by the spec")
     return "\n".join(out)
 
 

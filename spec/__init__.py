@@ -3,10 +3,15 @@
 The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 """
 
+from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
 from ._grid import (EPS, Grid, Variant, exact_n, exact_tf, joint_points, left_angles, left_box,
                     make_grid, rest_is_goal, right_box)
 from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
+from ._trajectory import (Trajectory, certify_trajectory, csv_column_order, executed_trajectory,
+                          load_trajectory, parse_trajectory_csv, parse_trajectory_json,
+                          tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
+from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
 from ._kinematics import arm_corners, joints, link_corners
 from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                      Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
@@ -17,11 +22,13 @@ from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightA
 from ._triples import (TRIPLES, Failure, Triple, builtdr_triple, cells_failures, cost_failures,
                        dr_cell_failures, dr_shape_failures, grid_failures, path_cells,
                        search_failures, search_triple)
+from ._witness import LABEL_LIMITS, WITNESS_FORMAT, Witness, check_witness, load_witness
 
 __all__ = [
     # scenario, grids and motion (docs/model.md §2-§3)
     "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm",
     "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
+    "MAX_EXTRA_POINTS", "decimal", "joint_grid",
     "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_is_goal", "right_box",
     # geometry
     "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
@@ -34,6 +41,12 @@ __all__ = [
     "dr_cell_failures", "dr_shape_failures", "grid_failures", "path_cells", "search_failures",
     "search_triple",
     "Certificate", "ContactDetail", "certificate_json", "certify", "require_clear",
+    # witnesses of the search's answer (docs/model.md §11)
+    "LABEL_LIMITS", "WITNESS_FORMAT", "Witness", "check_witness", "load_witness",
     # the path's cells re-decided in ball arithmetic (docs/model.md §7)
     "ExactCell", "ExactGaps", "exact_path_gaps",
+    # trajectories and the tolerance tube (docs/model.md §12)
+    "TRAJECTORY_COLUMNS", "Trajectory", "certify_trajectory", "csv_column_order",
+    "executed_trajectory", "load_trajectory", "parse_trajectory_csv", "parse_trajectory_json",
+    "tolerance_rad", "trajectory_csv", "trajectory_distances", "tube_lipschitz",
 ]

@@ -4,6 +4,10 @@ For all k <= N, i < m, j < n: P[k, i, j] = (dist(S_LArm[k], S_RArm[i][j]) > eps 
 regions come from ``_regions`` and distances from shapely (GEOS), sharing no code with impl/.
 Two float computations of the same polygons can differ by rounding, so a cell whose spec
 distance lies within ``band`` of eps is counted as indeterminate and accepted either way.
+
+``expected_cells`` is the definition, cell by cell (the sampled contracts use it);
+``full_verdicts`` decides every cell the same way, vectorised with rigorous bounds on the same
+regions, leaving to ``expected_cells`` the cells no bound decides (tests check the two agree).
 """
 
 from __future__ import annotations
@@ -15,10 +19,12 @@ import numpy.typing as npt
 import shapely
 
 from ._grid import EPS, Grid, Variant
-from ._regions import left_region_polygons, right_region_polygons
+from ._kinematics import corners
+from ._regions import left_region_polygons, margin, right_region_polygons
 from ._scenario import Scenario
 
-__all__ = ["BAND", "CellMismatch", "PostReport", "dr_postcondition", "expected_cells"]
+__all__ = ["BAND", "SLACK", "CellMismatch", "PostReport", "dr_postcondition", "expected_cells",
+           "full_verdicts"]
 
 #: Distances within this of eps (metres) may be decided either way by two float computations.
 BAND = 1e-10
@@ -68,41 +74,255 @@ def dr_postcondition(s: Scenario, variant: Variant | str, grid: Grid, dr: npt.ND
                      band: float = BAND, limit: int = 20) -> PostReport:
     """Check dr against the triple at ``cells`` ((C, 3) array of k, i, j), or at every cell.
 
-    Returns at most ``limit`` mismatches (the count of checked cells is exact).
+    At given cells the distances are ``expected_cells``'s (the definition); at every cell the
+    verdicts are ``full_verdicts``'s, the same decisions vectorised. Returns at most ``limit``
+    mismatches, each with the definition's distance (the count of checked cells is exact).
     """
     if cells is None:
-        k, i, j = np.meshgrid(np.arange(grid.N + 1), np.arange(grid.m), np.arange(grid.n),
-                              indexing="ij")
-        k, i, j = k.ravel(), i.ravel(), j.ravel()
-        # One layer's right regions serve all layers: compute them once, reuse per layer.
-        dist = _all_layers(s, variant, grid)
+        expected, near = (a.ravel() for a in full_verdicts(s, variant, grid, eps=eps, band=band))
+        got = np.asarray(dr).reshape(-1).astype(np.int8)
+        checked = got.size
     else:
         k, i, j = cells[:, 0], cells[:, 1], cells[:, 2]
         dist = expected_cells(s, variant, grid, k, i, j)
-    got = dr[k, i, j].astype(int)
-    expected = (dist <= eps).astype(int)
-    near = np.abs(dist - eps) <= band
+        expected = (dist <= eps).astype(np.int8)
+        near = np.abs(dist - eps) <= band
+        got = dr[k, i, j].astype(np.int8)
+        checked = len(k)
     bad = np.flatnonzero((got != expected) & ~near)
+    shown = bad[:limit]
+    at = np.unravel_index(shown, grid.shape) if cells is None else (k[shown], i[shown], j[shown])
+    dist_shown = expected_cells(s, variant, grid, *at)
     mismatches = tuple(
-        CellMismatch(layer=int(k[c]), cell=(int(i[c]), int(j[c])),
-                     angles=grid.angles((int(i[c]), int(j[c]))), got=int(got[c]),
-                     expected=int(expected[c]), distance_m=float(dist[c]))
-        for c in bad[:limit])
-    return PostReport(ok=len(bad) == 0, checked=len(k),
+        CellMismatch(layer=int(kk), cell=(int(ii), int(jj)),
+                     angles=grid.angles((int(ii), int(jj))), got=int(got[c]),
+                     expected=int(expected[c]), distance_m=float(d))
+        for c, kk, ii, jj, d in zip(shown, *at, dist_shown))
+    return PostReport(ok=len(bad) == 0, checked=checked,
                       indeterminate=int(((got != expected) & near).sum()), mismatches=mismatches)
 
 
-def _all_layers(s: Scenario, variant: Variant | str, grid: Grid) -> npt.NDArray[np.float64]:
-    ii, jj = np.meshgrid(np.arange(grid.m), np.arange(grid.n), indexing="ij")
-    r1, r2 = right_region_polygons(s, grid, ii.ravel(), jj.ravel())
-    shapely.prepare(r1)
-    shapely.prepare(r2)
+# --- every cell, vectorised ------------------------------------------------------------------
+#
+# A cell's distance is the least over four pairs: a left region (link 1 or 2 of layer k) and a
+# right region (link 1, which depends on the row i alone, or link 2). Link 1's pairs are few
+# (2 (N + 1) m) and get the definition's shapely distance where their boxes are close. Link 2's
+# (2 (N + 1) m n) are decided by bounds that are rigorous for convex sets, in numpy over whole
+# layers:
+#   1. bounding boxes: a gap above the limit below means free;
+#   2. the axis of link 2's rectangle at the cell's own angles (inside its region) crossing the
+#      left region (clipped by its edges' half-planes), or a corner of the left region inside
+#      that rectangle, means they meet: blocked;
+#   3. the gap of the two projections on link 2's direction or its normal: free above the limit;
+#   4. the separating-axis test on the edges of both convex polygons (one-sided: the other
+#      polygon beyond an edge's line): no separating edge means they meet (blocked), a gap
+#      above the limit means free (a gap on any unit axis is at most the distance).
+# A free verdict needs every gap above eps + band + SLACK, SLACK covering the rounding of two
+# float computations of one polygon; a cell no bound decides (a distance within about eps of
+# eps: none on the bundled scenarios) is decided by ``expected_cells`` itself. The right link-2
+# region of a cell is the hull of its 36 lattice corners; its hull corners are found on the
+# first row, and every other row is that row turned about the base by t_i - t_0 (changing t1
+# moves link 2 rigidly), rounding far inside SLACK.
+
+#: Metres a bound may be off by float rounding (of order 1e-16 m here); far below BAND.
+SLACK = 1e-12
+
+
+def full_verdicts(s: Scenario, variant: Variant | str, grid: Grid, *, eps: float = EPS,
+                  band: float = BAND) -> tuple[npt.NDArray[np.int8], npt.NDArray[np.bool_]]:
+    """For every cell (N + 1, m, n): the expected D_R value (dist <= eps -> 1 | 0) and whether it
+    is indeterminate (|dist - eps| <= band), as ``expected_cells`` decides them."""
+    N, m, n = grid.N, grid.m, grid.n
     left = left_region_polygons(s, variant, grid)
-    out = np.empty((grid.N + 1, grid.m * grid.n))
+    rows = np.arange(m)
+    r1, _ = right_region_polygons(s, grid, rows, np.zeros_like(rows))
+    b1 = shapely.bounds(r1)
+    free_at = eps + band + SLACK
+    link2 = _Link2(s, grid)
+    expected = np.zeros((N + 1, m * n), dtype=np.int8)
+    undecided = np.zeros((N + 1, m * n), dtype=bool)
     for k, links in enumerate(left):
-        d = np.full(grid.m * grid.n, np.inf)
+        d1 = np.full(m, np.inf)        # inf: more than free_at (the boxes' gap shows it)
         for a in links:
-            d = np.minimum(d, shapely.distance(a, r1))
-            d = np.minimum(d, shapely.distance(a, r2))
-        out[k] = d
-    return out.ravel()
+            close = np.flatnonzero(_box_gap(shapely.bounds(a), b1) <= free_at)
+            d1[close] = np.minimum(d1[close], shapely.distance(a, r1[close]))   # exact
+        meets = np.repeat(d1 <= eps - band, n)
+        unsure = np.repeat(np.abs(d1 - eps) <= band, n)
+        for a in links:
+            hit, open_ = link2.decide(a, free_at, meets)
+            meets |= hit
+            unsure |= open_
+        expected[k] = meets
+        undecided[k] = unsure & ~meets
+    near = np.zeros((N + 1, m * n), dtype=bool)
+    kk, cc = np.nonzero(undecided)
+    if kk.size:
+        dist = expected_cells(s, variant, grid, kk, cc // n, cc % n)
+        expected[kk, cc] = dist <= eps
+        near[kk, cc] = np.abs(dist - eps) <= band
+    return expected.reshape(N + 1, m, n), near.reshape(N + 1, m, n)
+
+
+def _box_gap(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """The larger per-axis gap between box a (4,) and boxes b (K, 4), (xmin, ymin, xmax, ymax):
+    at most the distance between anything inside them."""
+    return np.maximum(np.maximum(a[0] - b[:, 2], b[:, 0] - a[2]),
+                      np.maximum(a[1] - b[:, 3], b[:, 1] - a[3]))
+
+
+class _Link2:
+    """The right link-2 regions of every cell, prepared for the bounds: boxes, the axis of the
+    rectangle at the cell's own angles, the extents along it and its normal, the hull
+    (counter-clockwise) and its edges. Arrays hold cells last, (corners, cells), so that the
+    bounds reduce over the first axis."""
+
+    def __init__(self, s: Scenario, grid: Grid) -> None:
+        m, n, h = grid.m, grid.n, grid.h
+        steps = np.array([-1.0, 0.0, 1.0])
+        ti = grid.lo[0] + np.arange(m) * h[0]
+        tj = grid.lo[1] + np.arange(n) * h[1]
+        t1 = ti[0] + steps[:, None] * h[0]
+        t2 = tj[:, None, None] + steps[None, :] * h[1]
+        t1, t2 = np.broadcast_arrays(t1, t2)            # (n, 3, 3): the first row's lattices
+        grow = margin(s.right, 1, h, (3, 3))
+        pts = corners(s.right, t1, t2, 1, s.right.width / 2 + grow).reshape(n, 36, 2)
+        order, self.flat = _hull_order(pts)             # (n, L): the first row's hull corners
+        hull = np.take_along_axis(pts, order[:, :, None], axis=1)       # (n, L, 2)
+        # Row i is row 0 turned about the base by t_i - t_0, and so are its hull corners, axis
+        # and edge normals.
+        turn = ti - ti[0]
+        cos, sin = np.cos(turn)[None, :, None], np.sin(turn)[None, :, None]   # (1, m, 1)
+        bx, by = s.right.base
+
+        def rotate(x: npt.NDArray[np.float64], y: npt.NDArray[np.float64], about: bool
+                   ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+            """Points (about the base) or directions (not), (K, n), of row 0 -> (K, m n)."""
+            ox, oy = (bx, by) if about else (0.0, 0.0)
+            x, y = (x - ox)[:, None, :], (y - oy)[:, None, :]
+            k = x.shape[0]
+            return ((ox + cos * x - sin * y).reshape(k, m * n),
+                    (oy + sin * x + cos * y).reshape(k, m * n))
+
+        self.hx, self.hy = rotate(hull[..., 0].T, hull[..., 1].T, True)       # (L, cells)
+        nx0, ny0, _ = _edges(hull[..., 0].T, hull[..., 1].T)
+        self.nx, self.ny = rotate(nx0, ny0, False)
+        self.offset = self.nx * self.hx + self.ny * self.hy
+        self.box = (self.hx.min(axis=0), self.hy.min(axis=0), self.hx.max(axis=0),
+                    self.hy.max(axis=0))
+        # The rectangle at the cell's own angles (lattice point 4 of 9) lies in the region; its
+        # axis runs between the midpoints of its short sides.
+        ends = np.stack([(pts[:, 16] + pts[:, 19]) / 2, (pts[:, 17] + pts[:, 18]) / 2])
+        ex, ey = rotate(ends[..., 0], ends[..., 1], True)                    # (2, cells)
+        self.q0, self.d = (ex[0], ey[0]), (ex[1] - ex[0], ey[1] - ey[0])
+        length = np.hypot(*self.d)
+        self.u = (self.d[0] / length, self.d[1] / length)
+        self.v = (-self.u[1], self.u[0])
+        pu = self.hx * self.u[0] + self.hy * self.u[1]
+        pv = self.hx * self.v[0] + self.hy * self.v[1]
+        self.ext = (pu.min(axis=0), pu.max(axis=0), pv.min(axis=0), pv.max(axis=0))
+        # The rectangle itself in its frame: u from q0 to q1, v within +-(half its width).
+        self.core = (ex[0] * self.u[0] + ey[0] * self.u[1], ex[1] * self.u[0] + ey[1] * self.u[1],
+                     ex[0] * self.v[0] + ey[0] * self.v[1], s.right.width / 2 + grow)
+
+    def decide(self, a: shapely.Geometry, free_at: float, skip: npt.NDArray[np.bool_]
+               ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
+        """(meets, undecided) per cell for the left region ``a``: meets where the two regions
+        certainly meet, undecided where no bound shows a gap above ``free_at`` either; cells
+        in ``skip`` (already known to be blocked) are left out."""
+        C = skip.shape[0]
+        meets = np.zeros(C, dtype=bool)
+        undecided = np.zeros(C, dtype=bool)
+        if self.flat or shapely.get_type_id(a) != 3:
+            # A region that is not a polygon (of zero width: not with links of width > 0) is
+            # left to the definition, cell by cell.
+            return meets, ~skip
+        A = _ccw(shapely.get_coordinates(a)[:-1])
+        ax, ay = A[:, 0:1], A[:, 1:2]                                    # (V, 1)
+        bx0, by0, bx1, by1 = self.box
+        gap = np.maximum(np.maximum(ax.min() - bx1, bx0 - ax.max()),
+                         np.maximum(ay.min() - by1, by0 - ay.max()))
+        c = np.flatnonzero((gap <= free_at) & ~skip)                     # 1. boxes
+        if c.size == 0:
+            return meets, undecided
+        anx, any_, aoff = _edges(ax, ay)                                 # (V, 1) each
+        cross = _crosses(self.q0[0][c], self.q0[1][c], self.d[0][c], self.d[1][c],
+                         anx, any_, aoff)                                # 2. the axis
+        # 3. A's corners on the axis and its normal: a corner inside the rectangle at the
+        # cell's angles means they meet; a gap of the projections above the limit, free.
+        pu = ax * self.u[0][c] + ay * self.u[1][c]                       # (V, S)
+        pv = ax * self.v[0][c] + ay * self.v[1][c]
+        u0, u1, v0, half = self.core[0][c], self.core[1][c], self.core[2][c], self.core[3]
+        inside = ((pu >= u0) & (pu <= u1) & (np.abs(pv - v0) <= half)).any(axis=0)
+        hit = cross | inside
+        meets[c[hit]] = True
+        e = [x[c] for x in self.ext]
+        gap = np.maximum(np.maximum(e[0] - pu.max(axis=0), pu.min(axis=0) - e[1]),
+                         np.maximum(e[2] - pv.max(axis=0), pv.min(axis=0) - e[3]))
+        c = c[~hit & (gap <= free_at)]
+        if c.size == 0:
+            return meets, undecided
+        # 4. separating axes, one-sided: every corner of one polygon beyond an edge's line of
+        # the other. Edges of A against the hull's corners, then the hull's edges against A's.
+        hx, hy = self.hx[:, c], self.hy[:, c]                            # (L, S)
+        sep = np.full(c.size, -np.inf)
+        for k in range(len(ax)):
+            np.maximum(sep, (hx * anx[k] + hy * any_[k]).min(axis=0) - aoff[k], out=sep)
+        c, sep = c[sep <= free_at], sep[sep <= free_at]      # the rest: an edge of A separates
+        nx, ny = self.nx[:, c], self.ny[:, c]
+        least = nx * ax[0] + ny * ay[0]
+        for k in range(1, len(ax)):
+            np.minimum(least, nx * ax[k] + ny * ay[k], out=least)
+        np.maximum(sep, (least - self.offset[:, c]).max(axis=0), out=sep)
+        meets[c[sep <= 0]] = True
+        undecided[c[(sep > 0) & (sep <= free_at)]] = True
+        return meets, undecided
+
+
+def _ccw(p: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Vertices (V, 2) in counter-clockwise order."""
+    x, y = p[:, 0], p[:, 1]
+    return p if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) >= 0 else p[::-1]
+
+
+def _edges(x: npt.NDArray[np.float64], y: npt.NDArray[np.float64]
+           ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Outward unit normals (nx, ny) and offsets of counter-clockwise polygons, corners (V, C)
+    in x and y: the polygon is {p: n . p <= offset for every edge}. A zero-length edge (a
+    repeated corner) gets the normal 0 and offset 0, a half-plane that holds everywhere."""
+    ex, ey = np.roll(x, -1, axis=0) - x, np.roll(y, -1, axis=0) - y
+    length = np.hypot(ex, ey)
+    ok = length > 0
+    safe = np.where(ok, length, 1.0)
+    nx, ny = np.where(ok, ey / safe, 0.0), np.where(ok, -ex / safe, 0.0)
+    return nx, ny, nx * x + ny * y
+
+
+def _crosses(x0: npt.NDArray[np.float64], y0: npt.NDArray[np.float64],
+             dx: npt.NDArray[np.float64], dy: npt.NDArray[np.float64],
+             nx: npt.NDArray[np.float64], ny: npt.NDArray[np.float64],
+             offset: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]:
+    """Whether each segment (x0, y0) + t (dx, dy), 0 <= t <= 1 (S of them), meets the convex
+    polygon {n . p <= offset} ((V, 1) edges): [0, 1] clipped by every edge's half-plane is not
+    empty."""
+    num = offset - (x0 * nx + y0 * ny)                              # (V, S)
+    den = dx * nx + dy * ny
+    ratio = num / np.where(den != 0, den, 1.0)
+    hi = np.minimum(1.0, np.where(den > 0, ratio, np.inf).min(axis=0))
+    lo = np.maximum(0.0, np.where(den < 0, ratio, -np.inf).max(axis=0))
+    parallel_out = ((den == 0) & (num < 0)).any(axis=0)
+    return (lo <= hi) & ~parallel_out
+
+
+def _hull_order(pts: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.int64], bool]:
+    """For point sets (n, P, 2): the indices of each hull's corners, counter-clockwise, padded
+    to one length by repeating the last (a zero-length edge); and whether some hull is not a
+    polygon (then the indices mean nothing)."""
+    hulls = shapely.convex_hull(shapely.linestrings(pts))
+    if np.any(shapely.get_type_id(hulls) != 3):
+        return np.zeros((len(pts), 1), dtype=np.int64), True
+    out = []
+    for q, hull in zip(pts, hulls):
+        ring = _ccw(shapely.get_coordinates(hull)[:-1])
+        out.append(np.argmax((ring[:, None] == q[None]).all(axis=2), axis=1).tolist())
+    width = max(len(o) for o in out)
+    return np.array([o + [o[-1]] * (width - len(o)) for o in out], dtype=np.int64), False

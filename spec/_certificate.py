@@ -55,7 +55,10 @@ __all__ = [
     "ContactDetail",
     "certify",
     "certificate_json",
+    "prove_motion",
     "require_clear",
+    "link_speeds",
+    "link_rects",
     "DEFAULT_MAX_DEPTH",
     "DEFAULT_BOUND_RATIO",
     "DEFAULT_MAX_INTERVALS",
@@ -136,8 +139,21 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
         raise InputError("max_depth", max_depth, "must be an integer >= 0")
     if not 0.0 <= bound_ratio < 1.0:
         raise InputError("bound_ratio", bound_ratio, "must lie in [0, 1)")
-    motion = _Motion.of(scenario, grid, cells)
+    return prove_motion(_Motion.of(scenario, grid, cells), max_depth=max_depth,
+                        bound_ratio=bound_ratio, max_intervals=max_intervals)
 
+
+def prove_motion(motion: Any, *, max_depth: int = DEFAULT_MAX_DEPTH,
+                 bound_ratio: float = DEFAULT_BOUND_RATIO,
+                 max_intervals: int = DEFAULT_MAX_INTERVALS,
+                 first_contact: bool = False) -> Certificate:
+    """The proof loop of the module docstring, shared by the grid path's motion and a trajectory.
+
+    ``motion`` gives ``pieces()``, ``lipschitz(seg, moving)``, ``distances(t, seg)`` and
+    ``detail(contact, seg)``. With ``first_contact`` a found contact does not stop the search:
+    every interval before it is still decided (halved down to ``max_depth``), so the contact
+    reported is the first one, to within a piece's length / 2^max_depth.
+    """
     t0, t1, seg, moving = motion.pieces()
     lip = motion.lipschitz(seg, moving)                       # (K, 2, 2)
     d0 = motion.distances(t0, seg)
@@ -150,8 +166,14 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
     proved_lb = math.inf
     undecided: list[tuple[FloatArray, FloatArray]] = []
     deepest = 0
-    while best.contact is None:
-        deepest = int(depth.max())
+    while best.contact is None or first_contact:
+        if best.contact is not None:                # only what lies before it can come earlier
+            before = t0 < best.contact[0]
+            if not np.any(before):
+                break
+            t0, t1, seg, d0, d1, lip, depth = (x[before] for x in (t0, t1, seg, d0, d1, lip,
+                                                                    depth))
+        deepest = max(deepest, int(depth.max())) if first_contact else int(depth.max())
         lb = np.min((d0 + d1 - lip * (t1 - t0)[:, None, None]) / 2.0, axis=(1, 2))
         proved = lb > EPS
         tm = (t0 + t1) / 2.0
@@ -174,7 +196,7 @@ def certify(scenario: Scenario, grid: Grid, path: Sequence[Sequence[int]], *,
                                                                    depth))
         dm = motion.distances(tm, seg)
         samples += len(tm)
-        best = best.update(tm, dm, seg)
+        best = best.update(tm, dm, seg, earliest=first_contact)
         t0, t1 = np.concatenate([t0, tm]), np.concatenate([tm, t1])
         d0, d1 = np.concatenate([d0, dm]), np.concatenate([dm, d1])
         seg, lip = np.concatenate([seg, seg]), np.concatenate([lip, lip])
@@ -278,7 +300,9 @@ class _Best:
     def of(t: FloatArray, d: FloatArray, seg: IntArray) -> _Best:
         return _Best(math.inf, 0.0, None).update(t, d, seg)
 
-    def update(self, t: FloatArray, d: FloatArray, seg: IntArray) -> _Best:
+    def update(self, t: FloatArray, d: FloatArray, seg: IntArray, *,
+               earliest: bool = False) -> _Best:
+        """With ``earliest``, a sampled contact before the one held replaces it."""
         if len(t) == 0:
             return self
         arm = d.min(axis=(1, 2))
@@ -291,6 +315,12 @@ class _Best:
             a, b = np.unravel_index(int(np.argmin(d[first])), (2, 2))
             contact = (float(t[first]), (int(a), int(b)))
             best = _Best(0.0, contact[0], contact, int(seg[first]))
+        elif earliest and best.contact is not None and len(touching):
+            first = touching[np.argmin(t[touching])]
+            if float(t[first]) < best.contact[0]:
+                a, b = np.unravel_index(int(np.argmin(d[first])), (2, 2))
+                contact = (float(t[first]), (int(a), int(b)))
+                best = _Best(0.0, contact[0], contact, int(seg[first]))
         return best
 
 
@@ -341,8 +371,8 @@ class _Motion:
         if len(steps) == 0:                       # a one-cell path: the right arm never moves
             steps = np.zeros((1, 2))
         wr = np.where(seg[:, None] >= 0, steps[np.maximum(seg, 0)], 0.0)
-        vl = _link_speeds(s.left, wl)                                    # (K, 2)
-        vr = _link_speeds(s.right, wr)
+        vl = link_speeds(s.left, wl)                                    # (K, 2)
+        vr = link_speeds(s.right, wr)
         return vl[:, :, None] + vr[:, None, :]
 
     def right_angles(self, t: FloatArray, seg: IntArray) -> FloatArray:
@@ -373,8 +403,8 @@ class _Motion:
     def distances(self, t: FloatArray, seg: IntArray) -> FloatArray:
         """d[k, a, b]: distance between left link a and right link b at time t[k]."""
         s = self.scenario
-        left = _link_rects(s.left, left_angles(s, t))                     # (K, 2, 4, 2)
-        right = _link_rects(s.right, self.right_angles(t, seg))
+        left = link_rects(s.left, left_angles(s, t))                     # (K, 2, 4, 2)
+        right = link_rects(s.right, self.right_angles(t, seg))
         return polygon_distances(left[:, :, None], right[:, None, :])
 
 
@@ -403,14 +433,19 @@ def _reach(arm: Arm) -> tuple[FloatArray, FloatArray]:
     return np.array([r[0] for r in per_link]), np.array([r[1] for r in per_link])
 
 
-def _link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
+def link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
     """Upper bound on any link point's speed, |w1| R_base + |w2| R_elbow; w (K, 2) -> (K, 2)."""
     r_base, r_elbow = _reach(arm)
     w = np.abs(w)
     return w[:, 0:1] * r_base[None, :] + w[:, 1:2] * r_elbow[None, :]
 
 
-def _link_rects(arm: Arm, theta: FloatArray) -> FloatArray:
+def link_rects(arm: Arm, theta: FloatArray) -> FloatArray:
     """Corners of both links at each configuration, (K, 2) -> (K, 2 links, 4, 2)."""
     r = arm.width / 2.0
     return np.stack([corners(arm, theta[:, 0], theta[:, 1], link, r) for link in (0, 1)], axis=1)
+
+
+# The former private names, kept for callers that used them.
+_link_speeds = link_speeds
+_link_rects = link_rects

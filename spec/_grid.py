@@ -1,7 +1,11 @@
 """Time and C-space grids (docs/model.md §2), computed in exact rationals so rounding is the safe way.
 
-The floats in a scenario are dyadic rationals; N and m are computed from their exact values, so
-``N * dt >= Tf`` and ``h_q <= omega_q * dt`` hold exactly, not just up to rounding.
+The counts come from ``spec._counts`` (one owner): N and m are derived from the doubles' exact
+values in two readings (binary and decimal, ``Grid.READINGS``), and the float spacing h the
+planner uses is confirmed against the exact bound (a point is added when it fails), so
+``N * dt >= Tf`` and ``h_q <= omega_q * dt`` hold exactly, not just up to rounding. The loader,
+``make_grid``, the contracts (``grid_failures``) and the obligations judge through the same
+``Grid.time_readings`` and ``Grid.spacing_readings``.
 """
 
 from __future__ import annotations
@@ -13,7 +17,8 @@ from fractions import Fraction
 import numpy as np
 import numpy.typing as npt
 
-from ._counts import joint_points, time_steps, travel_time
+from ._counts import (READINGS, joint_grid, joint_points, spacing_readings, time_readings,
+                      time_steps, travel_time)
 from ._scenario import Scenario
 
 __all__ = [
@@ -48,12 +53,12 @@ class Variant(str, Enum):
 
 
 def exact_tf(s: Scenario) -> Fraction:
-    """Tf = max_q |goal_q - start_q| / omega_q, exactly."""
+    """Tf = max_q |goal_q - start_q| / omega_q, exactly (binary reading)."""
     return travel_time(s.left.start, s.left.goal, s.left.omega)
 
 
 def exact_n(s: Scenario) -> int:
-    """N = max(1, ceil(Tf / dt)), exactly; hence N dt >= Tf."""
+    """N: the least N >= 1 with N dt >= Tf in both readings, exactly."""
     return time_steps(s.left.start, s.left.goal, s.left.omega, s.dt)
 
 
@@ -68,6 +73,23 @@ class Grid:
     Tf: float
     lo: tuple[float, float]
     h: tuple[float, float]
+
+    #: The two exact readings every grid condition is judged in: "binary" (the doubles as the
+    #: rationals they are) and "decimal" (the numbers as written, Fraction(repr(x))).
+    READINGS = READINGS
+
+    @staticmethod
+    def time_readings(s: Scenario) -> dict[str, tuple[Fraction, Fraction]]:
+        """{reading: (dt, Tf)} of the scenario, exactly; N must satisfy N dt >= Tf in each."""
+        L = s.left
+        return time_readings(L.start, L.goal, L.omega, s.dt)
+
+    @staticmethod
+    def spacing_readings(s: Scenario, q: int) -> dict[str, tuple[Fraction, Fraction]]:
+        """{reading: (hi_q - lo_q, omega_q dt)} of the subordinate's joint q, exactly; the grid
+        must satisfy (hi - lo) / (m_q - 1) <= omega_q dt in each (and its float h in binary)."""
+        R = s.right
+        return spacing_readings(R.limits[q][0], R.limits[q][1], R.omega[q], s.dt)
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -89,10 +111,10 @@ class Grid:
 def make_grid(s: Scenario) -> Grid:
     """The grid of docs/model.md §2 for a validated scenario."""
     R = s.right
-    ms = [joint_points(R.limits[q][0], R.limits[q][1], R.omega[q], s.dt) for q in range(2)]
-    h = tuple((R.limits[q][1] - R.limits[q][0]) / (ms[q] - 1) for q in range(2))
-    return Grid(N=exact_n(s), m=ms[0], n=ms[1], dt=s.dt, Tf=float(exact_tf(s)),
-                lo=(R.limits[0][0], R.limits[1][0]), h=(h[0], h[1]))
+    (m, h1), (n, h2) = (joint_grid(R.limits[q][0], R.limits[q][1], R.omega[q], s.dt)
+                        for q in range(2))
+    return Grid(N=exact_n(s), m=m, n=n, dt=s.dt, Tf=float(exact_tf(s)),
+                lo=(R.limits[0][0], R.limits[1][0]), h=(h1, h2))
 
 
 def left_angles(s: Scenario, t: float | FloatArray) -> FloatArray:

@@ -12,14 +12,17 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ..errors import InputError
+
+if TYPE_CHECKING:
+    from ._witness import Witness
 
 __all__ = [
     "Cell",
@@ -64,13 +67,17 @@ class SearchStatus(str, Enum):
 
 @dataclass(frozen=True)
 class SearchResult:
-    """The outcome of an optimal-path search: the path and its (J1, J2), or no path and why."""
+    """The outcome of an optimal-path search: the path and its (J1, J2), or no path and why.
+
+    ``witness`` is the search's certificate when it was asked for one (``spec.check_witness``
+    verifies it, docs/model.md §11); it takes no part in comparisons."""
 
     status: SearchStatus
     reason: str | None
     path: tuple[Cell, ...]
     J1: int | None
     J2: int | None
+    witness: Witness | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "status", SearchStatus(self.status))  # accept "found" too

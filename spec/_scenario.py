@@ -4,10 +4,13 @@ Every refusal is an InputError naming the field and the value, e.g.
 ``right.omega[1] must be > 0, got -1.0``. Beyond finiteness and sign, values must lie in a
 physical range (so that no float in the geometry overflows): base coordinates within
 MAX_BASE_M = 1000 m, link lengths and widths in (0, MAX_LENGTH_M = 100 m], angles (start, goal,
-limits) within MAX_ANGLE_RAD = 1000 rad, and omega_q * dt <= MAX_STEP_RAD = 3.14 rad for every
-joint of both arms (the margin lemma, ``Lemma.sweep_margin``, is proved for lattice spacings
-g <= 3.14; the left spacing is omega dt, the right h_q <= omega_q dt). The grid's size is
-computed in exact integers and held to the memory budget before any float grid step exists.
+limits) within MAX_ANGLE_RAD = 1000 rad, and omega_q * dt <= 157/50 = 3.14 rad for every
+joint of both arms, exactly, both as the exact product of the doubles and as the float product
+the code uses (the margin lemma, ``Lemma.sweep_margin``, is proved for lattice spacings
+g <= 3.14; the left spacing is the float omega dt, the right h_q <= omega_q dt). The grid's size
+is computed in exact integers and held to the memory budget before any float grid step exists;
+each joint's grid then comes from ``joint_grid`` (spec/_counts.py), the same function
+``make_grid`` uses, and a joint it cannot confirm safe is refused naming right.limits[q].
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MISSING, InputError
-from ._counts import joint_points, time_steps
+from ._counts import GridRefused, joint_grid, min_points, time_steps
 
 __all__ = [
     "Arm",
@@ -105,7 +108,8 @@ class Scenario:
     def cells(self) -> int:
         """(N + 1) * m * n: the size of D_R for this scenario."""
         R, L = self.right, self.left
-        m, n = _grid_sizes(R.limits, R.omega, self.dt)
+        m, n = (joint_grid(R.limits[q][0], R.limits[q][1], R.omega[q], self.dt)[0]
+                for q in range(2))
         return (time_steps(L.start, L.goal, L.omega, self.dt) + 1) * m * n
 
 
@@ -237,17 +241,35 @@ def _arm_common(r: _Reader, doc: dict[str, Any], side: str, dt: float) -> dict[s
         "omega": r.pair(doc["omega"], f"{side}.omega", positive=True),
     }
     for q in range(2):
-        step = out["omega"][q] * dt
-        if not step <= MAX_STEP_RAD:
-            raise r.fail(f"{side}.omega[{q}]", out["omega"][q],
+        w = out["omega"][q]
+        step = w * dt
+        # Exactly, as margin_side checks it: the float product (the left spacing) and the
+        # exact product of the doubles (which bounds the right spacing h) both <= 157/50.
+        if not (step <= MAX_STEP_RAD and Fraction(step) <= _G_MAX
+                and Fraction(w) * Fraction(dt) <= _G_MAX):
+            raise r.fail(f"{side}.omega[{q}]", w,
                          f"times dt = {dt!r} is {step!r} rad per step, must be <= {MAX_STEP_RAD} "
-                         "(the margin lemma holds for lattice spacings up to 3.14 rad)")
+                         "exactly (157/50; the double 3.14 is slightly above it) (the margin "
+                         "lemma holds for lattice spacings up to 3.14 rad)")
     return out
 
 
-def _grid_sizes(limits: tuple[Pair, Pair], omega: Pair, dt: float) -> tuple[int, int]:
-    return (joint_points(limits[0][0], limits[0][1], omega[0], dt),
-            joint_points(limits[1][0], limits[1][1], omega[1], dt))
+#: The margin lemma's bound on a lattice spacing, exactly (MAX_STEP_RAD as written).
+_G_MAX = Fraction(157, 50)
+
+
+def _joint_grids(r: _Reader, limits: tuple[Pair, Pair], omega: Pair, dt: float
+                 ) -> tuple[tuple[int, float], tuple[int, float]]:
+    """Each joint's (m, h) from joint_grid; a joint that cannot be confirmed safe is refused."""
+    out = []
+    for q in range(2):
+        try:
+            out.append(joint_grid(limits[q][0], limits[q][1], omega[q], dt))
+        except GridRefused as exc:
+            raise r.fail(f"right.limits[{q}]", list(limits[q]),
+                         f"cannot be gridded safely with right.omega[{q}] = {omega[q]!r} and "
+                         f"dt = {dt!r}: {exc}; widen or narrow the limits slightly") from None
+    return (out[0], out[1])
 
 
 def _check_budget(r: _Reader, N: int, m: int, n: int, budget: int | None) -> None:
@@ -273,8 +295,10 @@ def _check_budget(r: _Reader, N: int, m: int, n: int, budget: int | None) -> Non
 
 
 def _grid_point(r: _Reader, doc: dict[str, Any], which: str, limits: tuple[Pair, Pair],
-                sizes: tuple[int, int]) -> tuple[int, int]:
+                grids: tuple[tuple[int, float], tuple[int, float]], omega: Pair, dt: float
+                ) -> tuple[int, int]:
     """Reads ``which``_cell, or ``which`` as angles snapped to the grid (within ANGLE_TOLERANCE)."""
+    sizes = (grids[0][0], grids[1][0])
     cell_key, angle_key = f"{which}_cell", which
     if (cell_key in doc) == (angle_key in doc):
         raise r.fail(f"right.{cell_key}", doc.get(cell_key, doc.get(angle_key, MISSING)),
@@ -290,19 +314,26 @@ def _grid_point(r: _Reader, doc: dict[str, Any], which: str, limits: tuple[Pair,
     out = []
     for q in range(2):
         lo, hi = limits[q]
-        m = sizes[q]
+        m, h = grids[q]
         field = f"right.{angle_key}[{q}]"
         if not lo - ANGLE_TOLERANCE <= angles[q] <= hi + ANGLE_TOLERANCE:
             raise r.fail(field, angles[q], f"must lie within the limits [{lo!r}, {hi!r}]")
-        h = (hi - lo) / (m - 1)
         x = (angles[q] - lo) / h
         i = min(max(round(x), 0), m - 1)
         if abs(lo + i * h - angles[q]) > ANGLE_TOLERANCE:
             below = min(max(math.floor(x), 0), m - 1)
             above = min(below + 1, m - 1)
+            base = min_points(lo, hi, omega[q], dt)
+            why = ""
+            if m > base:
+                why = (f"; joint {q + 1}'s grid has {m} points, not {base}: with {base} the float "
+                       f"spacing {(hi - lo) / (base - 1)!r} would exceed omega * dt = "
+                       f"{omega[q]!r} * {dt!r} in exact arithmetic, so a point was added and the "
+                       f"spacing is {h!r}")
             raise r.fail(field, angles[q],
                          f"must be a grid point (within {ANGLE_TOLERANCE} rad); nearest are index "
-                         f"{below} = {lo + below * h!r} and index {above} = {lo + above * h!r}")
+                         f"{below} = {lo + below * h!r} and index {above} = {lo + above * h!r}"
+                         + why)
         out.append(i)
     return (out[0], out[1])
 
@@ -340,11 +371,14 @@ def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str 
             r.number(limits[q][e], f"right.limits[{q}][{e}]", **angle)
     omega = common["omega"]
     # The grid's size in exact integers, before any float grid step is formed.
-    sizes = _grid_sizes(limits, omega, dt)
+    sizes = tuple(min_points(limits[q][0], limits[q][1], omega[q], dt) for q in range(2))
     N = time_steps(left.start, left.goal, left.omega, dt)
     _check_budget(r, N, sizes[0], sizes[1], max_cells() if check_budget else None)
-    start_cell = _grid_point(r, rd, "start", limits, sizes)
-    goal_cell = _grid_point(r, rd, "goal", limits, sizes)
+    # Then each joint's grid as make_grid builds it (possibly a point more), held again.
+    grids = _joint_grids(r, limits, omega, dt)
+    _check_budget(r, N, grids[0][0], grids[1][0], max_cells() if check_budget else None)
+    start_cell = _grid_point(r, rd, "start", limits, grids, omega, dt)
+    goal_cell = _grid_point(r, rd, "goal", limits, grids, omega, dt)
     right = RightArm(**common, limits=limits, start_cell=start_cell, goal_cell=goal_cell)
     return Scenario(name=name, purpose=purpose, dt=dt, left=left, right=right,
                     source=source or "<memory>", sha256=sha256)

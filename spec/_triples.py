@@ -19,6 +19,7 @@ import numpy.typing as npt
 
 from ..errors import ContractViolation
 from ._builtdr_post import CellMismatch, dr_postcondition
+from ._counts import SPAN_TOLERANCE, decimal
 from ._grid import Grid, Variant, exact_tf
 from ._paths import J1, J2, SearchResult, SearchStatus, path_violations
 from ._scenario import Scenario
@@ -47,8 +48,8 @@ __all__ = [
     "search_failures",
 ]
 
-#: How far (rad) the last grid point lo + (m - 1) h may sit from the upper joint limit.
-SPAN_TOLERANCE = 1e-9
+#: SPAN_TOLERANCE (from spec/_counts.py): how far (rad) the last grid point lo + (m - 1) h may sit
+#: from the upper joint limit; the construction (joint_grid) confirms it with the same tolerance.
 
 
 class Command(str, Enum):
@@ -133,9 +134,11 @@ class Triple:
 # --- the triples ------------------------------------------------------------------------------
 
 _GRID_PRE = (
-    Condition("pre.grid.N", "N >= 1 and N * dt >= Tf in exact arithmetic: the layers cover the "
+    Condition("pre.grid.N", "N >= 1 and N * dt >= Tf in exact arithmetic, in both readings "
+              "(binary: the doubles; decimal: the numbers as written): the layers cover the "
               "principal's whole motion"),
-    Condition("pre.grid.h", "h_q <= omega_q * dt for both joints in exact arithmetic, and the "
+    Condition("pre.grid.h", "h_q <= omega_q * dt for both joints in exact arithmetic (the float "
+              "h_q against the doubles, and (hi_q - lo_q)/(m_q - 1) in both readings), and the "
               "m x n grid points span the subordinate's joint limits"),
     Condition("pre.grid.scenario", "the grid's dt, Tf and lower limits are the scenario's"),
     Condition("pre.cells", "the start and goal cells lie inside the m x n grid"),
@@ -233,20 +236,33 @@ def search_triple(variant: Variant | str) -> Triple:
 def grid_failures(s: Scenario, grid: Grid) -> list[Failure]:
     """pre.grid.*: the grid is well formed for the scenario (exact rationals where it matters)."""
     out: list[Failure] = []
-    dt = Fraction(s.dt)
     tf = exact_tf(s)
-    if not (isinstance(grid.N, int) and grid.N >= 1 and grid.N * Fraction(grid.dt) >= tf):
+    times = Grid.time_readings(s)
+    grid_dt = {"binary": Fraction(grid.dt), "decimal": decimal(grid.dt)}
+    n_ok = isinstance(grid.N, int) and grid.N >= 1
+    short = [r for r in Grid.READINGS if n_ok and not grid.N * grid_dt[r] >= times[r][1]]
+    if not n_ok or short:
+        r = short[0] if short else "binary"
+        dt_r, tf_r = grid_dt[r], times[r][1]
         out.append(Failure("pre.grid.N", "the time grid ends before the principal arrives",
-                           (("N", grid.N), ("dt_s", grid.dt), ("N * dt_s", float(grid.N * dt)),
-                            ("Tf_s", float(tf)))))
+                           (("N", grid.N), ("dt_s", grid.dt), ("reading", r),
+                            ("N * dt_s", float(grid.N * dt_r) if n_ok else None),
+                            ("Tf_s", float(tf_r)))))
     R = s.right
-    bad_h = [q for q in range(2)
-             if not Fraction(grid.h[q]) <= Fraction(R.omega[q]) * dt]
+    bad_h: list[tuple[int, str, Fraction, Fraction]] = []
+    for q, points in enumerate((grid.m, grid.n)):
+        if not (isinstance(points, int) and points >= 2):
+            continue  # reported below, as points that do not span the limits
+        spans = Grid.spacing_readings(s, q)
+        checks = [("binary (float h)", Fraction(grid.h[q]), spans["binary"][1])]
+        checks += [(r, spans[r][0] / (points - 1), spans[r][1]) for r in Grid.READINGS]
+        bad = [(q, r, h, step) for r, h, step in checks if not h <= step]
+        bad_h += bad[:1]
     if bad_h:
-        q = bad_h[0]
+        q, r, h, step = bad_h[0]
         out.append(Failure("pre.grid.h", f"joint {q + 1}'s grid spacing exceeds omega * dt",
-                           (("joint", q + 1), ("h_rad", grid.h[q]),
-                            ("omega * dt_rad", float(Fraction(R.omega[q]) * dt)),
+                           (("joint", q + 1), ("reading", r), ("h_rad", float(h)),
+                            ("omega * dt_rad", float(step)),
                             ("points", grid.m if q == 0 else grid.n)), count=len(bad_h)))
     for q, points in enumerate((grid.m, grid.n)):
         lo, hi = R.limits[q]

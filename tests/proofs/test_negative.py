@@ -135,10 +135,13 @@ def test_tight_search_needs_its_own_rest_layer():
     assert _answer(VC(main.name, main.hypotheses, main.goal, counter_witness=small)) == z3.sat
 
 
-@pytest.mark.parametrize("bug,vc", [("inner_bound", "C.i.preserve"),
-                                    ("store_value", "C.j.preserve"),
+# The program is extracted from the loop form (cfmpa.impl.builtdr_loop_nest) and its invariants
+# generated from it, so a bug planted in the source keeps the loops consistent and fails the
+# triple (.main); only the weakened invariant, a defect of the proof, fails a preservation VC.
+@pytest.mark.parametrize("bug,vc", [("inner_bound", "BuiltDR.original.main"),
+                                    ("store_value", "BuiltDR.original.main"),
                                     ("weak_invariant", "C.i.preserve"),
-                                    ("rest_layer", "D.j.preserve")])
+                                    ("rest_layer", "BuiltDR.original.main")])
 def test_planted_builtdr_bugs_are_refuted(bug: str, vc: str):
     correct = {v.name: v for v in builtdr_query("original", "correctness").vcs}
     buggy = {v.name: v for v in builtdr_query("original", "correctness", bug).vcs}
@@ -152,10 +155,10 @@ def test_planted_builtdr_bugs_are_refuted(bug: str, vc: str):
 
 def test_a_buggy_builtdr_fails_its_obligation():
     ob = Obligation("T.bug", "test", "none", "buggy BuiltDR", Method.Z3, Verdict.PROVED,
-                    lambda: builtdr_query("original", "correctness", "rest_layer"))
+                    lambda: builtdr_query("original", "correctness", "inner_bound"))
     pr = discharge(ob)
     assert pr.verdict is Verdict.FAILED and pr.counterexample
-    assert "D.j.preserve" in {r.name for r in pr.vcs if r.answer == "sat"}
+    assert "BuiltDR.original.main" in {r.name for r in pr.vcs if r.answer == "sat"}
 
 
 def test_the_fixed_is_path_closes_the_printed_gap():

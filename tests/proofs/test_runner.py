@@ -14,7 +14,8 @@ import pytest
 import z3
 
 from cfmpa.proofs import (ASSUMPTIONS, FIXED_IDS, Verdict, collect_obligations, expected_ids,
-                          render_report, run_obligations, run_prove, selected)
+                          render_report, run_obligations, run_prove, scenarios_note,
+                          selected)
 
 REPO = Path(__file__).resolve().parents[2]
 CHEAP = ["Def1", "Lemma1", "Prop2", "Margin.naive_hull"]
@@ -23,7 +24,8 @@ CHEAP = ["Def1", "Lemma1", "Prop2", "Margin.naive_hull"]
 def _strip_times(doc: dict) -> dict:
     doc = dict(doc)
     doc.pop("seconds")
-    doc["obligations"] = [{k: v for k, v in o.items() if k not in ("seconds", "change")}
+    doc["obligations"] = [{k: v for k, v in o.items()
+                           if k not in ("seconds", "change", "cvc5_seconds")}
                           for o in doc["obligations"]]
     return doc
 
@@ -192,8 +194,18 @@ def test_another_scenarios_folder_says_what_it_expects(tmp_path: Path):
     rc = run_prove(out_dir=tmp_path / "out", scenarios_dir=tmp_path,
                    only=["Scenario.mine.time_grid"], stream=out)
     assert rc == 0
-    assert (f"scenarios: {tmp_path} is not the bundled folder" in out.getvalue()
-            and "Scenario.mine.{time_grid,cspace_grid,margin_side,containment}" in out.getvalue())
+    line = out.getvalue().splitlines()[2]
+    assert line == (f"scenarios: the 1 workcell(s) in {tmp_path}, expecting "
+                    "Scenario.mine.{time_grid,cspace_grid,margin_side,containment}")
+    assert "not the bundled" not in out.getvalue()
+
+
+def test_the_bundled_folder_says_what_it_expects():
+    from cfmpa.proofs import BUNDLED_DIR
+    note = scenarios_note(BUNDLED_DIR)
+    assert note.startswith("scenarios: the 5 bundled workcells, expecting "
+                           "Scenario.default.{time_grid,cspace_grid,margin_side,containment}, ")
+    assert "\n" not in note and "Scenario.original-fails.{" in note
 
 
 def test_results_json_records_what_it_is_of(tmp_path: Path):

@@ -150,7 +150,7 @@ def test_a_worse_path_reported_with_the_optimal_costs_fails_costs_and_optimality
     assert _fails(out) == ["FAIL  Theorem 4 post.costs", "FAIL  Theorem 4 post.optimal"]
     assert "the path's (J1, J2) is not the least" in out
     assert f"path's J1, J2 (recomputed) was {[worse.J1, worse.J2]}" in out
-    assert f"optimal J1, J2 was {best}" in out
+    assert f"least goal label + stop was {best}" in out            # the witness's labels
 
 
 def _fails(out: str) -> list[str]:
@@ -258,3 +258,94 @@ def test_extra_keys_are_allowed_and_optional_claims_may_be_absent(outputs):
     p.write_text(json.dumps(doc))
     report = check_outputs(s, np.load(outputs / "ref" / "dr.npy"), read_plan(p))
     assert report.ok and not any("plan.json" in line.what for line in report.lines)
+
+
+# --- witnesses (docs/model.md §11) ----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def witnessed(outputs):
+    """`cfmpa plan --witness`: the outputs with the search's witness file."""
+    from cfmpa.cli import main
+
+    out = outputs / "witnessed"
+    assert main(["plan", str(outputs / "small.toml"), "--out", str(out), "--witness",
+                 str(out / "witness.npz")]) == 0
+    return out
+
+
+def _run_witnessed(outputs, witnessed, capsys, witness=None):
+    code = run_check(outputs / "small.toml", witnessed / "dr.npy", witnessed / "plan.json",
+                     witness if witness is not None else witnessed / "witness.npz")
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err
+    return code, out, err
+
+
+def test_plan_writes_the_witness_and_its_hash(witnessed):
+    import hashlib
+
+    doc = json.loads((witnessed / "plan.json").read_text())
+    data = (witnessed / "witness.npz").read_bytes()
+    assert doc["witness_sha256"] == hashlib.sha256(data).hexdigest()
+    assert not list(witnessed.glob(".*tmp"))
+
+
+def test_a_witness_file_is_verified_and_its_hash_checked(outputs, witnessed, capsys):
+    code, out, _ = _run_witnessed(outputs, witnessed, capsys)
+    assert code == 0, out
+    assert "ok    plan.json witness_sha256 is the witness file's" in out
+    assert "ok    Theorem 4 post.optimal: through the witness given" in out
+    # without the file the fast search makes one
+    code, out, _ = _run(outputs, None, capsys)
+    assert code == 0 and "post.optimal: through a witness computed by the fast search" in out
+
+
+def test_a_tampered_witness_is_rejected_with_the_first_failing_condition(
+        outputs, witnessed, tmp_path, capsys):
+    from cfmpa.spec import MOVES, Witness, load_witness
+
+    w = load_witness(witnessed / "witness.npz")
+    doc = json.loads((witnessed / "plan.json").read_text())
+    a, b = doc["path"][2], doc["path"][3]
+    d = MOVES.index((b[0] - a[0], b[1] - a[1]))
+    j1, j2 = w.j1.copy(), w.j2.copy()
+    j1[3, d, b[0], b[1]] += 1                        # one label raised on the path's walk
+    forged = tmp_path / "forged.npz"
+    forged.write_bytes(Witness.of_labels(j1, j2).npz_bytes())
+    code, out, _ = _run_witnessed(outputs, witnessed, capsys, forged)
+    assert code == 1
+    assert _fails(out) == ["FAIL  plan.json witness_sha256 is the witness file's",
+                           "FAIL  Theorem 4 post.optimal"]
+    line = next(x for x in out.splitlines() if x.startswith("FAIL  Theorem 4 post.optimal"))
+    assert "the witness fails witness.edge" in line
+    assert f"'step': 3, 'cell': {b}" in out and "its label was" in out
+
+
+def test_a_bad_witness_file_exits_2(outputs, witnessed, tmp_path, capsys):
+    (tmp_path / "w.npz").write_bytes(b"not a zip")
+    code, out, err = _run_witnessed(outputs, witnessed, capsys, tmp_path / "w.npz")
+    assert code == 2 and out == "" and "witness is not an .npz witness file" in err
+
+
+def test_check_rejects_every_fault_the_selftest_seeds(tmp_path):
+    # Each fault's outputs (and, for the forged witness, its witness file) fail `cfmpa check`.
+    from cfmpa.runs._selftest import workcell
+    from cfmpa.spec import load_witness
+
+    for fault in FAULTS:
+        s = workcell(fault.workcell)
+        m = fault.make(s, fault.variant, make_grid(s))
+        kwargs = {k: v for k, v in (("grid", m.grid), ("build", m.build), ("search", m.search))
+                  if v is not None}
+        p = plan(s, fault.variant, contracts="off", stop=False, witness=True, **kwargs)
+        out = tmp_path / fault.name.replace(" ", "-")
+        write_plan(p, out, witness=out / "witness.npz")
+        report = check_outputs(s, np.load(out / "dr.npy"), read_plan(out / "plan.json"),
+                               witness=load_witness(out / "witness.npz"))
+        assert not report.ok, fault.name
+        if fault.name in ("non-optimal path", "forged witness"):
+            assert [x.what.split(":")[0] for x in report.failed] == [
+                "Theorem 4 post.optimal"], fault.name
+            want = "witness.edge" if fault.name == "forged witness" else "witness.goal"
+            assert want in report.failed[0].what, (fault.name, report.failed[0].what)

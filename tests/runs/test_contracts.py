@@ -15,7 +15,7 @@ from cfmpa.impl import build_dr, search_opt_path
 from cfmpa.runs._contracts import (DEFAULT_SAMPLE, Mode, Settings, builtdr_path_cells,
                                      builtdr_post, checked_build_dr, checked_search,
                                      sample_cells)
-from cfmpa.spec import Variant, make_grid
+from cfmpa.spec import Variant, Witness, make_grid
 from cfmpa.spec._paths import J1, J2, SearchResult
 from cfmpa.spec._triples import (THEOREM_1, THEOREM_2, THEOREM_3, THEOREM_3_TIGHT, THEOREM_4,
                                  THEOREM_4_TIGHT, TRIPLES, Command, builtdr_triple,
@@ -204,6 +204,26 @@ def test_the_reference_search_meets_theorem_4_in_full(small):
     assert result == r and all(run.ok for run in runs)
     checks = {c.condition: c for run in runs for c in run.checks}
     assert checks["post.optimal"].ok is True and checks["post.is_path"].count == len(r.path) + 1
+
+
+def test_full_mode_verifies_the_searchs_own_witness_and_rejects_a_forged_one(small):
+    s, g, dr, r = small
+
+    def certifying(*args):
+        return search_opt_path(*args, with_witness=True)
+
+    _, runs = checked_search(s, Variant.MODIFIED, g, dr, Settings(Mode.FULL), search=certifying)
+    checks = {c.condition: c for run in runs for c in run.checks}
+    assert checks["post.optimal"].ok and "the search's own witness" in checks["post.optimal"].scope
+
+    def forging(*args):
+        good = certifying(*args)
+        j1, j2 = good.witness.j1.copy(), good.witness.j2.copy()
+        j1[0, 4, START[0], START[1]] = 1                 # the start state's label is not 0
+        return replace(good, witness=Witness.of_labels(j1, j2))
+
+    with pytest.raises(ContractViolation, match="witness.start"):
+        checked_search(s, Variant.MODIFIED, g, dr, Settings(Mode.FULL), search=forging)
 
 
 def test_sampled_mode_says_optimality_was_not_checked(small):

@@ -72,6 +72,31 @@ def test_full_checks_every_cell_and_optimality(s):
     assert [c["count"] for c in cells] == [p.dr.size]
     assert all(c["ok"] is True and c["coverage"] == "all" for c in checks.values())
     assert any(cond == "post.optimal" and c["count"] == 1 for (_, cond, _), c in checks.items())
+    # optimality through the fast search's own witness, verified by the spec's checker
+    assert any(cond == "post.optimal" and "through the search's own witness" in scope
+               for (_, cond, scope) in checks)
+    assert p.search.witness is None                 # checked, then dropped: it is large
+    kept = plan(s, "modified", contracts="full", witness=True)
+    assert kept.search.witness is not None and kept.search.witness.kind == "labels"
+
+
+def test_a_witness_is_made_on_request_and_hashed_only_when_written(s, tmp_path):
+    import hashlib
+
+    off = plan(s, "modified", contracts="off")
+    assert off.search.witness is None and "witness_sha256" not in plan_json(off)
+    with pytest.raises(ValueError, match="witness=True"):
+        write_plan(off, tmp_path / "a", witness=tmp_path / "a" / "w.npz")
+    p = plan(s, "modified", contracts="off", witness=True)
+    assert p.search == off.search and p.search.path == off.search.path
+    write_plan(p, tmp_path / "b", witness=tmp_path / "b" / "w.npz")
+    doc = json.loads((tmp_path / "b" / "plan.json").read_text())
+    assert doc["witness_sha256"] == hashlib.sha256(
+        (tmp_path / "b" / "w.npz").read_bytes()).hexdigest()
+    # a search that makes no witness gets the fast search's
+    ref = plan(s, "modified", contracts="off", search=lambda *a: search_opt_path(*a),
+               witness=True)
+    assert ref.search.witness is not None
 
 
 @pytest.mark.parametrize("variant, names", [

@@ -22,6 +22,7 @@ FIRST_CATCH = {
     "N rounded down": "Theorem 3 pre.grid.N",
     "cell grid coarser than omega dt": "Theorem 3 pre.grid.h",
     "non-optimal path": "Theorem 4 post.optimal",
+    "forged witness": "Theorem 4 post.optimal",
     "path with a jump": "Theorem 4 post.is_path",
     "path ends early at a goal swept later": "Theorem 4 post.is_path",
     "path through a blocked cell in the rest layer": "Theorem 4 post.is_path",
@@ -53,6 +54,7 @@ def test_sampled_mode_catches_what_it_checks_for_certain(rows):
             FIRST_CATCH[name]), name
     # optimality is full mode's alone: stated, and so recorded
     assert not by["non-optimal path"].caught_sampled
+    assert not by["forged witness"].caught_sampled
 
 
 def test_the_waiting_path_is_also_a_real_contact(rows):

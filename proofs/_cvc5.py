@@ -1,0 +1,174 @@
+"""The second solver: replay a VC's standard SMT-LIB 2.6 proof check in cvc5.
+
+cvc5 runs in a worker process (this module run as a script), fed one query at a time over a
+pipe: its own time limit (``tlimit-per``) is not always honoured by the nonlinear procedures, so
+the worker is killed after the limit plus a grace period and restarted for the next query. The
+answer is cvc5's: ``unsat``, ``sat`` or ``unknown`` with its explanation (``timeout``,
+``incomplete``, ...), or ``unknown`` with the reason it could not run (``killed after ...``,
+cvc5 not installed, a parse error). Only ``unsat`` confirms a proof (``sat`` a refutation); an
+answer contradicting Z3's is a disagreement, which the caller makes a FAILED verdict.
+``Cvc5Pool`` runs the queries in the background (one worker, fed by a thread), so cvc5 works
+on the other core while the prove run goes on with Z3.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import select
+import subprocess
+import sys
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
+
+__all__ = ["CVC5_TIMEOUT_MS", "Cvc5Answer", "Cvc5Pool", "Cvc5Worker", "cvc5_version"]
+
+#: cvc5's time limit per query. A run replays only the statements cvc5 decided when they were
+#: pinned (``_pins.cvc5_skips``), so a query that runs into it is rare; ``--repin`` tries all.
+CVC5_TIMEOUT_MS = 5_000
+#: How long past its own limit a query may run before the worker is killed.
+_GRACE_S = 1.0
+#: The worker's start-up (importing cvc5), allowed on top on a query that starts it.
+_START_S = 2.0
+
+
+@dataclass(frozen=True)
+class Cvc5Answer:
+    answer: str          # unsat | sat | unknown
+    reason: str = ""     # cvc5's explanation of unknown, or why it did not run
+    seconds: float = 0.0
+
+
+def cvc5_version() -> str | None:
+    try:
+        import cvc5
+    except ImportError:
+        return None
+    return str(getattr(cvc5, "__version__", "unknown version"))
+
+
+class Cvc5Worker:
+    """A cvc5 process answering queries one at a time; restarted after a kill."""
+
+    def __init__(self) -> None:
+        self.proc: subprocess.Popen[str] | None = None
+
+    def __enter__(self) -> Cvc5Worker:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _start(self) -> tuple[subprocess.Popen[str], bool]:
+        if self.proc is None or self.proc.poll() is not None:
+            self.proc = subprocess.Popen(
+                [sys.executable, "-u", os.path.abspath(__file__)], stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
+            return self.proc, True
+        return self.proc, False
+
+    def close(self) -> None:
+        if self.proc is not None:
+            if self.proc.poll() is None:
+                self.proc.kill()
+            self.proc.wait()
+            for f in (self.proc.stdin, self.proc.stdout):
+                if f is not None:
+                    f.close()
+            self.proc = None
+
+    def check(self, text: str, timeout_ms: int = CVC5_TIMEOUT_MS) -> Cvc5Answer:
+        t0 = time.monotonic()
+        a = self._check(text, timeout_ms)
+        return Cvc5Answer(a.answer, a.reason, time.monotonic() - t0)
+
+    def _check(self, text: str, timeout_ms: int) -> Cvc5Answer:
+        if cvc5_version() is None:
+            return Cvc5Answer("unknown", "cvc5 is not installed")
+        proc, started = self._start()
+        assert proc.stdin is not None and proc.stdout is not None
+        try:
+            proc.stdin.write(json.dumps({"text": text, "ms": timeout_ms}) + "\n")
+            proc.stdin.flush()
+        except (BrokenPipeError, OSError):
+            self.close()
+            return Cvc5Answer("unknown", "the cvc5 worker died")
+        limit = timeout_ms / 1000 + _GRACE_S + (_START_S if started else 0.0)
+        t0 = time.monotonic()
+        ready, _, _ = select.select([proc.stdout], [], [], limit)
+        if not ready:
+            self.close()
+            return Cvc5Answer("unknown", f"killed after {time.monotonic() - t0:.1f} s "
+                              f"(cvc5 overran its {timeout_ms} ms limit)")
+        line = proc.stdout.readline()
+        if not line:
+            self.close()
+            return Cvc5Answer("unknown", "the cvc5 worker died")
+        doc = json.loads(line)
+        return Cvc5Answer(doc["answer"], doc.get("reason", ""))
+
+
+class Cvc5Pool:
+    """cvc5 in the background: ``submit`` queues a query for one worker (a thread waiting on
+    the worker process), so cvc5 runs on while the caller goes on with Z3."""
+
+    def __init__(self, timeout_ms: int = CVC5_TIMEOUT_MS) -> None:
+        self.timeout_ms = timeout_ms
+        self._worker = Cvc5Worker()
+        self._ex = ThreadPoolExecutor(max_workers=1, thread_name_prefix="cvc5")
+
+    def submit(self, text: str) -> Future[Cvc5Answer]:
+        return self._ex.submit(self._worker.check, text, self.timeout_ms)
+
+    def close(self) -> None:
+        self._ex.shutdown(wait=True)
+        self._worker.close()
+
+    def __enter__(self) -> Cvc5Pool:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _serve() -> None:
+    """The worker's loop: one JSON query a line in, one JSON answer a line out."""
+    import cvc5
+
+    for line in sys.stdin:
+        q = json.loads(line)
+        try:
+            tm = cvc5.TermManager()
+            s = cvc5.Solver(tm)
+            s.setOption("tlimit-per", str(int(q["ms"])))
+            p = cvc5.InputParser(s)
+            p.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, q["text"], "vc")
+            sm = p.getSymbolManager()
+            res = None
+            while True:
+                cmd = p.nextCommand()
+                if cmd.isNull():
+                    break
+                if cmd.getCommandName() == "check-sat":
+                    res = s.checkSat()
+                else:
+                    cmd.invoke(s, sm)
+            if res is None:
+                out = {"answer": "unknown", "reason": "no check-sat in the query"}
+            elif res.isUnsat():
+                out = {"answer": "unsat"}
+            elif res.isSat():
+                out = {"answer": "sat"}
+            else:
+                why = str(res.getUnknownExplanation()).rsplit(".", 1)[-1].lower()
+                out = {"answer": "unknown",
+                       "reason": f"{why} at {int(q['ms'])} ms" if why == "timeout" else why}
+        except Exception as exc:  # noqa: BLE001 - a parse or API error is an answer, not a crash
+            out = {"answer": "unknown", "reason": f"cvc5 error: {exc}"}
+        sys.stdout.write(json.dumps(out) + "\n")
+        sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    _serve()

@@ -1,0 +1,72 @@
+"""How deep a proved VC is: the weakest reasoning that proves it, found by running it.
+
+Levels, weakest first:
+
+- ``propositional``: the Boolean abstraction of the proof check (hypotheses and the negated
+  goal) is unsat. Every Boolean term whose head is not a connective (an equation, an
+  inequality, an application of a predicate, a quantified formula) is replaced by a fresh
+  Boolean constant, equal terms by the same one (``_smtlib.Mode.PROPOSITIONAL``). The VC then
+  holds by its Boolean skeleton: it would hold for any meaning of its atoms.
+- ``ground``: the check, with its outer existentials skolemised and every quantified formula
+  left replaced by a fresh Boolean constant (equal ones by the same), is unsat
+  (``_smtlib.Mode.GROUND``). Z3 then proves it with its theories (arithmetic, arrays,
+  uninterpreted functions) and no quantifier instantiated: there is none left to instantiate.
+  Skolemising is not instantiation (it names the witness of an existential, keeping
+  satisfiability), and a lambda applied by ``select`` is beta-reduced as the text is written.
+  This is the sound reading of "no quantifier instantiated": turning off Z3's e-matching and
+  MBQI instead would leave its preprocessing free to eliminate quantifiers (destructive
+  equality resolution, macro finding), which is instantiation by another name. A VC with no
+  quantifier left once skolemised (nothing abstracted) is ground by its own proof.
+- ``full``: neither abstraction is unsat (or the solver did not decide it within
+  ``DEPTH_TIMEOUT_MS``); the proof needs quantifier instantiation (or more time).
+
+Both abstractions over-approximate the check (a model of the check gives one of the
+abstraction), so their unsat is a proof of the VC by the weaker reasoning: the level is an upper
+bound on the weakest reasoning that proves it, exact unless a check ran out of time. The texts
+are standard SMT-LIB (``_smtlib``), parsed by Z3.
+"""
+
+from __future__ import annotations
+
+import z3
+
+from ._smtlib import Mode, NotStandard, smtlib_query
+
+__all__ = ["DEPTH_TIMEOUT_MS", "LEVELS", "deepest", "vc_depth"]
+
+#: Per abstraction check; the abstractions are small, or they fail fast.
+DEPTH_TIMEOUT_MS = 3_000
+
+#: Weakest first.
+LEVELS = ("propositional", "ground", "full")
+
+
+def _unsat(text: str, timeout_ms: int, ctx: z3.Context | None) -> bool:
+    s = z3.Solver(ctx=ctx or z3.Context())
+    s.set("timeout", timeout_ms)
+    s.from_string(text)
+    return s.check() == z3.unsat
+
+
+def vc_depth(hypotheses: list[z3.BoolRef], goal: z3.BoolRef,
+             timeout_ms: int = DEPTH_TIMEOUT_MS, ctx: z3.Context | None = None) -> str:
+    """The weakest level (LEVELS) at which ``hypotheses ∧ ¬goal`` is unsat; call it only for
+    a VC already proved (the level is then ``full`` at worst). The abstractions are parsed
+    into ``ctx`` (default: a fresh context), each by a fresh solver."""
+    for level, mode in (("propositional", Mode.PROPOSITIONAL), ("ground", Mode.GROUND)):
+        try:
+            q = smtlib_query(hypotheses, goal, mode)
+        except NotStandard:
+            continue
+        if mode is Mode.GROUND and q.abstracted == 0:
+            # Nothing was abstracted: once skolemised the check has no quantifier at all, and
+            # it is the proof itself (proved unsat), which instantiated nothing.
+            return level
+        if _unsat(q.text, timeout_ms, ctx):
+            return level
+    return "full"
+
+
+def deepest(levels: list[str]) -> str | None:
+    """An obligation is as deep as its deepest VC (None: no proved VC)."""
+    return max(levels, key=LEVELS.index) if levels else None

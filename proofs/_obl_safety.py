@@ -1,0 +1,1608 @@
+"""The end-to-end safety theorem (docs/model.md §10): the ``Safety.*`` obligations.
+
+For each variant, a path valid under the fixed is_path over a D_R that meets Theorem 1/3's
+postcondition never lets the arms touch, at any instant t >= 0 of the executed motion (the
+principal's PTP motion, the subordinate linear in joint space from cell to cell, one cell per
+dt, then at rest). The parts, each an obligation:
+
+(a) ``Safety.<variant>.principal_in_layer_box``: theta_L(t) = start + (goal - start)
+    min(t / Tf, 1) lies in layer k's box (the variant's rule) for t in [k dt, (k+1) dt], and
+    in the rest layer's box for t >= N dt (N = max(1, ceil(Tf / dt))).
+(b) ``Safety.subordinate_in_cell_box``: the linear move from cell L_k to a neighbour stays in
+    L_k's box over the whole step; on a valid path every step is such a move, a wait once the
+    list has ended.
+(c) ``Safety.region_soundness``: a point of a link at any configuration of a box lies in the
+    region built for that box (the lattice of impl.lattice_range's formula, the link
+    rectangles grown by impl.sweep_margin, their convex hull), the margin derived from
+    Margin.arc_chord and the snap slack, and compared with the margin sweep_margin computes.
+(d) ``Safety.separation``: regions more than eps apart contain links that share no point.
+(e) ``Safety.<variant>.composition``: (a)-(d), Def4.is_path_fixed_safe and the time-layer
+    decomposition give the theorem.
+
+Trigonometry. sin and cos are the uninterpreted functions ``Sin``, ``Cos`` over Z3's reals;
+all that is known of them are the ledger's facts (A3), each stated at points the proof names.
+A lemma is a VC over free names; a proof that uses it instantiates it by substitution, like the
+step lemmas of Lemma.sweep_margin: its premises are then Z3's to discharge, and the facts it
+rests on (A3 instances and instances of other proved lemmas, true at any point) are carried into
+the proof's hypotheses, substituted. Where a proof only chains norm bounds, |v|^2 is the
+uninterpreted ``sq`` and the dot product ``dt``: such a VC is valid for every sq and dt, hence
+for the polynomials, under which its lemma instances are the proved lemmas' instances.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+
+import z3
+
+from ..impl import SNAP, lattice_range, link_reach, sweep_margin
+from ..spec import EPS, Arm
+from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
+                            is_path_fixed, member, position, z3_path)
+from ._obl_margin import margin_obligations
+from ._obl_paths import path_obligations
+from ._obligation import VC, Method, Obligation, Verdict, Z3Query
+
+__all__ = ["VARIANTS", "safety_obligations"]
+
+GROUP = "End-to-end safety (docs/model.md §10)"
+
+VARIANTS = ("original", "modified", "tight")
+
+#: A rational below pi (the lattice spacings' bound, as in Margin.arc_chord).
+G_MAX = z3.Q(157, 50)
+#: impl.SNAP and spec.EPS as the rationals their decimal literals denote.
+SNAP_Q = z3.RealVal(repr(SNAP))
+EPS_Q = z3.RealVal(repr(EPS))
+
+Vec = tuple[z3.ArithRef, z3.ArithRef]
+Hyp = tuple[str, z3.BoolRef]
+_R = z3.RealSort()
+
+# --- vectors, norms, trigonometry -----------------------------------------------------------
+
+_SQ = z3.Function("sq", _R, _R, _R)
+_DT = z3.Function("dt", _R, _R, _R, _R, _R)
+_V0, _V1, _V2, _V3 = (z3.Var(i, _R) for i in range(4))
+#: sq(a, b) := a^2 + b^2 and dt(a, b, c, d) := a c + b d: what the abstract norms stand for.
+_CONCRETE = ((_SQ, _V0 * _V0 + _V1 * _V1), (_DT, _V0 * _V2 + _V1 * _V3))
+
+
+def concrete(f: z3.ExprRef) -> z3.ExprRef:
+    """f with sq and dt replaced by the polynomials they stand for."""
+    return z3.substitute_funs(f, *_CONCRETE)
+
+
+def _v(name: str) -> Vec:
+    return z3.Real(f"{name}.x"), z3.Real(f"{name}.y")
+
+
+def _add(a: Vec, b: Vec) -> Vec:
+    return (a[0] + b[0], a[1] + b[1])
+
+
+def _sub(a: Vec, b: Vec) -> Vec:
+    return (a[0] - b[0], a[1] - b[1])
+
+
+def _scale(c: z3.ArithRef, a: Vec) -> Vec:
+    return (c * a[0], c * a[1])
+
+
+def _comb(a: Vec, b: Vec, t: z3.ArithRef) -> Vec:
+    """(1 - t) a + t b."""
+    return ((1 - t) * a[0] + t * b[0], (1 - t) * a[1] + t * b[1])
+
+
+def _veq(a: Vec, b: Vec) -> z3.BoolRef:
+    return z3.And(a[0] == b[0], a[1] == b[1])
+
+
+def N2(v: Vec) -> z3.ArithRef:
+    """|v|^2, abstract: ``concrete`` makes it v.x^2 + v.y^2."""
+    return _SQ(v[0], v[1])
+
+
+def DOT(a: Vec, b: Vec) -> z3.ArithRef:
+    return _DT(a[0], a[1], b[0], b[1])
+
+
+_COS = z3.Function("Cos", _R, _R)
+_SIN = z3.Function("Sin", _R, _R)
+
+
+def e(x: z3.ArithRef) -> Vec:
+    """(cos x, sin x)."""
+    return (_COS(x), _SIN(x))
+
+
+def _rot(cs: Vec, v: Vec) -> Vec:
+    """v turned by the angle whose (cos, sin) is cs."""
+    return (cs[0] * v[0] - cs[1] * v[1], cs[1] * v[0] + cs[0] * v[1])
+
+
+def _unit(cs: Vec) -> z3.BoolRef:
+    """(cos, sin) on the unit circle, |cs|^2 = 1 (abstract norm: concrete, c^2 + s^2 = 1)."""
+    return N2(cs) == 1
+
+
+def _sum_rule(t: Vec, x: Vec, y: Vec) -> z3.BoolRef:
+    """e(x + y) = e(x) e(y) on values: t is (cos, sin) of x + y."""
+    return z3.And(t[0] == x[0] * y[0] - x[1] * y[1], t[1] == x[1] * y[0] + x[0] * y[1])
+
+
+def _diff_rule(t: Vec, x: Vec, y: Vec) -> z3.BoolRef:
+    """e(x - y) from e(x), e(y)."""
+    return z3.And(t[0] == x[0] * y[0] + x[1] * y[1], t[1] == x[1] * y[0] - x[0] * y[1])
+
+
+def _same(a: z3.ArithRef, b: z3.ArithRef) -> None:
+    """a and b are the same real for every value of their names (else the fact is not one)."""
+    if z3.is_true(z3.simplify(a == b)):
+        return
+    s = z3.Solver()
+    s.set("timeout", 2000)
+    s.add(a != b)
+    if s.check() != z3.unsat:
+        raise ValueError(f"not an identity: {a} = {b}")
+
+
+# The ledger's trigonometric facts (A3), each at the points given; ``at`` names them.
+def a3_unit(x: z3.ArithRef, at: str) -> Hyp:
+    return (f"A3 cos^2 + sin^2 = 1 at {at}", _unit(e(x)))
+
+
+def a3_sum(total: z3.ArithRef, x: z3.ArithRef, y: z3.ArithRef, at: str) -> Hyp:
+    _same(total, x + y)
+    return (f"A3 cos, sin of a sum at {at}", _sum_rule(e(total), e(x), e(y)))
+
+
+def a3_diff(total: z3.ArithRef, x: z3.ArithRef, y: z3.ArithRef, at: str) -> Hyp:
+    _same(total, x - y)
+    return (f"A3 cos, sin of a difference at {at}", _diff_rule(e(total), e(x), e(y)))
+
+
+def a3_cos_bound(x: z3.ArithRef, at: str) -> Hyp:
+    return (f"A3 cos x >= 1 - x^2/2 at {at}", _COS(x) >= 1 - x * x / 2)
+
+
+def a3_cos_mono(x: z3.ArithRef, y: z3.ArithRef, at: str) -> Hyp:
+    return (f"A3 cos even, non-increasing on [0, pi], at {at}",
+            z3.Implies(z3.And(-y <= x, x <= y, y <= G_MAX), _COS(x) >= _COS(y)))
+
+
+def a3_sin_nonneg(x: z3.ArithRef, at: str) -> Hyp:
+    return (f"A3 sin >= 0 on [0, pi] at {at}",
+            z3.Implies(z3.And(0 <= x, x <= G_MAX), _SIN(x) >= 0))
+
+
+def a3_cos_nonneg(x: z3.ArithRef, at: str) -> Hyp:
+    return (f"A3 cos >= 0 on [0, pi/2] at {at}",
+            z3.Implies(z3.And(0 <= x, 2 * x <= G_MAX), _COS(x) >= 0))
+
+
+# --- lemmas and their use by substitution ----------------------------------------------------
+
+#: A lemma's trigonometric facts (A3, assumed at any point): a proof that uses the lemma carries
+#: them, substituted, into its own hypotheses. Its instances of other proved lemmas ("by ...")
+#: are not carried: they hold wherever the norms mean |v|^2 and the dot product, where the
+#: user's conclusion is read.
+_CARRIED = ("A3 ",)
+_PROVED = "by "
+
+Pairs = Sequence[tuple[z3.ExprRef, z3.ExprRef]]
+
+
+@dataclass(frozen=True)
+class Lemma:
+    """A proved VC and the form a proof instantiates: ``hyps``/``goal`` in abstract norms
+    (``vc`` holds them concrete unless the lemma is abstract: its VC is then proved for every
+    sq, dt). ``names`` are its free names, by key, for ``at``."""
+
+    vc: VC
+    hyps: tuple[Hyp, ...]
+    goal: z3.BoolRef
+    names: tuple[tuple[str, object], ...] = ()
+
+    def use(self, pairs: Pairs, at: str) -> list[Hyp]:
+        """The hypotheses a proof adds to use this lemma at ``pairs`` (names -> terms): its
+        trigonometric facts, substituted, and the lemma instantiated under its other premises.
+        Sound: the lemma's VC is proved with those facts and its instances of proved lemmas
+        as hypotheses, and the instances hold where the norms are |v|^2 (for an abstract
+        lemma) or are none (for a concrete one)."""
+        sub = (lambda f: z3.substitute(f, *pairs)) if pairs else (lambda f: f)
+        carried = [(n, h) for n, h in self.hyps if n.startswith(_CARRIED)]
+        rest = [h for n, h in self.hyps if not n.startswith(_CARRIED + (_PROVED,))]
+        out = [(f"{n} [{at}]", sub(h)) for n, h in carried]
+        body = z3.Implies(z3.And(rest), self.goal) if rest else self.goal
+        out.append((f"by {self.vc.name} at {at}", sub(body)))
+        return out
+
+    def at(self, at: str, **terms: object) -> list[Hyp]:
+        """``use`` with the free names given by key (a vector name takes a pair of terms)."""
+        names = dict(self.names)
+        unknown = set(terms) - set(names)
+        if unknown:
+            raise KeyError(f"{self.vc.name} has no names {sorted(unknown)}")
+        return self.use(_pairs(*[(names[k], v) for k, v in terms.items()]), at)
+
+    def term(self, f: z3.ExprRef, **terms: object) -> z3.ExprRef:
+        """A term in this lemma's names, at ``terms``."""
+        names = dict(self.names)
+        pairs = _pairs(*[(names[k], v) for k, v in terms.items()])
+        return z3.substitute(f, *pairs) if pairs else f
+
+
+def lemma(name: str, hyps: Sequence[Hyp], goal: z3.BoolRef, key: str, *, abstract: bool = False,
+          names: dict[str, object] | None = None, witness: Pairs = (),
+          counter_witness: Pairs = ()) -> Lemma:
+    hyps = _dedupe(hyps)
+    if key not in [n for n, _ in hyps]:
+        raise KeyError(f"{name}: no hypothesis {key!r}")
+    if abstract:
+        vc = VC(name, hyps, goal, key_premise=key, witness=tuple(witness),
+                counter_witness=tuple(counter_witness))
+    else:
+        vc = VC(name, tuple((n, concrete(h)) for n, h in hyps), concrete(goal), key_premise=key,
+                witness=tuple(witness), counter_witness=tuple(counter_witness))
+    return Lemma(vc, hyps, goal, tuple((names or {}).items()))
+
+
+def _dedupe(hyps: Sequence[Hyp]) -> tuple[Hyp, ...]:
+    out: list[Hyp] = []
+    seen: list[z3.BoolRef] = []
+    for n, h in hyps:
+        if any(z3.eq(h, s) for s in seen):
+            continue
+        seen.append(h)
+        out.append((" ".join(n.split()), h))
+    return tuple(out)
+
+
+def _pairs(*groups: tuple[object, object]) -> list[tuple[z3.ExprRef, z3.ExprRef]]:
+    """Substitution pairs; a vector pairs component by component."""
+    out: list[tuple[z3.ExprRef, z3.ExprRef]] = []
+    for name, term in groups:
+        if isinstance(name, tuple):
+            out += list(zip(name, term))  # type: ignore[arg-type]
+        else:
+            out.append((name, term))  # type: ignore[arg-type]
+    return out
+
+
+def _obligation_vc(ident: str, vc_name: str, obligations: Sequence[Obligation]) -> VC:
+    """A VC of another obligation, as the prove run discharges it."""
+    ob = next(o for o in obligations if o.id == ident)
+    q = ob.build()
+    assert isinstance(q, Z3Query)
+    return next(v for v in q.vcs if v.name == vc_name)
+
+
+# --- Margin.arc_chord, as proved ---------------------------------------------------------------
+
+def abstract_norms(f: z3.ExprRef) -> z3.ExprRef:
+    """f with every a*a + b*b (as Margin's _n2 builds it) written sq(a, b)."""
+    if z3.is_add(f) and f.num_args() == 2:
+        a, b = f.arg(0), f.arg(1)
+        if (z3.is_mul(a) and z3.is_mul(b) and a.num_args() == 2 and b.num_args() == 2
+                and z3.eq(a.arg(0), a.arg(1)) and z3.eq(b.arg(0), b.arg(1))):
+            return _SQ(abstract_norms(a.arg(0)), abstract_norms(b.arg(0)))
+    if z3.is_app(f) and f.num_args() > 0:
+        return f.decl()(*[abstract_norms(c) for c in f.children()])
+    return f
+
+
+@dataclass(frozen=True)
+class ArcChord:
+    """Margin.arc_chord's VC (its names r, g, c = cos(g/2), s = sin(g/2), c_psi, s_psi) and the
+    parts of its goal the other lemmas use: the chord weight t, the bound delta (r g^2/8 as
+    proved) and m - q, the point minus its chord point, in abstract norms."""
+
+    vc: VC
+    r: z3.ArithRef
+    g: z3.ArithRef
+    c: z3.ArithRef
+    s: z3.ArithRef
+    cp: z3.ArithRef
+    sp: z3.ArithRef
+    t: z3.ArithRef
+    delta: z3.ArithRef
+    mq: Vec
+
+    def lemma(self) -> Lemma:
+        hyps = tuple((n, abstract_norms(h)) for n, h in self.vc.hypotheses)
+        goal = abstract_norms(self.vc.goal)
+        pairs = [(h[1], h0[1]) for h, h0 in zip(hyps, self.vc.hypotheses)] + [(goal, self.vc.goal)]
+        if not all(z3.eq(concrete(a), b) for a, b in pairs):
+            raise ValueError("Margin.arc_chord does not read back from abstract norms")
+        return Lemma(self.vc, hyps, goal)
+
+    def delta_at(self, radius: z3.ArithRef, turn: z3.ArithRef) -> z3.ArithRef:
+        """The lemma's bound for a point at ``radius`` turning through ``turn``."""
+        return z3.substitute(self.delta, (self.r, radius), (self.g, turn))
+
+
+def arc_chord(vc: VC | None = None) -> ArcChord:
+    """Margin.arc_chord as the prove run has it (or ``vc``, a mutant for the tests)."""
+    if vc is None:
+        vc = _obligation_vc("Margin.arc_chord", "arc_within_chord", margin_obligations())
+    r, g, c, s, cp, sp = z3.Reals("r g c s c_psi s_psi")
+    goal = abstract_norms(vc.goal)
+    bad = ValueError("Margin.arc_chord's goal is not 0 <= t <= 1 and |m - q|^2 <= delta^2")
+    if not (z3.is_and(goal) and goal.num_args() == 3):
+        raise bad
+    lo, hi, bound = goal.children()
+    t = hi.arg(0)
+    lhs, rhs = bound.arg(0), bound.arg(1)
+    if not (z3.is_le(hi) and z3.is_ge(lo) and z3.eq(lo.arg(0), t) and z3.is_le(bound)
+            and lhs.decl().eq(_SQ) and z3.is_mul(rhs) and rhs.num_args() == 2
+            and z3.eq(rhs.arg(0), rhs.arg(1))):
+        raise bad
+    return ArcChord(vc, r, g, c, s, cp, sp, t, rhs.arg(0), (lhs.arg(0), lhs.arg(1)))
+
+
+# --- the margin impl computes, read symbolically -----------------------------------------------
+
+#: A probe arm: impl.sweep_margin is called with it on symbolic spacings, and its reach values
+#: (impl.link_reach) are replaced by symbols; the reading is checked on other arms' floats.
+_PROBE = Arm(base=(0.0, 0.0), links=(0.35, 0.3), width=0.06, omega=(1.0, 1.0))
+_SAMPLE_ARMS = (_PROBE, Arm(base=(0.6, 0.0), links=(0.5, 0.25), width=0.04, omega=(1.0, 1.0)),
+                Arm(base=(-2.0, 1.0), links=(1.3, 0.7), width=0.2, omega=(2.0, 0.5)))
+_SAMPLE_G = ((0.02, 0.02), (0.5, 0.01), (3.14, 1.0))
+
+
+def _q(x: float | Fraction) -> z3.ArithRef:
+    f = Fraction(x)
+    return z3.RealVal(f"{f.numerator}/{f.denominator}")
+
+
+def _occurs(term: z3.ExprRef, inside: z3.ExprRef) -> bool:
+    if z3.eq(term, inside):
+        return True
+    return any(_occurs(term, c) for c in inside.children())
+
+
+def impl_margin_term(link: int, g: Vec, reach: Vec, flags: tuple[bool, bool],
+                     margin: Callable[..., object] = sweep_margin) -> z3.ArithRef:
+    """``margin(arm, link, g, flags)`` (impl.sweep_margin) for symbolic spacings g and reach
+    (R_base, R_elbow): called on the probe arm, its reach numerals replaced by the symbols, and
+    checked against the floats ``margin`` gives for sample arms and spacings."""
+    rb, re = link_reach(_PROBE, link)
+    out = margin(_PROBE, link, g, flags)
+    term = (out if isinstance(out, z3.ExprRef)
+            else z3.RealVal(repr(float(out))))  # type: ignore[arg-type]
+    pairs = [(z3.RealVal(rb), reach[0])] + ([(z3.RealVal(re), reach[1])] if re else [])
+    read = z3.substitute(term, *pairs)
+    if any(_occurs(z3.RealVal(x), read) for x in (rb, re) if x):
+        raise ValueError("the probe's reach survives in the margin read")
+    for arm in _SAMPLE_ARMS:
+        rb2, re2 = link_reach(arm, link)
+        for gg in _SAMPLE_G:
+            want = Fraction(float(margin(arm, link, gg, flags)))  # type: ignore[arg-type]
+            got = z3.simplify(z3.substitute(read, (g[0], _q(gg[0])), (g[1], _q(gg[1])),
+                                            (reach[0], _q(rb2)), (reach[1], _q(re2))))
+            if not z3.is_rational_value(got):
+                raise ValueError(f"the margin read is not a number at sample inputs: {got}")
+            val = got.as_fraction()
+            if abs(val - want) > abs(want) * Fraction(1, 10**12):
+                raise ValueError(f"the margin read gives {float(val)!r}, sweep_margin "
+                                 f"{float(want)!r} for {arm}, link {link}, g = {gg}")
+    return read
+
+
+def impl_margin(link: int, g: Vec, reach: Vec, moving: tuple[z3.BoolRef, z3.BoolRef],
+                margin: Callable[..., object] = sweep_margin) -> z3.ArithRef:
+    """The margin swept_region grows link ``link``'s rectangles by, for the lattice's moving
+    joints (link 1 never moves joint 2: it does not depend on theta2)."""
+    def at(f1: bool, f2: bool) -> z3.ArithRef:
+        return impl_margin_term(link, g, reach, (f1, f2), margin)
+    if link == 0:
+        return z3.If(moving[0], at(True, False), at(False, False))
+    return z3.If(moving[0], z3.If(moving[1], at(True, True), at(True, False)),
+                 z3.If(moving[1], at(False, True), at(False, False)))
+
+
+# --- (c) region soundness: the construction --------------------------------------------------
+
+@dataclass(frozen=True)
+class Lattice:
+    """One joint of a box [lo, hi], its lattice anchored at A with spacing g (impl's
+    swept_region): the indices impl.lattice_range gives (i_lo, i_hi), whether the lattice has
+    more than one point (``moving``), theta clamped onto the lattice's span (theta_c), and the
+    lattice cell [c, c + G] holding it: j its first index, G = g if moving, else 0, the far
+    corner's index j + step. Each is a name; ``defs`` define them (impl's formulas)."""
+
+    i_lo: z3.ArithRef
+    i_hi: z3.ArithRef
+    moving: z3.BoolRef
+    theta_c: z3.ArithRef
+    j: z3.ArithRef
+    G: z3.ArithRef
+    c: z3.ArithRef
+    defs: tuple[Hyp, ...]
+
+    @property
+    def step(self) -> z3.ArithRef:
+        return z3.If(self.moving, z3.IntVal(1), z3.IntVal(0))
+
+    def names(self) -> dict[str, object]:
+        return dict(i_lo=self.i_lo, i_hi=self.i_hi, moving=self.moving, theta_c=self.theta_c,
+                    j=self.j, G=self.G, c=self.c)
+
+
+def lattice(prefix: str, lo: z3.ArithRef, hi: z3.ArithRef, th: z3.ArithRef, A: z3.ArithRef,
+            g: z3.ArithRef) -> Lattice:
+    i_lo, i_hi, j = z3.Ints(f"{prefix}.i_lo {prefix}.i_hi {prefix}.j")
+    moving = z3.Bool(f"{prefix}.moving")
+    thc, G, c = z3.Reals(f"{prefix}.theta_c {prefix}.G {prefix}.c")
+    # lattice_range: floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP), then (min, max).
+    a = z3.ToInt((lo - A) / g + SNAP_Q)
+    b = -z3.ToInt(-((hi - A) / g - SNAP_Q))
+    x = (th - A) / g
+    lo_r, hi_r = z3.ToReal(i_lo), z3.ToReal(i_hi)
+    xc = z3.If(x < lo_r, lo_r, z3.If(x > hi_r, hi_r, x))
+    fl = z3.ToInt(xc)
+    defs = (
+        (f"{prefix}: i_lo, i_hi = impl.lattice_range(lo, hi, A, g)",
+         z3.And(i_lo == z3.If(a <= b, a, b), i_hi == z3.If(a <= b, b, a))),
+        (f"{prefix}: moving = i_hi > i_lo (more than one lattice point)", moving == (i_hi > i_lo)),
+        (f"{prefix}: theta_c = theta clamped onto [A + i_lo g, A + i_hi g]", thc == A + xc * g),
+        (f"{prefix}: the cell [c, c + G] of theta_c, j its first index",
+         z3.And(j == z3.If(moving, z3.If(fl >= i_hi, i_hi - 1, fl), i_lo),
+                G == z3.If(moving, g, z3.RealVal(0)), c == A + z3.ToReal(j) * g)),
+    )
+    return Lattice(i_lo, i_hi, moving, thc, j, G, c, defs)
+
+
+def check_lattice_reading() -> None:
+    """The model's i_lo, i_hi are impl.lattice_range's, on sample boxes (floats, exactly)."""
+    for box, anchor, sp in (((-0.04, 0.04), 0.0, 0.04), ((0.3, 0.32), 0.3, 0.02),
+                            ((1.0, 1.0), 1.0, 0.5), ((-1.3, 0.7), 0.25, 0.1),
+                            ((0.1 - 1e-12, 0.5 + 1e-12), 0.1, 0.1)):
+        L = lattice("chk", _q(box[0]), _q(box[1]), _q(box[0]), _q(anchor), _q(sp))
+        s = z3.Solver()
+        s.set("timeout", 2000)
+        s.add([h for _, h in L.defs])
+        if s.check() != z3.sat:
+            raise ValueError(f"lattice model undecided at {box, anchor, sp}")
+        m = s.model()
+        got = (m.eval(L.i_lo).as_long(), m.eval(L.i_hi).as_long())
+        want = lattice_range(box[0], box[1], anchor, sp)
+        if got != want:
+            raise ValueError(f"lattice_range{box, anchor, sp} = {want}, the model gives {got}")
+
+
+def snap_bound(th: z3.ArithRef, thc: z3.ArithRef, s: z3.ArithRef) -> z3.BoolRef:
+    return z3.And(-s <= th - thc, th - thc <= s)
+
+
+def _wvec_cs(l1: z3.ArithRef, cs: Vec, u: z3.ArithRef, v: z3.ArithRef) -> Vec:
+    p = _rot(cs, (u, v))
+    return (l1 + p[0], p[1])
+
+
+def _wvec(l1: z3.ArithRef, beta: z3.ArithRef, u: z3.ArithRef, v: z3.ArithRef) -> Vec:
+    """Link 2's point (u, v) seen from the base with theta1 = 0: (l1, 0) + R(beta) (u, v)."""
+    return _wvec_cs(l1, e(beta), u, v)
+
+
+def _elbow_cs(b: Vec, l1: z3.ArithRef, cs: Vec) -> Vec:
+    return _add(b, _scale(l1, cs))
+
+
+def _elbow(b: Vec, l1: z3.ArithRef, alpha: z3.ArithRef) -> Vec:
+    return _elbow_cs(b, l1, e(alpha))
+
+
+def _point2_cs(b: Vec, l1: z3.ArithRef, ca: Vec, cphi: Vec, u: z3.ArithRef,
+               v: z3.ArithRef) -> Vec:
+    return _add(_elbow_cs(b, l1, ca), _rot(cphi, (u, v)))
+
+
+def _point2(b: Vec, l1: z3.ArithRef, alpha: z3.ArithRef, phi: z3.ArithRef, u: z3.ArithRef,
+            v: z3.ArithRef) -> Vec:
+    """docs/model.md §2: the elbow b + l1 e(alpha), then (u, v) in link 2's frame at angle phi
+    (phi = alpha + theta2, the absolute angle of link 2)."""
+    return _point2_cs(b, l1, e(alpha), e(phi), u, v)
+
+
+def grown_coords(phi: z3.ArithRef, u: z3.ArithRef, v: z3.ArithRef, d: Vec) -> Vec:
+    """The frame coordinates (at angle phi) of the frame point (u, v) moved by d."""
+    c, s = e(phi)
+    return (u + (c * d[0] + s * d[1]), v + (-s * d[0] + c * d[1]))
+
+
+def in_rect(uv: Vec, r: z3.ArithRef, ell: z3.ArithRef) -> z3.BoolRef:
+    """(u, v) in the frame of a link of length ell, half-width r, extended by r past both ends."""
+    return z3.And(-r <= uv[0], uv[0] <= ell + r, -r <= uv[1], uv[1] <= r)
+
+
+# --- (c) region soundness: small lemmas, proved on the polynomials ---------------------------
+
+def _rot_norm() -> Lemma:
+    c, s = z3.Reals("rn.c rn.s")
+    y, z = _v("rn.y"), _v("rn.z")
+    key = "z = R(c, s) y"
+    return lemma("rot_norm", (("(c, s) on the unit circle", _unit((c, s))),
+                              (key, _veq(z, _rot((c, s), y)))), N2(z) == N2(y), key,
+                 names=dict(cs=(c, s), y=y, z=z))
+
+
+def _rot_scale() -> Lemma:
+    c, s = z3.Reals("rs.c rs.s")
+    y, z = _v("rs.y"), _v("rs.z")
+    key = "z = R(c, s) y"
+    return lemma("rot_scale", ((key, _veq(z, _rot((c, s), y))),), N2(z) == N2((c, s)) * N2(y),
+                 key, names=dict(cs=(c, s), y=y, z=z))
+
+
+def _scale_norm() -> Lemma:
+    c = z3.Real("sn.c")
+    y, z = _v("sn.y"), _v("sn.z")
+    key = "z = c y"
+    return lemma("scale_norm", ((key, _veq(z, _scale(c, y))),), N2(z) == c * c * N2(y), key,
+                 names=dict(c=c, y=y, z=z))
+
+
+def _expand() -> Lemma:
+    x, y, z = _v("ex.x"), _v("ex.y"), _v("ex.z")
+    key = "z = x + y"
+    return lemma("expand", ((key, _veq(z, _add(x, y))),),
+                 N2(z) == N2(x) + 2 * DOT(x, y) + N2(y), key, names=dict(x=x, y=y, z=z))
+
+
+def _dot_bound() -> Lemma:
+    x, y = _v("db.x"), _v("db.y")
+    a, b = z3.Reals("db.a db.b")
+    key = "|y| <= b"
+    return lemma("dot_bound", (("a, b >= 0", z3.And(a >= 0, b >= 0)), ("|x| <= a", N2(x) <= a * a),
+                               (key, N2(y) <= b * b)), DOT(x, y) <= a * b, key,
+                 names=dict(x=x, y=y, a=a, b=b))
+
+
+def _square_monotone() -> Lemma:
+    a, b, m = z3.Reals("sm.a sm.b sm.m")
+    key = "a <= b"
+    return lemma("square_monotone", (("0 <= a", 0 <= a), (key, a <= b), ("m <= a^2", m <= a * a)),
+                 m <= b * b, key, names=dict(a=a, b=b, m=m))
+
+
+def _proj_id() -> Lemma:
+    c, s = z3.Reals("pj.c pj.s")
+    d = _v("pj.d")
+    key = "(c, s) on the unit circle"
+    return lemma("proj_id", ((key, _unit((c, s))),),
+                 N2((c * d[0] + s * d[1], -s * d[0] + c * d[1])) == N2(d), key,
+                 names=dict(cs=(c, s), d=d))
+
+
+def _proj_bound() -> Lemma:
+    p, q, dl = z3.Reals("pb.p pb.q pb.delta")
+    key = "|(p, q)| <= delta"
+    return lemma("proj_bound", (("delta >= 0", dl >= 0), (key, N2((p, q)) <= dl * dl)),
+                 z3.And(-dl <= p, p <= dl, -dl <= q, q <= dl), key, names=dict(p=p, q=q, delta=dl))
+
+
+def _grow_id() -> Lemma:
+    c, s, u, v = z3.Reals("gi.c gi.s gi.u gi.v")
+    J, d = _v("gi.J"), _v("gi.d")
+    key = "(c, s) on the unit circle"
+    uv2 = (u + (c * d[0] + s * d[1]), v + (-s * d[0] + c * d[1]))
+    goal = _veq(_add(_add(J, _rot((c, s), (u, v))), d), _add(J, _rot((c, s), uv2)))
+    return lemma("grow_id", ((key, _unit((c, s))),), goal, key,
+                 names=dict(cs=(c, s), u=u, v=v, J=J, d=d))
+
+
+def _chord0() -> Lemma:
+    c, sn, x, R, s = z3.Reals("c0.c c0.s c0.x c0.R c0.sbound")
+    w = _v("c0.w")
+    key = "c >= 1 - x^2/2"
+    hyps = (("(c, s) on the unit circle", _unit((c, sn))), (key, c >= 1 - x * x / 2),
+            ("-s <= x <= s", z3.And(-s <= x, x <= s)),
+            ("|w| <= R", z3.And(R >= 0, N2(w) <= R * R)))
+    return lemma("chord0", hyps, N2(_sub(_rot((c, sn), w), w)) <= (s * R) * (s * R), key,
+                 names=dict(cs=(c, sn), x=x, R=R, s=s, w=w))
+
+
+def _chord_id() -> Lemma:
+    A, B, X = _v("ci.A"), _v("ci.B"), _v("ci.X")
+    o, w = _v("ci.o"), _v("ci.w")
+    key = "e(alpha) = e(beta) e(x)"
+    goal = _veq(_sub(_add(o, _rot(A, w)), _add(o, _rot(B, w))), _rot(B, _sub(_rot(X, w), w)))
+    return lemma("chord_id", ((key, _sum_rule(A, B, X)),), goal, key,
+                 names=dict(A=A, B=B, X=X, o=o, w=w))
+
+
+def _ab(cp: z3.ArithRef, sp: z3.ArithRef, c: z3.ArithRef, s: z3.ArithRef, t: z3.ArithRef) -> Vec:
+    """R(psi) - (1 - t) R(-half) - t R(half), a scaled rotation, as its (cos, sin)-like pair."""
+    return (cp - ((1 - t) * c + t * c), sp - ((1 - t) * (-s) + t * s))
+
+
+def _rigid_id() -> Lemma:
+    """A point turning about o, minus its chord point at weight t, is R(mid) applied to the
+    same difference for the arc at the origin, symmetric about the x-axis (on values: T, S0,
+    S1 are e(theta), e(a0), e(a0 + G); M, P, H are e(mid), e(psi), e(G/2))."""
+    M, P, H, T, S0, S1 = (_v(f"ri.{n}") for n in ("mid", "psi", "half", "theta", "start", "end"))
+    t = z3.Real("ri.t")
+    o, w = _v("ri.o"), _v("ri.w")
+    key = "e(theta) = e(mid) e(psi)"
+    hyps = ((key, _sum_rule(T, M, P)), ("e(a0) = e(mid) e(-G/2)", _diff_rule(S0, M, H)),
+            ("e(a0 + G) = e(mid) e(G/2)", _sum_rule(S1, M, H)))
+    X, A, B = (_add(o, _rot(cs, w)) for cs in (T, S0, S1))
+    goal = _veq(_sub(X, _comb(A, B, t)), _rot(M, _rot(_ab(P[0], P[1], H[0], H[1], t), w)))
+    one, zero = z3.RealVal(1), z3.RealVal(0)
+    pins = ((T[0], z3.RealVal(2)), (w[0], one), (w[1], zero), (t, zero))
+    return lemma("rigid_id", hyps, goal, key, counter_witness=pins,
+                 names=dict(M=M, P=P, H=H, T=T, S0=S0, S1=S1, t=t, o=o, w=w))
+
+
+def _arc_monotone(arc: ArcChord) -> Lemma:
+    r, R, G, m = z3.Reals("am.r am.R am.G am.m")
+    key = "r^2 <= R^2"
+    lo, hi = arc.delta_at(r, G), arc.delta_at(R, G)
+    hyps = (("r, R >= 0", z3.And(r >= 0, R >= 0)), (key, r * r <= R * R),
+            ("m <= bound(r)^2", m <= lo * lo))
+    return lemma("arc_monotone", hyps, m <= hi * hi, key, names=dict(r=r, R=R, G=G, m=m))
+
+
+def _kin() -> Lemma:
+    """docs/model.md §2's link 2 point is the base turned by theta1 of the point at theta1 = 0
+    (on values: A, B, AB are e(theta1), e(theta2), e(theta1 + theta2))."""
+    A, B, AB = _v("kin.A"), _v("kin.B"), _v("kin.AB")
+    l1, u, v = z3.Reals("kin.l1 kin.u kin.v")
+    b = _v("kin.b")
+    key = "e(theta1 + theta2) = e(theta1) e(theta2)"
+    goal = _veq(_add(b, _rot(A, _wvec_cs(l1, B, u, v))), _point2_cs(b, l1, A, AB, u, v))
+    return lemma("kin", ((key, _sum_rule(AB, A, B)),), goal, key,
+                 names=dict(A=A, B=B, AB=AB, l1=l1, u=u, v=v, b=b))
+
+
+def _reach_uv(link: int) -> Lemma:
+    ell, r, R, u, v = z3.Reals(f"ru{link}.ell ru{link}.r ru{link}.R ru{link}.u ru{link}.v")
+    key = f"R = sqrt((l{link + 1} + r)^2 + r^2)"
+    hyps = ((f"l{link + 1}, r > 0", z3.And(ell > 0, r > 0)),
+            (key, z3.And(R >= 0, R * R == (ell + r) * (ell + r) + r * r)),
+            (f"(u, v) in link {link + 1}'s rectangle", in_rect((u, v), r, ell)))
+    return lemma(f"reach_uv_link{link + 1}", hyps, N2((u, v)) <= R * R, key,
+                 names=dict(ell=ell, r=r, R=R, u=u, v=v))
+
+
+def _reach_shift() -> Lemma:
+    l1, R = z3.Reals("rsh.l1 rsh.R")
+    y = _v("rsh.y")
+    key = "|y| <= R"
+    hyps = (("l1 > 0, R >= 0", z3.And(l1 > 0, R >= 0)), (key, N2(y) <= R * R))
+    return lemma("reach_shift", hyps, N2((l1 + y[0], y[1])) <= (l1 + R) * (l1 + R), key,
+                 names=dict(l1=l1, R=R, y=y))
+
+
+def lattice_goal(L: Lattice, th: z3.ArithRef, A: z3.ArithRef, g: z3.ArithRef) -> z3.BoolRef:
+    return z3.And(L.i_lo <= L.j, L.j + L.step <= L.i_hi, L.c <= L.theta_c,
+                  L.theta_c <= L.c + L.G, L.c + L.G == A + z3.ToReal(L.j + L.step) * g,
+                  0 <= L.G, L.G <= g, snap_bound(th, L.theta_c, SNAP_Q * g))
+
+
+def _lattice() -> Lemma:
+    lo, hi, th, A, g = z3.Reals("lat.lo lat.hi lat.theta lat.A lat.g")
+    L = lattice("lat", lo, hi, th, A, g)
+    hyps = (("g > 0", g > 0), ("lo <= theta <= hi", z3.And(lo <= th, th <= hi))) + L.defs
+    return lemma("lattice", hyps, lattice_goal(L, th, A, g), "lo <= theta <= hi",
+                 names=dict(lo=lo, hi=hi, theta=th, A=A, g=g, **L.names()))
+
+
+def margin_parts(arc: ArcChord, g: Vec, reach: Vec, G: Vec) -> tuple[z3.ArithRef, ...]:
+    """The derived margin's terms: the snap slack SNAP g_q R_q per joint, then Margin.arc_chord's
+    bound at R_q over the cell's turn G_q (0 for a joint with one lattice point)."""
+    return ((SNAP_Q * g[0]) * reach[0], (SNAP_Q * g[1]) * reach[1], arc.delta_at(reach[0], G[0]),
+            arc.delta_at(reach[1], G[1]))
+
+
+def _margin_covers(arc: ArcChord, link: int, margin: Callable[..., object]) -> Lemma:
+    """impl.sweep_margin covers the derived margin: the snap slack and Margin.arc_chord's bound
+    over each moving joint's lattice step, at the link's reach."""
+    P = f"mc{link + 1}"
+    g1, g2, rb, re, dl, G1, G2 = z3.Reals(f"{P}.g1 {P}.g2 {P}.Rb {P}.Re {P}.Delta {P}.G1 {P}.G2")
+    m1, m2 = z3.Bools(f"{P}.moving1 {P}.moving2")
+    key = f"Delta = impl.sweep_margin(arm, link {link + 1}, g, moving), read"
+    moving = (m1, m2) if link == 1 else (m1, z3.BoolVal(False))
+    s1, s2, e1, e2 = margin_parts(arc, (g1, g2), (rb, re), (G1, G2))
+    hyps = [("0 < g_q <= 3.14", z3.And(0 < g1, g1 <= G_MAX, 0 < g2, g2 <= G_MAX)),
+            ("R_base, R_elbow >= 0", z3.And(rb >= 0, re >= 0)),
+            ("G1 = g1 if joint 1 moves, else 0", G1 == z3.If(m1, g1, z3.RealVal(0)))]
+    if link == 1:
+        hyps.append(("G2 = g2 if joint 2 moves, else 0", G2 == z3.If(m2, g2, z3.RealVal(0))))
+    hyps.append((key, dl == impl_margin(link, (g1, g2), (rb, re), moving, margin)))
+    if link == 1:
+        goal = z3.And(z3.And(s1 >= 0, s2 >= 0, e1 >= 0, e2 >= 0), s1 + s2 + e1 + e2 <= dl, dl >= 0)
+    else:
+        goal = z3.And(z3.And(s1 >= 0, e1 >= 0), s1 + e1 <= dl, dl >= 0)
+    names = dict(g1=g1, g2=g2, Rb=rb, Re=re, Delta=dl, moving1=m1, G1=G1)
+    if link == 1:
+        names.update(moving2=m2, G2=G2)
+    return lemma(f"margin_covers_link{link + 1}", hyps, goal, key, names=names)
+
+
+# --- (c) region soundness: compositions, proved for every sq and dt ---------------------------
+
+def _elbow_reach(l2: z3.ArithRef, r: z3.ArithRef, re: z3.ArithRef) -> z3.BoolRef:
+    return z3.And(re >= 0, re * re == (l2 + r) * (l2 + r) + r * r)
+
+
+def _chord(k: dict[str, Lemma]) -> Lemma:
+    """Chord <= arc: turning by alpha - beta, |alpha - beta| <= s, moves a point at radius <= R
+    about o by at most s R (from cos x >= 1 - x^2/2)."""
+    al, be, R, s = z3.Reals("ch.alpha ch.beta ch.R ch.s")
+    o, w = _v("ch.o"), _v("ch.w")
+    x = al - be
+    X, Y = _add(o, _rot(e(al), w)), _add(o, _rot(e(be), w))
+    y = _sub(_rot(e(x), w), w)
+    key = "-s <= alpha - beta <= s"
+    hyps = [(key, snap_bound(al, be, s)), ("|w| <= R", z3.And(R >= 0, N2(w) <= R * R)),
+            a3_unit(be, "beta"), a3_unit(x, "x = alpha - beta"),
+            a3_cos_bound(x, "x = alpha - beta"), a3_sum(al, be, x, "alpha = beta + x")]
+    hyps += k["chord_id"].at("alpha, beta", A=e(al), B=e(be), X=e(x), o=o, w=w)
+    hyps += k["rot_norm"].at("e(beta), the turned difference", cs=e(be), y=y, z=_sub(X, Y))
+    hyps += k["chord0"].at("x = alpha - beta", cs=e(x), x=x, R=R, s=s, w=w)
+    return lemma("chord", hyps, N2(_sub(X, Y)) <= (s * R) * (s * R), key, abstract=True,
+                 names=dict(alpha=al, beta=be, R=R, s=s, o=o, w=w))
+
+
+def _arc_in_place(arc: ArcChord, k: dict[str, Lemma]) -> tuple[Lemma, z3.ArithRef]:
+    """A point at radius r = |w| <= R from a pivot o, turning from a0 through G <= 3.14, stays
+    within Margin.arc_chord's bound at R of the chord between its end positions: the lemma at
+    the origin, instantiated at (r, G, e(G/2), e(psi)), moved by the rigid motion R(mid)."""
+    th, a0, G, r, R, t = z3.Reals("aip.theta aip.a0 aip.G aip.r aip.R aip.t")
+    o, w = _v("aip.o"), _v("aip.w")
+    half = G / 2
+    mid = a0 + half
+    psi = th - mid
+    end = a0 + G
+    to_arc = ((arc.r, r), (arc.g, G), (arc.c, _COS(half)), (arc.s, _SIN(half)),
+              (arc.cp, _COS(psi)), (arc.sp, _SIN(psi)))
+    t_arc = z3.substitute(arc.t, *to_arc)
+    mq = (z3.substitute(arc.mq[0], *to_arc), z3.substitute(arc.mq[1], *to_arc))
+    ab = _ab(_COS(psi), _SIN(psi), _COS(half), _SIN(half), t)
+    ab_arc = _ab(_COS(psi), _SIN(psi), _COS(half), _SIN(half), t_arc)
+    X, A, B = (_add(o, _rot(e(x), w)) for x in (th, a0, end))
+    diff = _sub(X, _comb(A, B, t))
+    bound = arc.delta_at(R, G)
+    mono = a3_cos_mono(psi, half, "psi = theta - mid, G/2")
+    hyps: list[Hyp] = [
+        ("t = Margin.arc_chord's chord weight at the arc", t == t_arc),
+        ("0 <= G <= 3.14", z3.And(0 <= G, G <= G_MAX)),
+        ("a0 <= theta <= a0 + G", z3.And(a0 <= th, th <= end)),
+        ("r = |w| (a square root, named)", z3.And(r >= 0, r * r == N2(w))),
+        ("|w| <= R", z3.And(R >= 0, N2(w) <= R * R)),
+        a3_unit(mid, "mid = a0 + G/2"), a3_unit(psi, "psi"), a3_unit(half, "G/2"),
+        a3_cos_bound(half, "G/2"), mono, a3_sin_nonneg(half, "G/2"), a3_cos_nonneg(half, "G/2"),
+        a3_sum(th, mid, psi, "theta = mid + psi"), a3_diff(a0, mid, half, "a0 = mid - G/2"),
+        a3_sum(end, mid, half, "a0 + G = mid + G/2"),
+    ]
+    hyps += arc.lemma().use(to_arc, "r, G, e(G/2), e(psi)")
+    hyps += k["rigid_id"].at("the arc", M=e(mid), P=e(psi), H=e(half), T=e(th), S0=e(a0),
+                             S1=e(end), t=t, o=o, w=w)
+    hyps += k["rot_norm"].at("R(mid)", cs=e(mid), y=_rot(ab, w), z=diff)
+    hyps += k["rot_scale"].at("the scaled rotation", cs=ab, y=w, z=_rot(ab, w))
+    hyps += k["scale_norm"].at("m - q = r (..)", c=r, y=ab_arc, z=mq)
+    hyps += k["arc_monotone"].at("r <= R", r=r, R=R, G=G, m=N2(diff))
+    goal = z3.And(0 <= t, t <= 1, N2(diff) <= bound * bound)
+    return (lemma("arc_in_place", hyps, goal, mono[0], abstract=True,
+                  names=dict(theta=th, a0=a0, G=G, r=r, R=R, o=o, w=w, t=t)), t_arc)
+
+
+def _reach_link2(k: dict[str, Lemma]) -> Lemma:
+    be, l1, l2, r, re, u, v = z3.Reals("rl.beta rl.l1 rl.l2 rl.r rl.Re rl.u rl.v")
+    key = "R_elbow = sqrt((l2 + r)^2 + r^2)"
+    p = _rot(e(be), (u, v))
+    hyps = [a3_unit(be, "theta2"), ("l1, l2, r > 0", z3.And(l1 > 0, l2 > 0, r > 0)),
+            (key, _elbow_reach(l2, r, re)),
+            ("(u, v) in link 2's rectangle", in_rect((u, v), r, l2))]
+    hyps += k["reach_uv_link2"].at("link 2", ell=l2, r=r, R=re, u=u, v=v)
+    hyps += k["rot_norm"].at("R(theta2)", cs=e(be), y=(u, v), z=p)
+    hyps += k["reach_shift"].at("(l1, 0) + R(theta2) (u, v)", l1=l1, R=re, y=p)
+    goal = z3.And(N2((u, v)) <= re * re, N2(_wvec(l1, be, u, v)) <= (l1 + re) * (l1 + re))
+    return lemma("reach_link2", hyps, goal, key, abstract=True,
+                 names=dict(beta=be, l1=l1, l2=l2, r=r, Re=re, u=u, v=v))
+
+
+def _grow(k: dict[str, Lemma]) -> Lemma:
+    """A point of a link rectangle (frame at angle phi) moved by d, |d| <= delta, lies in the
+    rectangle grown by delta, at the frame coordinates grown_coords gives."""
+    phi, u, v, r, ell, dl = z3.Reals("gw.phi gw.u gw.v gw.r gw.ell gw.delta")
+    J, d = _v("gw.J"), _v("gw.d")
+    key = "|d| <= delta"
+    c, s = e(phi)
+    hyps = [a3_unit(phi, "phi"), ("(u, v) in the rectangle", in_rect((u, v), r, ell)),
+            ("delta >= 0", dl >= 0), (key, N2(d) <= dl * dl)]
+    hyps += k["proj_id"].at("the frame at phi", cs=e(phi), d=d)
+    hyps += k["proj_bound"].at("d in the frame", p=c * d[0] + s * d[1], q=-s * d[0] + c * d[1],
+                               delta=dl)
+    hyps += k["grow_id"].at("the frame at phi", cs=e(phi), u=u, v=v, J=J, d=d)
+    uv2 = grown_coords(phi, u, v, d)
+    goal = z3.And(_veq(_add(_add(J, _rot(e(phi), (u, v))), d), _add(J, _rot(e(phi), uv2))),
+                  in_rect(uv2, r + dl, ell))
+    return lemma("grow", hyps, goal, key, abstract=True,
+                 names=dict(phi=phi, u=u, v=v, r=r, ell=ell, delta=dl, J=J, d=d))
+
+
+def _weighted(ws: Sequence[z3.ArithRef], pts: Sequence[Vec]) -> Vec:
+    return (z3.Sum([w * p[0] for w, p in zip(ws, pts)]),
+            z3.Sum([w * p[1] for w, p in zip(ws, pts)]))
+
+
+def _combine2(k: dict[str, Lemma]) -> Lemma:
+    """The two joints' bounds add: X0 (the point), X1, X2 (after snapping theta1, theta2),
+    A, B (its chord's ends about the base), A', B' (their chord points about the elbow, between
+    the corners K): |X0 - h| <= s1 + s2 + e1 + e2 <= Delta for h = (1 - lam) A' + lam B', a
+    convex combination of the corners, and X0 = sum of w_c (K_c + (X0 - h))."""
+    X0, X1, X2, A, B, K00, K01, K10, K11 = (_v(f"cb2.{n}") for n in
+                                            "X0 X1 X2 A B K00 K01 K10 K11".split())
+    lam, mu, nu, s1, s2, e1, e2, dl = z3.Reals("cb2.lam cb2.mu cb2.nu cb2.s1 cb2.s2 cb2.e1 "
+                                               "cb2.e2 cb2.Delta")
+    h1 = _comb(A, B, lam)
+    A2, B2 = _comb(K00, K01, mu), _comb(K10, K11, nu)
+    h = _comb(A2, B2, lam)
+    dA, dB = _sub(A, A2), _sub(B, B2)
+    xa, yb = _scale(1 - lam, dA), _scale(lam, dB)
+    c4 = _add(xa, yb)
+    D = _v("cb2.D")
+    z1, z2 = _sub(X0, X2), _sub(X0, h1)
+    key = "s1 + s2 + e1 + e2 <= Delta"
+    hyps: list[Hyp] = [
+        ("D = X0 - h", _veq(D, _sub(X0, h))),
+        ("|X0 - X1| <= s1", N2(_sub(X0, X1)) <= s1 * s1),
+        ("|X1 - X2| <= s2", N2(_sub(X1, X2)) <= s2 * s2),
+        ("|X2 - h1| <= e1", N2(_sub(X2, h1)) <= e1 * e1),
+        ("|A - A'| <= e2", N2(dA) <= e2 * e2), ("|B - B'| <= e2", N2(dB) <= e2 * e2),
+        ("s1, s2, e1, e2 >= 0", z3.And(s1 >= 0, s2 >= 0, e1 >= 0, e2 >= 0)),
+        (key, s1 + s2 + e1 + e2 <= dl),
+        ("0 <= lam, mu, nu <= 1", z3.And(0 <= lam, lam <= 1, 0 <= mu, mu <= 1, 0 <= nu, nu <= 1)),
+    ]
+    hyps += k["expand"].at("X0 - X2", x=_sub(X0, X1), y=_sub(X1, X2), z=z1)
+    hyps += k["dot_bound"].at("X0 - X1, X1 - X2", x=_sub(X0, X1), y=_sub(X1, X2), a=s1, b=s2)
+    hyps += k["expand"].at("X0 - h1", x=z1, y=_sub(X2, h1), z=z2)
+    hyps += k["dot_bound"].at("X0 - X2, X2 - h1", x=z1, y=_sub(X2, h1), a=s1 + s2, b=e1)
+    hyps += k["scale_norm"].at("(1 - lam)(A - A')", c=1 - lam, y=dA, z=xa)
+    hyps += k["scale_norm"].at("lam (B - B')", c=lam, y=dB, z=yb)
+    hyps += k["expand"].at("h1 - h", x=xa, y=yb, z=c4)
+    hyps += k["dot_bound"].at("(1 - lam)(A - A'), lam (B - B')", x=xa, y=yb, a=(1 - lam) * e2,
+                              b=lam * e2)
+    hyps += k["expand"].at("X0 - h", x=z2, y=c4, z=D)
+    hyps += k["dot_bound"].at("X0 - h1, h1 - h", x=z2, y=c4, a=s1 + s2 + e1, b=e2)
+    hyps += k["square_monotone"].at("s1 + s2 + e1 + e2 <= Delta", a=s1 + s2 + e1 + e2, b=dl,
+                                    m=N2(D))
+    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
+    goal = z3.And(N2(D) <= dl * dl, *[w >= 0 for w in ws], z3.Sum(ws) == 1,
+                  _veq(X0, _weighted(ws, [_add(K, D) for K in (K00, K01, K10, K11)])))
+    return lemma("combine2", hyps, goal, key, abstract=True,
+                 names=dict(X0=X0, X1=X1, X2=X2, A=A, B=B, K00=K00, K01=K01, K10=K10, K11=K11,
+                            lam=lam, mu=mu, nu=nu, s1=s1, s2=s2, e1=e1, e2=e2, Delta=dl, D=D))
+
+
+def _combine1(k: dict[str, Lemma]) -> Lemma:
+    """One joint: |X0 - h1| <= s1 + e1 <= Delta, h1 = (1 - lam) A + lam B, and
+    X0 = (1 - lam)(A + (X0 - h1)) + lam (B + (X0 - h1))."""
+    X0, X1, A, B = (_v(f"cb1.{n}") for n in ("X0", "X1", "A", "B"))
+    lam, s1, e1, dl = z3.Reals("cb1.lam cb1.s1 cb1.e1 cb1.Delta")
+    h1 = _comb(A, B, lam)
+    D = _v("cb1.D")
+    key = "s1 + e1 <= Delta"
+    hyps: list[Hyp] = [
+        ("D = X0 - h1", _veq(D, _sub(X0, h1))),
+        ("|X0 - X1| <= s1", N2(_sub(X0, X1)) <= s1 * s1),
+        ("|X1 - h1| <= e1", N2(_sub(X1, h1)) <= e1 * e1),
+        ("s1, e1 >= 0", z3.And(s1 >= 0, e1 >= 0)), (key, s1 + e1 <= dl),
+        ("0 <= lam <= 1", z3.And(0 <= lam, lam <= 1)),
+    ]
+    hyps += k["expand"].at("X0 - h1", x=_sub(X0, X1), y=_sub(X1, h1), z=D)
+    hyps += k["dot_bound"].at("X0 - X1, X1 - h1", x=_sub(X0, X1), y=_sub(X1, h1), a=s1, b=e1)
+    hyps += k["square_monotone"].at("s1 + e1 <= Delta", a=s1 + e1, b=dl, m=N2(D))
+    ws = (1 - lam, lam)
+    goal = z3.And(N2(D) <= dl * dl, *[w >= 0 for w in ws],
+                  _veq(X0, _weighted(ws, [_add(A, D), _add(B, D)])))
+    return lemma("combine1", hyps, goal, key, abstract=True,
+                 names=dict(X0=X0, X1=X1, A=A, B=B, lam=lam, s1=s1, e1=e1, Delta=dl, D=D))
+
+
+def _transport() -> Lemma:
+    """A norm bound on X - Y holds for equal points X', Y' (congruence, for every sq)."""
+    X, Y, X2, Y2 = (_v(f"tp.{n}") for n in ("X", "Y", "X'", "Y'"))
+    m = z3.Real("tp.m")
+    key = "X = X'"
+    hyps = ((key, _veq(X, X2)), ("Y = Y'", _veq(Y, Y2)), ("|X - Y|^2 <= m", N2(_sub(X, Y)) <= m))
+    return lemma("transport", hyps, N2(_sub(X2, Y2)) <= m, key, abstract=True,
+                 names=dict(X=X, Y=Y, X2=X2, Y2=Y2, m=m))
+
+
+def _transport_chord() -> Lemma:
+    """A norm bound on X minus a chord point of A B holds for equal points X', A', B'."""
+    X, A, B, X2, A2, B2 = (_v(f"tc.{n}") for n in ("X", "A", "B", "X'", "A'", "B'"))
+    t, m = z3.Reals("tc.t tc.m")
+    key = "X = X'"
+    hyps = ((key, _veq(X, X2)), ("A = A'", _veq(A, A2)), ("B = B'", _veq(B, B2)),
+            ("|X - ((1 - t) A + t B)|^2 <= m", N2(_sub(X, _comb(A, B, t))) <= m))
+    return lemma("transport_chord", hyps, N2(_sub(X2, _comb(A2, B2, t))) <= m, key,
+                 abstract=True, names=dict(X=X, A=A, B=B, X2=X2, A2=A2, B2=B2, t=t, m=m))
+
+
+def _sum_subst(n: int) -> Lemma:
+    """X = sum of w_i P_i and P_i = Q_i give X = sum of w_i Q_i."""
+    X = _v(f"ss{n}.X")
+    Ps = [_v(f"ss{n}.P{i}") for i in range(n)]
+    Qs = [_v(f"ss{n}.Q{i}") for i in range(n)]
+    ws = list(z3.Reals(" ".join(f"ss{n}.w{i}" for i in range(n))))
+    key = "P_0 = Q_0"
+    hyps = [("X = sum w_i P_i", _veq(X, _weighted(ws, Ps)))]
+    hyps += [(f"P_{i} = Q_{i}", _veq(P, Q)) for i, (P, Q) in enumerate(zip(Ps, Qs))]
+    names: dict[str, object] = dict(X=X)
+    for i in range(n):
+        names.update({f"P{i}": Ps[i], f"Q{i}": Qs[i], f"w{i}": ws[i]})
+    return lemma(f"sum_subst{n}", hyps, _veq(X, _weighted(ws, Qs)), key, abstract=True,
+                 names=names)
+
+
+@dataclass(frozen=True)
+class Kit:
+    """Every lemma of Safety.region_soundness by name; what the tests mutate: Margin.arc_chord's
+    VC and the margin function read as impl's."""
+
+    arc: ArcChord
+    lemmas: dict[str, Lemma]
+    arc_t: z3.ArithRef           # Margin.arc_chord's chord weight, in arc_in_place's names
+    margin: Callable[..., object]
+
+    def __getitem__(self, name: str) -> Lemma:
+        return self.lemmas[name]
+
+
+def _pins(pairs: Sequence[tuple[z3.ExprRef, int | z3.ArithRef]]
+          ) -> list[tuple[z3.ExprRef, z3.ExprRef]]:
+    return [(c, z3.RealVal(x) if isinstance(x, int) else x) for c, x in pairs]
+
+
+def _link2(kit: Kit) -> Lemma:
+    """Link 2 at any configuration of a box lies in the region built for it."""
+    k = kit.lemmas
+    b = _v("lk2.b")
+    l1, l2, r, re, u, v, r1, r2, dl = z3.Reals("lk2.l1 lk2.l2 lk2.r lk2.Re lk2.u lk2.v lk2.r1 "
+                                               "lk2.r2 lk2.Delta")
+    lo1, hi1, th1, A1, g1 = z3.Reals("lk2.lo1 lk2.hi1 lk2.theta1 lk2.A1 lk2.g1")
+    lo2, hi2, th2, A2, g2 = z3.Reals("lk2.lo2 lk2.hi2 lk2.theta2 lk2.A2 lk2.g2")
+    rb = l1 + re
+    L1 = lattice("lk2.joint1", lo1, hi1, th1, A1, g1)
+    L2 = lattice("lk2.joint2", lo2, hi2, th2, A2, g2)
+    t1c, t2c = L1.theta_c, L2.theta_c
+    c1, G1, c2, G2 = L1.c, L1.G, L2.c, L2.G
+    c1e = c1 + G1
+
+    def P(alpha: z3.ArithRef, phi: z3.ArithRef) -> Vec:
+        return _point2(b, l1, alpha, phi, u, v)
+    alphas = (c1, c1, c1e, c1e)
+    phis = (c1 + c2, (c1 + c2) + G2, c1e + c2, (c1e + c2) + G2)
+    # The points, named by their definitions: the link's point at theta, after snapping theta1
+    # (X1) and theta2 (X2), the chord's ends A, B about the base, the cell's corners K.
+    at = [("X0", th1, th1 + th2, "theta"), ("X1", t1c, t1c + th2, "(theta1', theta2)"),
+          ("X2", t1c, t1c + t2c, "theta'"), ("A", c1, c1 + t2c, "(c1, theta2')"),
+          ("B", c1e, c1e + t2c, "(c1 + G1, theta2')")]
+    at += [(f"K{i}", a, ph, f"corner {i}") for i, (a, ph) in enumerate(zip(alphas, phis))]
+    pts = {n: _v(f"lk2.{n}") for n, *_ in at}
+    X0, X1, X2, A, B = (pts[n] for n in ("X0", "X1", "X2", "A", "B"))
+    Ks = [pts[f"K{i}"] for i in range(4)]
+    key = "Delta = impl.sweep_margin(arm, link 2, g, moving), read"
+    moving = (L1.moving, L2.moving)
+    hyps: list[Hyp] = [
+        ("link 2 (docs/model.md §2): l1, l2 > 0, r = w/2 > 0", z3.And(l1 > 0, l2 > 0, r > 0)),
+        ("R_elbow = sqrt((l2 + r)^2 + r^2), R_base = l1 + R_elbow", _elbow_reach(l2, r, re)),
+        ("theta in the box", z3.And(lo1 <= th1, th1 <= hi1, lo2 <= th2, th2 <= hi2)),
+        ("lattice spacings 0 < g_q <= 3.14", z3.And(0 < g1, g1 <= G_MAX, 0 < g2, g2 <= G_MAX)),
+        ("(u, v) a point of link 2's rectangle", in_rect((u, v), r, l2)),
+        ("r1 = |w(theta2')|, r2 = |(u, v)| (square roots, named)",
+         z3.And(r1 >= 0, r1 * r1 == N2(_wvec(l1, t2c, u, v)), r2 >= 0, r2 * r2 == N2((u, v)))),
+        (key, dl == impl_margin(1, (g1, g2), (rb, re), moving, kit.margin)),
+    ]
+    hyps += [(f"{n} = the point (u, v) of link 2 at {where} (named)", _veq(pts[n], P(a, ph)))
+             for n, a, ph, where in at]
+    hyps += L1.defs + L2.defs
+    hyps += k["lattice"].at("joint 1", lo=lo1, hi=hi1, theta=th1, A=A1, g=g1, **L1.names())
+    hyps += k["lattice"].at("joint 2", lo=lo2, hi=hi2, theta=th2, A=A2, g=g2, **L2.names())
+    hyps += k["margin_covers_link2"].at("the box's lattice", g1=g1, g2=g2, Rb=rb, Re=re, Delta=dl,
+                                        moving1=L1.moving, moving2=L2.moving, G1=G1, G2=G2)
+    for beta, where in ((th2, "theta2"), (t2c, "theta2'")):
+        hyps += k["reach_link2"].at(where, beta=beta, l1=l1, l2=l2, r=r, Re=re, u=u, v=v)
+    for alpha, beta, where in ((th1, th2, "theta"), (t1c, th2, "(theta1', theta2)"),
+                               (t1c, t2c, "theta'"), (c1, t2c, "(c1, theta2')"),
+                               (c1e, t2c, "(c1 + G1, theta2')")):
+        hyps.append(a3_sum(alpha + beta, alpha, beta, where))
+        hyps += k["kin"].at(where, A=e(alpha), B=e(beta), AB=e(alpha + beta), l1=l1, u=u, v=v,
+                            b=b)
+    hyps += k["chord"].at("snapping theta1", alpha=th1, beta=t1c, o=b, w=_wvec(l1, th2, u, v),
+                          R=rb, s=SNAP_Q * g1)
+
+    def nested(alpha: z3.ArithRef, beta: z3.ArithRef) -> Vec:
+        return _add(b, _rot(e(alpha), _wvec(l1, beta, u, v)))
+    s1, s2, e1, e2 = margin_parts(kit.arc, (g1, g2), (rb, re), (G1, G2))
+    hyps += k["transport"].at("snapping theta1, in docs/model.md §2's form", X=nested(th1, th2),
+                              Y=nested(t1c, th2), X2=X0, Y2=X1, m=s1 * s1)
+    hyps += k["chord"].at("snapping theta2", alpha=t1c + th2, beta=t1c + t2c,
+                          o=_elbow(b, l1, t1c), w=(u, v), R=re, s=SNAP_Q * g2)
+    aip = k["arc_in_place"]
+    arcs = (("the base arc", dict(theta=t1c, a0=c1, G=G1, o=b, w=_wvec(l1, t2c, u, v), r=r1,
+                                  R=rb)),
+            ("the elbow arc at c1", dict(theta=c1 + t2c, a0=c1 + c2, G=G2, o=_elbow(b, l1, c1),
+                                         w=(u, v), r=r2, R=re)),
+            ("the elbow arc at c1 + G1", dict(theta=c1e + t2c, a0=c1e + c2, G=G2,
+                                              o=_elbow(b, l1, c1e), w=(u, v), r=r2, R=re)))
+    lam, mu, nu = z3.Reals("lk2.lam lk2.mu lk2.nu")
+    for t, (where, arc_at) in zip((lam, mu, nu), arcs):
+        hyps.append((f"{t} = Margin.arc_chord's chord weight on {where}",
+                     t == aip.term(kit.arc_t, **arc_at)))
+        hyps += aip.at(where, t=t, **arc_at)
+    hyps += k["transport_chord"].at("the base arc, in docs/model.md §2's form",
+                                    X=nested(t1c, t2c), A=nested(c1, t2c), B=nested(c1e, t2c),
+                                    X2=X2, A2=A, B2=B, t=lam, m=e1 * e1)
+    D = _v("lk2.D")
+    hyps.append(("D = X0 - h, h = (1 - lam) A' + lam B' (named)",
+                 _veq(D, _sub(X0, _comb(_comb(Ks[0], Ks[1], mu), _comb(Ks[2], Ks[3], nu), lam)))))
+    hyps += k["combine2"].at("the link's points", X0=X0, X1=X1, X2=X2, A=A, B=B, K00=Ks[0],
+                             K01=Ks[1], K10=Ks[2], K11=Ks[3], lam=lam, mu=mu, nu=nu, s1=s1,
+                             s2=s2, e1=e1, e2=e2, Delta=dl, D=D)
+    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
+        hyps += k["grow"].at(f"corner {i}", phi=phi, u=u, v=v, r=r, ell=l2, delta=dl,
+                             J=_elbow(b, l1, alpha), d=D)
+    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
+    Qs = [_add(_elbow(b, l1, a), _rot(e(ph), grown_coords(ph, u, v, D)))
+          for a, ph in zip(alphas, phis)]
+    sub: dict[str, object] = dict(X=X0)
+    for i in range(4):
+        sub.update({f"P{i}": _add(Ks[i], D), f"Q{i}": Qs[i], f"w{i}": ws[i]})
+    hyps += k["sum_subst4"].at("the corners' grown rectangles", **sub)
+    goal = z3.And(
+        L1.i_lo <= L1.j, L1.j + L1.step <= L1.i_hi, L2.i_lo <= L2.j, L2.j + L2.step <= L2.i_hi,
+        c1e == A1 + z3.ToReal(L1.j + L1.step) * g1, c2 + G2 == A2 + z3.ToReal(L2.j + L2.step) * g2,
+        *[w >= 0 for w in ws], z3.Sum(ws) == 1,
+        *[in_rect(grown_coords(ph, u, v, D), r + dl, l2) for ph in phis],
+        _veq(X0, _weighted(ws, Qs)))
+    # A small arm at rest in a one-point box (l2 + r = 2/5, r = 3/10: R_elbow = 1/2), for the
+    # vacuity check; with a negative margin for the negative test's counter-model.
+    q = z3.Q
+    wit = _pins([(b[0], 0), (b[1], 0), (l1, q(1, 10)), (l2, q(1, 10)), (r, q(3, 10)),
+                 (re, q(1, 2)), (lo1, 0), (hi1, 0), (th1, 0), (A1, 0), (g1, q(1, 2)), (lo2, 0),
+                 (hi2, 0), (th2, 0), (A2, 0), (g2, q(1, 2)), (u, 0), (v, 0), (r1, q(1, 10)),
+                 (r2, 0)])
+    return lemma("link2_in_region", hyps, goal, key, abstract=True, witness=wit,
+                 counter_witness=wit + [(dl, z3.RealVal(-1))])
+
+
+def _link1(kit: Kit) -> Lemma:
+    """Link 1 at any configuration of a box lies in the region built for it (it does not
+    depend on theta2: its lattice has the single point anchor2 in theta2)."""
+    k = kit.lemmas
+    b = _v("lk1.b")
+    l1, r, rb, u, v, r1, dl, g2 = z3.Reals("lk1.l1 lk1.r lk1.Rb lk1.u lk1.v lk1.r1 lk1.Delta "
+                                           "lk1.g2")
+    lo1, hi1, th1, A1, g1 = z3.Reals("lk1.lo1 lk1.hi1 lk1.theta1 lk1.A1 lk1.g1")
+    L1 = lattice("lk1.joint1", lo1, hi1, th1, A1, g1)
+    t1c, c1, G1 = L1.theta_c, L1.c, L1.G
+    c1e = c1 + G1
+
+    def P(alpha: z3.ArithRef) -> Vec:
+        return _add(b, _rot(e(alpha), (u, v)))
+    X0, X1, A, B = P(th1), P(t1c), P(c1), P(c1e)
+    key = "Delta = impl.sweep_margin(arm, link 1, g, moving), read"
+    zero = z3.RealVal(0)
+    hyps: list[Hyp] = [
+        ("link 1 (docs/model.md §2): l1 > 0, r = w/2 > 0", z3.And(l1 > 0, r > 0)),
+        ("R_base = sqrt((l1 + r)^2 + r^2)",
+         z3.And(rb >= 0, rb * rb == (l1 + r) * (l1 + r) + r * r)),
+        ("theta1 in the box", z3.And(lo1 <= th1, th1 <= hi1)),
+        ("lattice spacings 0 < g_q <= 3.14", z3.And(0 < g1, g1 <= G_MAX, 0 < g2, g2 <= G_MAX)),
+        ("(u, v) a point of link 1's rectangle", in_rect((u, v), r, l1)),
+        ("r1 = |(u, v)| (a square root, named)", z3.And(r1 >= 0, r1 * r1 == N2((u, v)))),
+        (key, dl == impl_margin(0, (g1, g2), (rb, zero), (L1.moving, z3.BoolVal(False)),
+                                kit.margin)),
+    ]
+    hyps += L1.defs
+    hyps += k["lattice"].at("joint 1", lo=lo1, hi=hi1, theta=th1, A=A1, g=g1, **L1.names())
+    hyps += k["margin_covers_link1"].at("the box's lattice", g1=g1, g2=g2, Rb=rb, Re=zero,
+                                        Delta=dl, moving1=L1.moving, G1=G1)
+    hyps += k["reach_uv_link1"].at("link 1", ell=l1, r=r, R=rb, u=u, v=v)
+    hyps += k["chord"].at("snapping theta1", alpha=th1, beta=t1c, o=b, w=(u, v), R=rb,
+                          s=SNAP_Q * g1)
+    arc_at = dict(theta=t1c, a0=c1, G=G1, o=b, w=(u, v), r=r1, R=rb)
+    lam = z3.Real("lk1.lam")
+    hyps.append(("lam = Margin.arc_chord's chord weight on the base arc",
+                 lam == k["arc_in_place"].term(kit.arc_t, **arc_at)))
+    hyps += k["arc_in_place"].at("the base arc", t=lam, **arc_at)
+    s1, _, e1, _ = margin_parts(kit.arc, (g1, g2), (rb, zero), (G1, zero))
+    D = _v("lk1.D")
+    hyps.append(("D = X0 - h1, h1 = (1 - lam) A + lam B (named)",
+                 _veq(D, _sub(X0, _comb(A, B, lam)))))
+    hyps += k["combine1"].at("the link's points", X0=X0, X1=X1, A=A, B=B, lam=lam, s1=s1, e1=e1,
+                             Delta=dl, D=D)
+    for i, alpha in enumerate((c1, c1e)):
+        hyps += k["grow"].at(f"corner {i}", phi=alpha, u=u, v=v, r=r, ell=l1, delta=dl, J=b, d=D)
+    ws = (1 - lam, lam)
+    Qs = [_add(b, _rot(e(a), grown_coords(a, u, v, D))) for a in (c1, c1e)]
+    hyps += k["sum_subst2"].at("the corners' grown rectangles", X=X0, P0=_add(A, D),
+                               P1=_add(B, D), Q0=Qs[0], Q1=Qs[1], w0=ws[0], w1=ws[1])
+    goal = z3.And(L1.i_lo <= L1.j, L1.j + L1.step <= L1.i_hi,
+                  c1e == A1 + z3.ToReal(L1.j + L1.step) * g1, *[w >= 0 for w in ws],
+                  *[in_rect(grown_coords(a, u, v, D), r + dl, l1) for a in (c1, c1e)],
+                  _veq(X0, _weighted(ws, Qs)))
+    # A small arm at rest in a one-point box (l1 + r = 2/5, r = 3/10: R_base = 1/2), for the
+    # vacuity check; with a negative margin for the negative test's counter-model.
+    q = z3.Q
+    wit = _pins([(b[0], 0), (b[1], 0), (l1, q(1, 10)), (r, q(3, 10)), (rb, q(1, 2)), (lo1, 0),
+                 (hi1, 0), (th1, 0), (A1, 0), (g1, q(1, 2)), (g2, q(1, 2)), (u, 0), (v, 0),
+                 (r1, 0)])
+    return lemma("link1_in_region", hyps, goal, key, abstract=True, witness=wit,
+                 counter_witness=wit + [(dl, z3.RealVal(-1))])
+
+
+def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_margin) -> Kit:
+    """Every lemma of Safety.region_soundness; ``arc_vc`` and ``margin`` replace
+    Margin.arc_chord's VC and impl.sweep_margin (the tests' mutants)."""
+    arc = arc_chord(arc_vc)
+    k: dict[str, Lemma] = {}
+    for L in (_rot_norm(), _rot_scale(), _scale_norm(), _expand(), _dot_bound(),
+              _square_monotone(), _proj_id(), _proj_bound(), _grow_id(), _chord0(), _chord_id(),
+              _rigid_id(), _arc_monotone(arc), _kin(), _reach_uv(0), _reach_uv(1), _reach_shift(),
+              _lattice(), _margin_covers(arc, 0, margin), _margin_covers(arc, 1, margin)):
+        k[L.vc.name] = L
+    k["arc_in_place"], arc_t = _arc_in_place(arc, k)
+    for L in (_chord(k), _reach_link2(k), _grow(k), _combine2(k), _combine1(k), _transport(),
+              _transport_chord(), _sum_subst(2), _sum_subst(4)):
+        k[L.vc.name] = L
+    kit = Kit(arc, k, arc_t, margin)
+    k["link1_in_region"] = _link1(kit)
+    k["link2_in_region"] = _link2(kit)
+    return kit
+
+
+def region_query(kit: Kit | None = None) -> Z3Query:
+    """Safety.region_soundness: Margin.arc_chord's VC (re-proved: the lemma the margin rests
+    on) and every lemma of the kit."""
+    kit = kit or region_kit()
+    check_lattice_reading()
+    arc = kit.arc.vc
+    first = VC("Margin.arc_chord", arc.hypotheses, arc.goal, arc.key_premise, arc.witness,
+               arc.kind, arc.counter_witness)
+    return Z3Query((first,) + tuple(L.vc for L in kit.lemmas.values()))
+
+
+# --- (a) the principal in its layer's box ------------------------------------------------------
+
+def _mn(a: z3.ArithRef, b: z3.ArithRef) -> z3.ArithRef:
+    return z3.If(a <= b, a, b)
+
+
+def _mx(a: z3.ArithRef, b: z3.ArithRef) -> z3.ArithRef:
+    return z3.If(a <= b, b, a)
+
+
+def _abs(a: z3.ArithRef) -> z3.ArithRef:
+    return z3.If(a >= 0, a, -a)
+
+
+@dataclass(frozen=True)
+class Principal:
+    """The principal's PTP motion (docs/model.md §2) over symbolic start, goal, omega, dt."""
+
+    start: Vec
+    goal: Vec
+    omega: Vec
+    dt: z3.ArithRef
+    Tf: z3.ArithRef
+    N: z3.ArithRef
+
+    @classmethod
+    def named(cls) -> Principal:
+        return cls(_v("L.start"), _v("L.goal"), _v("L.omega"), z3.Real("dt"), z3.Real("Tf"),
+                   Z3Dims.named().N)
+
+    def frac(self, t: z3.ArithRef) -> z3.ArithRef:
+        """min(max(t / Tf, 0), 1); 1 when Tf = 0 (spec.left_angles)."""
+        return z3.If(self.Tf <= 0, z3.RealVal(1),
+                     _mn(_mx(t / self.Tf, z3.RealVal(0)), z3.RealVal(1)))
+
+    def theta(self, t: z3.ArithRef) -> Vec:
+        f = self.frac(t)
+        return (self.start[0] + (self.goal[0] - self.start[0]) * f,
+                self.start[1] + (self.goal[1] - self.start[1]) * f)
+
+    def tf_def(self) -> Hyp:
+        d = [_abs(self.goal[q] - self.start[q]) / self.omega[q] for q in range(2)]
+        return ("Tf = max_q |goal_q - start_q| / omega_q (spec.exact_tf)",
+                self.Tf == _mx(d[0], d[1]))
+
+    def n_def(self) -> Hyp:
+        ceil = -z3.ToInt(-(self.Tf / self.dt))
+        return ("N = max(1, ceil(Tf / dt)) (spec.exact_n)", self.N == z3.If(ceil >= 1, ceil, 1))
+
+    def basics(self) -> tuple[Hyp, ...]:
+        return (("dt > 0", self.dt > 0),
+                ("omega_q > 0", z3.And(self.omega[0] > 0, self.omega[1] > 0)), self.tf_def())
+
+    def box(self, variant: str, k: z3.ArithRef, *, sign_flip: bool = False) -> tuple[Vec, Vec]:
+        """spec.left_box's rule for layer k (a real), per joint (lo, hi), docs/model.md §4.1."""
+        a = self.theta(k * self.dt)
+        out = []
+        for q in range(2):
+            step = self.omega[q] * self.dt
+            if variant == "original":
+                out.append((a[q] - step, a[q] + step))
+            elif variant == "modified":
+                up, down = z3.RealVal(1), z3.RealVal(-1)
+                sign = z3.If(self.goal[q] > self.start[q], down if sign_flip else up,
+                             up if sign_flip else down)
+                end = a[q] + sign * step
+                out.append((_mn(a[q], end), _mx(a[q], end)))
+            elif variant == "tight":
+                b = self.theta((k + 1) * self.dt)[q]
+                out.append((_mn(a[q], b), _mx(a[q], b)))
+            else:
+                raise ValueError(variant)
+        return (out[0], out[1])
+
+    def rest_box(self, variant: str, **kw: bool) -> tuple[Vec, Vec]:
+        """The rest layer's box: layer N-1's (original, modified), the goal (tight)."""
+        if variant == "tight":
+            return ((self.goal[0], self.goal[0]), (self.goal[1], self.goal[1]))
+        return self.box(variant, z3.ToReal(self.N) - 1, **kw)
+
+
+def in_box(theta: Vec, box: tuple[Vec, Vec]) -> z3.BoolRef:
+    return z3.And(*[z3.And(box[q][0] <= theta[q], theta[q] <= box[q][1]) for q in range(2)])
+
+
+def step_window(k: z3.ArithRef, t: z3.ArithRef, dt: z3.ArithRef) -> z3.BoolRef:
+    K = z3.ToReal(k)
+    return z3.And(K * dt <= t, t <= (K + 1) * dt)
+
+
+def principal_lemmas(variant: str, *, sign_flip: bool = False,
+                     n_def: Hyp | None = None) -> tuple[Lemma, Lemma]:
+    """(a) for ``variant``: the motion in layer k's box over [k dt, (k+1) dt], and in the rest
+    layer's box from N dt on. ``sign_flip`` and ``n_def`` are the tests' mutants."""
+    P = Principal.named()
+    k, t = z3.Int("k"), z3.Real("t")
+    key = "k dt <= t <= (k+1) dt"
+    motion = lemma("motion", P.basics() + (("k >= 0", k >= 0), (key, step_window(k, t, P.dt))),
+                   in_box(P.theta(t), P.box(variant, z3.ToReal(k), sign_flip=sign_flip)), key,
+                   names=dict(k=k, t=t))
+    nd = n_def or P.n_def()
+    rest = lemma("rest", P.basics() + (nd, ("t >= N dt", t >= z3.ToReal(P.N) * P.dt)),
+                 in_box(P.theta(t), P.rest_box(variant, sign_flip=sign_flip)), nd[0],
+                 names=dict(t=t))
+    return motion, rest
+
+
+# --- (b) the subordinate in its cell's box -----------------------------------------------------
+
+@dataclass(frozen=True)
+class Subordinate:
+    lo: Vec
+    h: Vec
+
+    @classmethod
+    def named(cls) -> Subordinate:
+        return cls(_v("R.lo"), _v("R.h"))
+
+    def angle(self, c: tuple[z3.ArithRef, z3.ArithRef]) -> Vec:
+        return (self.lo[0] + z3.ToReal(c[0]) * self.h[0], self.lo[1] + z3.ToReal(c[1]) * self.h[1])
+
+    def box(self, c: tuple[z3.ArithRef, z3.ArithRef]) -> tuple[Vec, Vec]:
+        """spec.right_box: [t_i - h1, t_i + h1] x [t_j - h2, t_j + h2]."""
+        a = self.angle(c)
+        return ((a[0] - self.h[0], a[0] + self.h[0]), (a[1] - self.h[1], a[1] + self.h[1]))
+
+    def theta(self, c: tuple[z3.ArithRef, z3.ArithRef], c2: tuple[z3.ArithRef, z3.ArithRef],
+              k: z3.ArithRef, t: z3.ArithRef, dt: z3.ArithRef) -> Vec:
+        """The linear move in joint space from c (at k dt) to c2 (at (k+1) dt)."""
+        f = (t - z3.ToReal(k) * dt) / dt
+        a, b = self.angle(c), self.angle(c2)
+        return (a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]))
+
+
+def subordinate_lemmas(*, reach: int = 1) -> tuple[Lemma, Lemma]:
+    """(b): a move to a neighbour stays in the cell's box; on a valid path every step is one
+    (a wait once the list has ended). ``reach`` is the tests' mutant (2: a jump of two cells)."""
+    S = Subordinate.named()
+    dt, t = z3.Real("dt"), z3.Real("t")
+    k = z3.Int("k")
+    c, c2 = (z3.Int("c.i"), z3.Int("c.j")), (z3.Int("c'.i"), z3.Int("c'.j"))
+    key = "c' a neighbour of c: |c'_q - c_q| <= 1"
+    hyps = (("dt > 0", dt > 0), ("h_q > 0", z3.And(S.h[0] > 0, S.h[1] > 0)), ("k >= 0", k >= 0),
+            ("k dt <= t <= (k+1) dt", step_window(k, t, dt)),
+            (key, z3.And(abs_int(c2[0] - c[0]) <= reach, abs_int(c2[1] - c[1]) <= reach)))
+    move = lemma("neighbour_move", hyps, in_box(S.theta(c, c2, k, t, dt), S.box(c)), key,
+                 names=dict(c=c, c2=c2, k=k, t=t))
+    d = Z3Dims.named()
+    ints = z3.IntSort()
+    P = z3.Array("P", ints, ints, ints, ints)
+    start, goal = (z3.Int("start.i"), z3.Int("start.j")), (z3.Int("goal.i"), z3.Int("goal.j"))
+    L = z3_path("L")
+    key2 = "is_path L (fixed, docs/model.md §5)"
+    here, nxt = position(L, k), position(L, k + 1)
+    hyps2 = (("N >= 1, m, n >= 1", d.sane()),
+             ("start, goal in the grid", z3.And(in_grid(d, start), in_grid(d, goal))),
+             (key2, is_path_fixed(P, d, start, goal, L)), ("k >= 0", k >= 0))
+    goal2 = z3.And(in_grid(d, here), adjacent(here, nxt),
+                   z3.Implies(k + 1 >= L.length, z3.And(here[0] == goal[0], here[1] == goal[1],
+                                                        nxt[0] == goal[0], nxt[1] == goal[1])))
+    on_path = lemma("on_path", hyps2, goal2, key2, names=dict(k=k))
+    return move, on_path
+
+
+# --- (d) separation ------------------------------------------------------------------------------
+
+_LINK_L = z3.Function("linkL", z3.IntSort(), _R, _R, _R, _R, z3.BoolSort())
+_LINK_R = z3.Function("linkR", z3.IntSort(), _R, _R, _R, _R, z3.BoolSort())
+
+
+def link_l(a: z3.ArithRef, theta: Vec, p: Vec) -> z3.BoolRef:
+    """p is a point of the principal's link a (0, 1) at configuration theta."""
+    return _LINK_L(a, theta[0], theta[1], p[0], p[1])
+
+
+def link_r(b: z3.ArithRef, theta: Vec, p: Vec) -> z3.BoolRef:
+    """p is a point of the subordinate's link b (0, 1) at configuration theta."""
+    return _LINK_R(b, theta[0], theta[1], p[0], p[1])
+
+
+def apart(A: z3.ExprRef, B: z3.ExprRef, eps: z3.ArithRef) -> z3.BoolRef:
+    """dist(A, B) > eps: every point of A is more than eps from every point of B (the regions
+    are compact polygons, so their distance is attained)."""
+    x1, y1, x2, y2 = z3.Reals("ap!x1 ap!y1 ap!x2 ap!y2")
+    return z3.ForAll([x1, y1, x2, y2], z3.Implies(
+        z3.And(member(A, (x1, y1)), member(B, (x2, y2))),
+        (x1 - x2) * (x1 - x2) + (y1 - y2) * (y1 - y2) > eps * eps))
+
+
+def separation_lemma() -> Lemma:
+    A, B = z3.Consts("sep.A sep.B", REGION)
+    a, b = z3.Ints("sep.a sep.b")
+    tl, tr, p = _v("sep.thetaL"), _v("sep.thetaR"), _v("sep.p")
+    eps = z3.Real("eps")
+    key = "dist(A, B) > eps"
+    hyps = (("eps = spec.EPS = 1e-9 m", eps == EPS_Q), (key, apart(A, B, eps)),
+            ("(c) link a of the principal at theta_L lies in A (at p)",
+             z3.Implies(link_l(a, tl, p), member(A, p))),
+            ("(c) link b of the subordinate at theta_R lies in B (at p)",
+             z3.Implies(link_r(b, tr, p), member(B, p))))
+    goal = z3.Not(z3.And(link_l(a, tl, p), link_r(b, tr, p)))
+    return lemma("no_common_point", hyps, goal, key,
+                 names=dict(A=A, B=B, a=a, b=b, thetaL=tl, thetaR=tr, p=p))
+
+
+# --- (e) the composition -------------------------------------------------------------------------
+
+def _step_lemma() -> Lemma:
+    """The time-layer decomposition: t >= 0 lies in the step k = floor(t / dt)."""
+    dt, t = z3.Reals("dt t")
+    k, N = z3.Int("st.k"), z3.Int("st.N")
+    key = "t >= 0"
+    hyps = (("dt > 0", dt > 0), (key, t >= 0), ("k = floor(t / dt)", k == z3.ToInt(t / dt)))
+    goal = z3.And(k >= 0, step_window(k, t, dt), z3.Implies(k >= N, z3.ToReal(N) * dt <= t))
+    return lemma("time_step", hyps, goal, key, names=dict(k=k, N=N, t=t))
+
+
+def _regions(variant: str) -> tuple[Callable[..., z3.ExprRef], Callable[..., z3.ExprRef],
+                                    Callable[..., z3.ExprRef]]:
+    """The principal's region of link a at layer k, its rest region, and the subordinate's
+    region of link b at cell (i, j): opaque values, as in Theorems 1 and 3."""
+    ints = z3.IntSort()
+    region_l = z3.Function(f"regionL_{variant}", ints, ints, REGION)
+    region_r = z3.Function("regionR", ints, ints, ints, REGION)
+    N = Z3Dims.named().N
+    if variant == "tight":
+        region_rest = z3.Function("regionRest_tight", ints, REGION)
+
+        def rest(a: z3.ArithRef) -> z3.ExprRef:
+            return region_rest(a)
+    else:
+        def rest(a: z3.ArithRef) -> z3.ExprRef:
+            return region_l(N - 1, a)     # the paper's: layer N-1's region
+    return (lambda k, a: region_l(k, a)), rest, (lambda i, j, b: region_r(i, j, b))
+
+
+LINKS = (0, 1)
+
+
+def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
+                   b: tuple[Lemma, Lemma] | None = None, sep: Lemma | None = None) -> VC:
+    """(e) for ``variant``; the lemmas may be replaced (the tests' mutants)."""
+    motion, rest = a or principal_lemmas(variant)
+    move, on_path = b or subordinate_lemmas()
+    sep = sep or separation_lemma()
+    step = _step_lemma()
+    def4 = _obligation_vc("Def4.is_path_fixed_safe", "every_step", path_obligations())
+    P = Principal.named()
+    S = Subordinate.named()
+    d = Z3Dims.named()
+    ints = z3.IntSort()
+    DR = z3.Array("P", ints, ints, ints, ints)
+    start, goal = (z3.Int("start.i"), z3.Int("start.j")), (z3.Int("goal.i"), z3.Int("goal.j"))
+    L = z3_path("L")
+    t, eps = z3.Real("t"), z3.Real("eps")
+    k = z3.Int("kk")
+    p = _v("p")
+    region_l, region_rest, region_r = _regions(variant)
+
+    def all_apart(left: Callable[[int], z3.ExprRef], i: z3.ArithRef, j: z3.ArithRef) -> z3.BoolRef:
+        return z3.And([apart(left(x), region_r(i, j, y), eps) for x in LINKS for y in LINKS])
+
+    post = blocked_exact(
+        DR, d, motion=lambda kk, i, j: z3.Not(all_apart(lambda x: region_l(kk, x), i, j)),
+        rest=lambda _, i, j: z3.Not(all_apart(region_rest, i, j)))
+    here, nxt = position(L, k), position(L, k + 1)
+    theta_l = P.theta(t)
+    theta_r = S.theta(here, nxt, k, t, P.dt)
+    key = "Theorem 1/3's postcondition: P[k,i,j] = 0 iff every pair of link regions is > eps apart"
+    hyps: list[Hyp] = [
+        *P.basics(), P.n_def(), ("h_q > 0", z3.And(S.h[0] > 0, S.h[1] > 0)),
+        ("N >= 1, m, n >= 1", d.sane()),
+        ("start, goal in the grid", z3.And(in_grid(d, start), in_grid(d, goal))),
+        ("is_path L (fixed, docs/model.md §5)", is_path_fixed(DR, d, start, goal, L)),
+        ("eps = spec.EPS = 1e-9 m", eps == EPS_Q),
+        (key, post),
+        ("t >= 0", t >= 0),
+        ("k = floor(t / dt), the step at t (named)", k == z3.ToInt(t / P.dt)),
+    ]
+    hyps += step.at("t", k=k, N=d.N, t=t)
+    hyps += motion.at("the step k (a)", k=k, t=t)
+    hyps += rest.at("t (a)", t=t)
+    hyps += on_path.at("the step k (b)", k=k)
+    hyps += move.at("the step k (b)", c=here, c2=nxt, k=k, t=t)
+    inst = z3.substitute(z3.Implies(z3.And([h for _, h in def4.hypotheses]), def4.goal),
+                         (z3.Int("k"), k))
+    hyps.append(("by Def4.is_path_fixed_safe at the step k", inst))
+    box_k = P.box(variant, z3.ToReal(k))
+    for x in LINKS:
+        hyps.append((f"(c) Safety.region_soundness: link {x + 1} of the principal at theta_L(t) "
+                     f"in layer k's region (its box, k < N; at p)",
+                     z3.Implies(z3.And(0 <= k, k < d.N, in_box(theta_l, box_k)),
+                                z3.Implies(link_l(x, theta_l, p), member(region_l(k, x), p)))))
+        hyps.append((f"(c) Safety.region_soundness: link {x + 1} of the principal at theta_L(t) "
+                     f"in the rest region (its box; at p)",
+                     z3.Implies(in_box(theta_l, P.rest_box(variant)),
+                                z3.Implies(link_l(x, theta_l, p), member(region_rest(x), p)))))
+        hyps.append((f"(c) Safety.region_soundness: link {x + 1} of the subordinate at "
+                     f"theta_R(t) in the region of its cell (its box; at p)",
+                     z3.Implies(z3.And(in_grid(d, here), in_box(theta_r, S.box(here))),
+                                z3.Implies(link_r(x, theta_r, p),
+                                           member(region_r(here[0], here[1], x), p)))))
+    for x in LINKS:
+        for y in LINKS:
+            for where, A in (("layer k", region_l(k, x)), ("the rest layer", region_rest(x))):
+                hyps += sep.at(f"links ({x + 1}, {y + 1}), {where} (d)", A=A,
+                               B=region_r(here[0], here[1], y), a=z3.IntVal(x), b=z3.IntVal(y),
+                               thetaL=theta_l, thetaR=theta_r, p=p)
+    target = z3.And([z3.Not(z3.And(link_l(x, theta_l, p), link_r(y, theta_r, p)))
+                     for x in LINKS for y in LINKS])
+    one, zero = z3.IntVal(1), z3.IntVal(0)
+    # One layer, a one-cell grid, a one-cell path: where Z3 finds the models the vacuity check
+    # and the negative tests ask for.
+    pins = ((d.N, one), (d.m, one), (d.n, one), (L.length, one), (start[0], zero),
+            (start[1], zero), (goal[0], zero), (goal[1], zero))
+    return VC(f"composition_{variant}", _dedupe(hyps), target, key_premise=key, witness=pins,
+              counter_witness=pins)
+
+
+# --- the obligations ---------------------------------------------------------------------------
+
+_RULES = {
+    "original": ("[a - omega_q dt, a + omega_q dt], a = theta_L(k dt) (Algorithm 1)",
+                 "layer N-1's box"),
+    "modified": ("from a = theta_L(k dt) to a + s_q omega_q dt, s_q = +1 if goal_q > start_q "
+                 "else -1 (Section IV.A)", "layer N-1's box"),
+    "tight": ("from theta_L(k dt) to theta_L((k+1) dt)", "the goal, a one-point box"),
+}
+
+
+def _principal_query(variant: str) -> Z3Query:
+    motion, rest = principal_lemmas(variant)
+    return Z3Query((motion.vc, rest.vc))
+
+
+def _subordinate_query() -> Z3Query:
+    move, on_path = subordinate_lemmas()
+    return Z3Query((move.vc, on_path.vc))
+
+
+def _separation_query() -> Z3Query:
+    return Z3Query((separation_lemma().vc,))
+
+
+def _composition_query(variant: str) -> Z3Query:
+    return Z3Query((_step_lemma().vc, composition_vc(variant)))
+
+
+def safety_obligations() -> list[Obligation]:
+    """Safety.*: (a) per variant, (b), (c), (d), (e) per variant (docs/model.md §10)."""
+    P, Z = Verdict.PROVED, Method.Z3
+    out = []
+    for v in VARIANTS:
+        rule, rest = _RULES[v]
+        out.append(Obligation(
+            f"Safety.{v}.principal_in_layer_box", GROUP, "docs/model.md §2, §4.1, §10 (a)",
+            "For symbolic start, goal, omega_q > 0 and dt > 0 (both joints), with Tf = max_q "
+            "|goal_q - start_q| / omega_q and theta_L(t) = start + (goal - start) min(max(t / Tf, "
+            "0), 1) (1 when Tf = 0, spec.left_angles): (motion) for every integer k >= 0 and t in "
+            f"[k dt, (k+1) dt], theta_L(t) lies in layer k's box, {rule}; (rest) with N = "
+            "max(1, ceil(Tf / dt)) (spec.exact_n), for every t >= N dt it lies in the rest "
+            f"layer's box, {rest}. Quantifier-free nonlinear real arithmetic (division, min, max, "
+            "ceil); the box rule is docs/model.md §4.1's, and the tests check it against "
+            "spec.left_box on every layer of the bundled scenarios.",
+            Z, P, lambda v=v: _principal_query(v)))
+    out.append(Obligation(
+        "Safety.subordinate_in_cell_box", GROUP, "docs/model.md §2, §4.1, §5, §10 (b)",
+        "(neighbour_move) For cells c, c' with |c'_q - c_q| <= 1, grid angles lo_q + i h_q (h_q > "
+        "0) and t in [k dt, (k+1) dt], the subordinate's linear move theta_R(t) = angle(c) + ((t - "
+        "k dt) / dt)(angle(c') - angle(c)) lies in c's box [t_i - h1, t_i + h1] x [t_j - h2, t_j "
+        "+ h2] (spec.right_box) over the whole step. (on_path) Under the fixed is_path, at every "
+        "step k >= 0 the cell held (position(L, k)) is in the grid and the cell held at k + 1 is "
+        "a neighbour of it or itself; once the list has ended (k + 1 >= LENGTH(L)) both are the "
+        "goal: the subordinate is at rest there.", Z, P, _subordinate_query))
+    out.append(Obligation(
+        "Safety.region_soundness", GROUP, "docs/model.md §2, §4.2, §10 (c)",
+        "A point (u, v) of link 1's or link 2's rectangle (docs/model.md §2: half-width r = w/2, "
+        "extended by r past both joints; R_base, R_elbow the §2 reach) at any configuration "
+        "theta of a box [lo1, hi1] x [lo2, hi2] lies in the region impl.swept_region builds for "
+        "the box: the lattice A_q + i g_q (0 < g_q <= 3.14) with impl.lattice_range's indices "
+        "(floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP), checked against lattice_range on "
+        "samples), the link's rectangle at every lattice configuration grown by Delta = "
+        "impl.sweep_margin, and their convex hull. The point is exhibited as a convex "
+        "combination of points of the grown rectangles at the corners of the lattice cell that "
+        "holds theta clamped onto the lattice's span (four corners for link 2, two for link 1, "
+        "which does not depend on theta2). The margin is derived, not assumed: clamping theta_q "
+        "by at most SNAP g_q moves the point by at most SNAP g_q R_q (chord, from cos x >= 1 - "
+        "x^2/2), and Margin.arc_chord, re-proved here as the first VC, is instantiated by "
+        "substitution at every arc (about the base, and about the elbow at both ends), at (r, "
+        "G, e(G/2), e(psi)), and moved from the origin to the arc's pivot and position by the "
+        "rigid motion R(mid) (rigid_id, rot_norm, rot_scale, scale_norm): its bound r G^2/8 at "
+        "R, G the cell's step for a joint with more than one lattice point, else 0. "
+        "margin_covers_link1/2 show that impl.sweep_margin, read by calling it on symbolic "
+        "spacings (its probe arm's reach replaced by symbols; the reading checked against its "
+        "floats on sample arms), is at least the derived margin: a wrong constant fails the "
+        "obligation (1/16 in the lemma its first VC; 1/4 there, or 1/16 in sweep_margin, "
+        "margin_covers). sin and cos are the uninterpreted Cos, Sin with "
+        "the ledger's facts (A3) at the points named. Split into lemmas Z3 proves quickly: small "
+        "ones on the polynomials, and compositions (chord, arc_in_place, reach_link2, grow, "
+        "combine1, combine2, transport, sum_subst, link1_in_region, link2_in_region) valid for "
+        "every function sq, dt standing for |v|^2 and the dot product, each using the others "
+        "by substitution with the facts they rest on carried along; intermediate quantities "
+        "(lattice indices, chord weights, points, the displacement D) are named by their "
+        "definitions. For both arms: the subordinate's regions are built at t_i = 0 and turned "
+        "by t_i, the same construction up to rounding (ledger A2).",
+        Z, P, region_query))
+    out.append(Obligation(
+        "Safety.separation", GROUP, "docs/model.md §4.3, §10 (d)",
+        "If every point of a region A is more than eps = 1e-9 m from every point of a region B "
+        "(dist(A, B) > eps, how BuiltDR decides a cell free; the regions are compact), then a "
+        "link lying in A and a link lying in B share no point (at any point p). Regions and "
+        "links are opaque; Z3 instantiates the distance's quantifier at (p, p).",
+        Z, P, _separation_query))
+    for v in VARIANTS:
+        rest = ("the principal at rest at its goal" if v == "tight" else "layer N-1's region")
+        out.append(Obligation(
+            f"Safety.{v}.composition", GROUP, "docs/model.md §5, §7.2, §10 (e)",
+            f"For the {v} variant: if D_R meets Theorem 1/3's postcondition with the "
+            "intersection test read as distance (P[k,i,j] = 0 iff every pair of a principal link "
+            f"region of layer k, the rest layer from N on ({rest}), and a subordinate link region "
+            "of cell (i, j) is more than eps apart) and L is a path under the fixed is_path, "
+            "then at every instant t >= 0 no link of the principal at theta_L(t) shares a point "
+            "with a link of the subordinate at theta_R(t), the linear move from the cell held "
+            "at step k to the one held at k + 1, k = floor(t / dt) (time_step: k dt <= t <= "
+            "(k+1) dt, and t >= N dt once k >= N). Composed by substitution from "
+            f"Safety.{v}.principal_in_layer_box (motion for k < N, rest from N dt on), "
+            "Safety.subordinate_in_cell_box (on_path, neighbour_move), "
+            "Def4.is_path_fixed_safe and Safety.separation (for the four link pairs, in layer k "
+            "and in the rest layer); Safety.region_soundness enters as its statement for the "
+            "regions involved (a link at a configuration of a region's box lies in the region), "
+            "instantiated at theta_L(t), theta_R(t) and the point, its links and regions "
+            "opaque here; Z3 instantiates the postcondition's quantifier.",
+            Z, P, lambda v=v: _composition_query(v)))
+    return out

@@ -1,0 +1,265 @@
+"""The witness checker is sound (docs/model.md §11): its local conditions imply its answer.
+
+``spec.check_witness`` accepts a found path when labels on the capped states pass
+``witness.start``, ``witness.edge`` and ``witness.goal``, and a no-path answer when a set of
+states passes ``witness.start``, ``witness.closure`` and ``witness.exclusion``. Here, for
+arbitrary grids (N, m, n symbolic, D_R any integer array), those conditions are hypotheses and
+the answers are proved by an inductive invariant over the prefixes of any valid path L (the
+fixed ``is_path``): padded with the goal, L holds the cell ``c(k) = position(L, k)`` at step k,
+arriving by the move ``p(k) = c(k) - c(k - 1)`` (``p(0) = (0, 0)``), for k = 0 .. T with
+T = max(LENGTH L - 1, N); its state at step k is ``(min(k, N), c(k), p(k))``.
+
+- ``Witness.labels_sound``: the invariant "the state at step k is labelled, at most the cost of
+  the first k moves" holds at k = 0 (the start condition), is kept from k to k + 1 (the edge
+  condition at the path's own edge), and at k = T bounds C, the least goal label, by L's cost.
+- ``Witness.reachable_sound``: the invariant "the state at step k is in the set" holds at 0,
+  is kept by closure, and at T contradicts the exclusion: no list is a valid path.
+
+Each has four VCs: the induction's base, its step (split in two: ``walk``, that is_path makes
+L's edge k a free edge to its state at k + 1; and ``step``, that the edge or closure condition
+at that edge keeps the invariant), and its conclusion; the induction principle over 0 .. T
+(what the while rule is for a loop) joins them. The checker tests its edge condition at every
+edge; the VCs use it at L's edge k, an instance named (ledger A8). L's costs are their prefix
+sums over the padded moves, ``A1[k + 1] = A1[k] + |d_k|_1`` and
+``A2[k + 1] = A2[k] + |d_k - d_{k-1}|_1`` with ``d_k = p(k + 1)``, and
+``(J1, J2)(L) = (A1[T], A2[T] + |d_{T-1}|_1)``: the spec's J1 and J2 (padding with the goal adds
+nothing; tests/proofs/test_obl_witness.py checks the two agree). Labels, sets and costs are
+unconstrained integer (Boolean) arrays, so the proof covers any witness, not the search's alone.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import z3
+
+from ..spec.z3defs import (Z3Dims, Z3PathVar, abs_int, in_grid, is_path_fixed, lex_le, position,
+                            z3_path)
+from ._obligation import VC, Method, Obligation, Verdict, Z3Query
+
+__all__ = ["GROUP", "witness_obligations", "witness_vcs"]
+
+GROUP = "Witness checker (certifying search)"
+
+Cell = tuple[z3.ArithRef, z3.ArithRef]
+Hyp = tuple[str, z3.BoolRef]
+State = tuple[z3.ArithRef, ...]
+
+
+@dataclass(frozen=True)
+class _World:
+    """The symbolic grid, D_R, endpoints, a list L, and L's walk through the capped states."""
+
+    d: Z3Dims
+    P: z3.ArrayRef
+    start: Cell
+    goal: Cell
+    L: Z3PathVar
+
+    @property
+    def T(self) -> z3.ArithRef:
+        """The walk's last step: max(LENGTH L - 1, N)."""
+        return z3.If(self.L.length - 1 > self.d.N, self.L.length - 1, self.d.N)
+
+    def step(self, k: z3.ArithRef) -> z3.ArithRef:
+        """The capped step min(k, N): the layer in force."""
+        return z3.If(k < self.d.N, k, self.d.N)
+
+    def cell(self, k: z3.ArithRef) -> Cell:
+        return position(self.L, k)
+
+    def prev(self, k: z3.ArithRef) -> Cell:
+        """The move that arrived at step k: c(k) - c(k - 1), the rest move (0, 0) at k = 0."""
+        c, b = self.cell(k), self.cell(k - 1)
+        return (z3.If(k == 0, 0, c[0] - b[0]), z3.If(k == 0, 0, c[1] - b[1]))
+
+    def state(self, k: z3.ArithRef) -> State:
+        c, p = self.cell(k), self.prev(k)
+        return (self.step(k), c[0], c[1], p[0], p[1])
+
+    def base(self) -> tuple[Hyp, ...]:
+        return (("N >= 1, m, n >= 1", self.d.sane()),
+                ("start, goal in the grid", z3.And(in_grid(self.d, self.start),
+                                                   in_grid(self.d, self.goal))),
+                ("is_path L (the fixed definition)",
+                 is_path_fixed(self.P, self.d, self.start, self.goal, self.L)))
+
+
+def _world() -> _World:
+    ints = z3.IntSort()
+    return _World(Z3Dims.named(), z3.Array("P", ints, ints, ints, ints),
+                  (z3.Int("start.i"), z3.Int("start.j")), (z3.Int("goal.i"), z3.Int("goal.j")),
+                  z3_path("L"))
+
+
+def _move(x: z3.ArithRef) -> z3.BoolRef:
+    return z3.And(-1 <= x, x <= 1)
+
+
+def _state_array(name: str, sort: z3.SortRef) -> z3.ArrayRef:
+    """A value per state (s, i, j, pi, pj): a witness's labels or its set."""
+    ints = z3.IntSort()
+    return z3.Array(name, ints, ints, ints, ints, ints, sort)
+
+
+def _free_edge(w: _World, src: State, d: Cell) -> tuple[z3.BoolRef, State]:
+    """(the move d from state ``src`` is a free edge, its target state): 0 <= s <= N, the cell in
+    the grid and free in layer s, p and d moves, cell + d in the grid and free in layer
+    min(s + 1, N); the target is (min(s + 1, N), cell + d, d)."""
+    s, i, j, pi, pj = src
+    N = w.d.N
+    t = z3.If(s + 1 < N, s + 1, N)
+    target = (t, i + d[0], j + d[1], d[0], d[1])
+    free = z3.And(0 <= s, s <= N, in_grid(w.d, (i, j)), w.P[s, i, j] == 0,
+                  _move(pi), _move(pj), _move(d[0]), _move(d[1]),
+                  in_grid(w.d, (i + d[0], j + d[1])), w.P[t, i + d[0], j + d[1]] == 0)
+    return free, target
+
+
+def _edge_condition(w: _World, mark: z3.ArrayRef, then: Callable[[State, State, Cell], z3.BoolRef],
+                    src: State, d: Cell) -> z3.BoolRef:
+    """The checker's edge condition at one edge: if it is a free edge from a state marked in
+    ``mark``, then ``then(source, target, d)``."""
+    free, target = _free_edge(w, src, d)
+    return z3.Implies(z3.And(free, mark[src]), then(src, target, d))
+
+
+def _walk(w: _World, k: z3.ArithRef) -> z3.BoolRef:
+    """L's edge k is a free edge, and its target is L's state at step k + 1."""
+    free, target = _free_edge(w, w.state(k), w.prev(k + 1))
+    return z3.And(free, *[a == b for a, b in zip(target, w.state(k + 1))])
+
+
+def _walk_vc(w: _World, name: str) -> VC:
+    k = z3.Int("k")
+    dims, cells, valid = w.base()
+    return VC(name, (dims, cells, valid, ("0 <= k < T", z3.And(0 <= k, k < w.T))), _walk(w, k),
+              key_premise=valid[0])
+
+
+def _labels_vcs() -> tuple[VC, ...]:
+    w = _world()
+    has = _state_array("label.has", z3.BoolSort())
+    lab1, lab2 = _state_array("label.J1", z3.IntSort()), _state_array("label.J2", z3.IntSort())
+    ints = z3.IntSort()
+    A1, A2 = z3.Array("A1", ints, ints), z3.Array("A2", ints, ints)
+    C = (z3.Int("C.J1"), z3.Int("C.J2"))
+
+    def label(x: State) -> tuple[z3.ArithRef, z3.ArithRef]:
+        return lab1[x], lab2[x]
+
+    def edge_ok(src: State, dst: State, d: Cell) -> z3.BoolRef:
+        p = src[3:]
+        cost = (abs_int(d[0]) + abs_int(d[1]), abs_int(d[0] - p[0]) + abs_int(d[1] - p[1]))
+        return z3.And(has[dst], lex_le(label(dst), (lab1[src] + cost[0], lab2[src] + cost[1])))
+
+    k = z3.Int("k")
+    kk = z3.Int("pre!k")
+    d_k = w.prev(kk + 1)
+    p_k = w.prev(kk)
+    prefix = ("A1, A2: the costs of L's prefixes (J1, J2 summed over the padded moves)", z3.And(
+        A1[0] == 0, A2[0] == 0,
+        z3.ForAll([kk], z3.Implies(z3.And(0 <= kk, kk < w.T), z3.And(
+            A1[kk + 1] == A1[kk] + abs_int(d_k[0]) + abs_int(d_k[1]),
+            A2[kk + 1] == A2[kk] + abs_int(d_k[0] - p_k[0]) + abs_int(d_k[1] - p_k[1]))))))
+    origin = (0, w.start[0], w.start[1], 0, 0)
+    start = ("witness.start: the start state labelled (0, 0) or less",
+             z3.And(has[origin], lex_le(label(origin), (0, 0))))
+    edge = ("witness.edge at L's edge k: label[s'] <= label[s] + cost if it is a free edge from "
+            "a labelled state", _edge_condition(w, has, edge_ok, w.state(k), w.prev(k + 1)))
+    qi, qj = z3.Ints("g!pi g!pj")
+    at_goal = (w.d.N, w.goal[0], w.goal[1], qi, qj)
+    goal = ("witness.goal: C <= label + (0, |p|_1) at every labelled admissible goal state",
+            z3.ForAll([qi, qj], z3.Implies(
+                z3.And(_move(qi), _move(qj), has[at_goal], w.P[w.d.N, w.goal[0], w.goal[1]] == 0),
+                lex_le(C, (lab1[at_goal], lab2[at_goal] + abs_int(qi) + abs_int(qj))))))
+
+    def inv(x: z3.ArithRef) -> z3.BoolRef:
+        return z3.And(has[w.state(x)], lex_le(label(w.state(x)), (A1[x], A2[x])))
+
+    last = w.prev(w.T)
+    cost_L = (A1[w.T], A2[w.T] + abs_int(last[0]) + abs_int(last[1]))
+    dims = w.base()[0]
+    return (
+        VC("labels.base", w.base() + (prefix, start), inv(z3.IntVal(0)), key_premise=start[0]),
+        _walk_vc(w, "labels.walk"),
+        VC("labels.step", (dims, prefix, ("L's edge k is a free edge to its state at k + 1 "
+                                           "(VC labels.walk)", _walk(w, k)),
+                           edge, ("0 <= k < T", z3.And(0 <= k, k < w.T)),
+                           ("invariant at k", inv(k))),
+           inv(k + 1), key_premise=edge[0]),
+        VC("labels.conclusion", w.base() + (prefix, goal, ("invariant at T", inv(w.T))),
+           lex_le(C, cost_L), key_premise=goal[0]),
+    )
+
+
+def _reachable_vcs() -> tuple[VC, ...]:
+    w = _world()
+    S = _state_array("reach", z3.BoolSort())
+    origin = (0, w.start[0], w.start[1], 0, 0)
+    start = ("witness.start: the start state in S when the start is free in layer 0",
+             z3.Implies(w.P[0, w.start[0], w.start[1]] == 0, S[origin]))
+    k = z3.Int("k")
+    closure = ("witness.closure at L's edge k: it ends in S if it is a free edge from S",
+               _edge_condition(w, S, lambda src, dst, d: S[dst], w.state(k), w.prev(k + 1)))
+    qi, qj = z3.Ints("x!pi x!pj")
+    exclusion = ("witness.exclusion: no admissible goal state in S",
+                 z3.Implies(w.P[w.d.N, w.goal[0], w.goal[1]] == 0, z3.ForAll([qi, qj], z3.Implies(
+                     z3.And(_move(qi), _move(qj)),
+                     z3.Not(S[w.d.N, w.goal[0], w.goal[1], qi, qj])))))
+
+    def inv(x: z3.ArithRef) -> z3.BoolRef:
+        return S[w.state(x)]
+
+    dims, cells, valid = w.base()
+    return (
+        VC("reachable.base", (dims, cells, valid, start), inv(z3.IntVal(0)),
+           key_premise=start[0]),
+        _walk_vc(w, "reachable.walk"),
+        VC("reachable.step", (dims, ("L's edge k is a free edge to its state at k + 1 (VC "
+                                     "reachable.walk)", _walk(w, k)), closure,
+                              ("0 <= k < T", z3.And(0 <= k, k < w.T)), ("invariant at k", inv(k))),
+           inv(k + 1), key_premise=closure[0]),
+        # Not assuming is_path L here: the conclusion is that L is not a valid path.
+        VC("reachable.conclusion", (dims, cells, exclusion,
+                                    ("invariant at T (for a valid L)", inv(w.T))),
+           z3.Not(valid[1]), key_premise=exclusion[0]),
+    )
+
+
+def witness_vcs(kind: str) -> tuple[VC, ...]:
+    """The VCs of ``Witness.labels_sound`` (kind "labels") or ``Witness.reachable_sound``."""
+    return _labels_vcs() if kind == "labels" else _reachable_vcs()
+
+
+def witness_obligations() -> list[Obligation]:
+    P, Z = Verdict.PROVED, Method.Z3
+    return [
+        Obligation(
+            "Witness.labels_sound", GROUP, "ours: McConnell et al.'s certifying algorithms",
+            "For every grid (N >= 1, m, n >= 1), D_R, start and goal, and any labels (J1, J2) "
+            "on the capped states (step min(k, N), cell, previous move) and C: if the start "
+            "state is labelled (0, 0) or less (witness.start), every free edge from a labelled "
+            "state ends at a labelled state with label[s'] <= label[s] + (|d|_1, |d - p|_1) "
+            "lexicographically (witness.edge), and C <= label + (0, |p|_1) at every labelled "
+            "admissible goal state (N, goal, p) (witness.goal), then every valid path L (the "
+            "fixed is_path) has (J1, J2)(L) >= C. By induction over L's prefixes, padded with "
+            "the goal to T = max(LENGTH L - 1, N) moves: the state held at step k is labelled "
+            "at most the first k moves' cost (VCs base; walk and step, with the edge condition "
+            "at L's own edge, a named instance: ledger A8); the last is an admissible goal "
+            "state (VC conclusion). So a valid returned path of cost C, the least goal label, "
+            "is optimal (Definition 5): spec.check_witness's acceptance is sound (ledger A6).",
+            Z, P, lambda: Z3Query(_labels_vcs())),
+        Obligation(
+            "Witness.reachable_sound", GROUP, "ours: McConnell et al.'s certifying algorithms",
+            "For every grid, D_R, start and goal, and any set S of capped states: if S holds "
+            "the start state when the start is free in layer 0 (witness.start), every free "
+            "edge from a state of S ends in S (witness.closure), and S holds no admissible "
+            "goal state when the goal is free in the rest layer (witness.exclusion), then no "
+            "list L is a valid path: by induction over a valid L's prefixes its states stay in "
+            "S (VCs base; walk and step, closure at L's own edge), and its last is an "
+            "admissible goal state (VC conclusion). So spec.check_witness's acceptance of 'no "
+            "path' is sound (ledger A6).",
+            Z, P, lambda: Z3Query(_reachable_vcs())),
+    ]

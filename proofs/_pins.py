@@ -1,0 +1,165 @@
+"""Pinned statements: proofs/obligations.lock holds, per obligation id, the expected verdict and
+the hash of every VC's statement, so that a changed premise, goal or constant fails the run
+until it is re-pinned (``cfmpa prove --repin``), and the diff of the lock shows a reviewer what
+changed.
+
+- A Z3 obligation is pinned by each VC's hash: the sha256 of its proof check in standard
+  SMT-LIB 2.6 (``_smtlib``; a function of the terms, not of Z3's printer), or of Z3's own text
+  where there is no standard rendering. The words of the statement are not pinned (editing
+  them changes no proof).
+- A sympy or fixed data check is pinned by the hash of its canonical text (its source and
+  inputs), ``source``.
+- The per-scenario data checks (``Scenario.<stem>.<check>``) are pinned once per check, under
+  ``Scenario.*.<check>``, by the hash of the check's source alone: the scenario data they read
+  (the first line of their text: the file's name and sha256) is not a statement (it is recorded
+  in results.json's run record instead), and a user's folder holds other files. Every
+  scenario's check must match the one pin.
+
+The lock is JSON, keys sorted, one obligation per entry; ``repin`` rewrites it and says which
+ids were added, removed or changed, with the old and new hashes. An entry also records what cvc5
+answered on each VC when it was pinned (``cvc5``; not part of the comparison): a run replays
+in cvc5 only the statements cvc5 decided then (``cvc5_skips``), since the same text gets the
+same answer, and ``--repin`` replays every one again.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+from ._obligation import Proof
+
+__all__ = ["LOCK", "Mismatch", "check_pins", "cvc5_skips", "load_lock", "pin_entry", "pin_key",
+           "repin"]
+
+#: The lock file shipped with the package (package data), next to this module.
+LOCK = Path(__file__).with_name("obligations.lock")
+
+_FORMAT = "cfmpa obligations lock 1"
+
+Mismatch = tuple[str, str]     # (obligation id, what differs)
+
+
+def pin_key(ident: str) -> str:
+    """The lock's key for an obligation id: per-scenario checks share ``Scenario.*.<check>``."""
+    parts = ident.split(".")
+    if len(parts) >= 3 and parts[0] == "Scenario":
+        return f"Scenario.*.{parts[-1]}"
+    return ident
+
+
+def pin_entry(p: Proof) -> dict[str, Any]:
+    """What the lock holds for a proof: its expected verdict and its statement hashes."""
+    entry: dict[str, Any] = {"expected": p.expected.value}
+    if "source" in p.pins:
+        entry["source"] = p.pins["source"]
+    else:
+        entry["vcs"] = dict(sorted(p.pins.items()))
+        entry["cvc5"] = {v.name: v.cvc5 if v.cvc5 in ("sat", "unsat")
+                         else f"undecided: {v.cvc5_reason or 'not replayed'}" for v in p.vcs}
+    return entry
+
+
+def _statement(entry: dict[str, Any]) -> dict[str, Any]:
+    """The part of an entry a run must match (cvc5's recorded answers are not)."""
+    return {k: v for k, v in entry.items() if k != "cvc5"}
+
+
+def cvc5_skips(lock: dict[str, dict[str, Any]]) -> dict[str, str]:
+    """Statement hash -> why cvc5 is not re-run on it: cvc5 did not decide it when pinned."""
+    out: dict[str, str] = {}
+    for entry in lock.values():
+        answers = entry.get("cvc5") or {}
+        for name, sha in (entry.get("vcs") or {}).items():
+            a = answers.get(name, "")
+            if isinstance(a, str) and a.startswith("undecided"):
+                out[sha] = a.removeprefix("undecided: ")
+    return out
+
+
+def load_lock(path: str | Path | None = None) -> dict[str, dict[str, Any]]:
+    """The pinned entries by key ({} for a missing or unreadable lock: nothing is pinned)."""
+    f = Path(path) if path is not None else LOCK
+    try:
+        doc = json.loads(f.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    obs = doc.get("obligations") if isinstance(doc, dict) else None
+    return dict(obs) if isinstance(obs, dict) else {}
+
+
+def _short(h: object) -> str:
+    return str(h)[:12] if h else "absent"
+
+
+def _diff(old: dict[str, Any], new: dict[str, Any]) -> str:
+    parts = []
+    if old.get("expected") != new.get("expected"):
+        parts.append(f"expected {old.get('expected')} -> {new.get('expected')}")
+    if old.get("source") != new.get("source"):
+        parts.append(f"source {_short(old.get('source'))} -> {_short(new.get('source'))}")
+    ov, nv = old.get("vcs") or {}, new.get("vcs") or {}
+    for name in sorted(set(ov) | set(nv)):
+        if ov.get(name) != nv.get(name):
+            parts.append(f"VC {name}: {_short(ov.get(name))} -> {_short(nv.get(name))}")
+    return "; ".join(parts)
+
+
+def check_pins(proofs: Iterable[Proof], lock: dict[str, dict[str, Any]]) -> list[Mismatch]:
+    """Every proof whose statement is not the pinned one: not pinned at all, or changed."""
+    out: list[Mismatch] = []
+    for p in proofs:
+        entry = pin_entry(p)
+        old = lock.get(pin_key(p.id))
+        if old is None:
+            out.append((p.id, "not pinned (a new obligation)"))
+        elif _statement(old) != _statement(entry):
+            out.append((p.id, "statement changed, not re-pinned: " + _diff(old, entry)))
+    return out
+
+
+def repin(proofs: Iterable[Proof], path: str | Path | None = None, *,
+          complete: bool = True) -> list[str]:
+    """Rewrite the lock with the proofs' statements; return the changes, one line each.
+
+    ``complete``: the proofs are a whole run, so a pinned id not among them is removed (with
+    ``--only`` the others are kept as they are)."""
+    f = Path(path) if path is not None else LOCK
+    old = load_lock(f)
+    new: dict[str, dict[str, Any]] = {} if complete else dict(old)
+    produced: dict[str, dict[str, Any]] = {}
+    conflicts = []
+    for p in proofs:
+        key, entry = pin_key(p.id), pin_entry(p)
+        if key in produced and _statement(produced[key]) != _statement(entry):
+            conflicts.append(f"conflict: {p.id} is not {key} as pinned by another scenario")
+        produced.setdefault(key, entry)
+    new.update(produced)
+    lines = []
+    for key in sorted(set(old) | set(new)):
+        if key not in old:
+            lines.append(f"added   {key}")
+        elif key not in new:
+            lines.append(f"removed {key}")
+        elif _statement(old[key]) != _statement(new[key]):
+            lines.append(f"changed {key}: {_diff(old[key], new[key])}")
+    doc = {"format": _FORMAT,
+           "note": "Written by `cfmpa prove --repin`: review the diff. Per obligation, the "
+                   "expected verdict and the sha256 of each VC's statement in standard SMT-LIB "
+                   "2.6 (or of a check's source); per-scenario checks once, as Scenario.*.",
+           "obligations": {k: new[k] for k in sorted(new)}}
+    text = json.dumps(doc, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
+    fd, tmp = tempfile.mkstemp(prefix=f".{f.name}.", dir=f.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, f)
+        os.chmod(f, 0o644)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return conflicts + lines

@@ -1,0 +1,347 @@
+"""Timed trajectories of both arms (docs/model.md §12): files, their certificate and tolerance tube.
+
+A trajectory is waypoints (t_k, left1, left2, right1, right2): seconds and radians, theta1
+absolute and theta2 relative, as in the scenario file. Between rows the motion is linear in joint
+space; before the first row both arms rest at it, after the last row at that one. Files: CSV with
+the header ``t,left1,left2,right1,right2`` (any column order), one row per waypoint, or JSON
+``{"t": [...], "left1": [...], ...}``.
+
+The tolerance tube. If the certificate proves clearance c > 0 over every instant, every motion
+whose four joint angles stay within delta (max norm) of the trajectory at every instant is also
+contact-free whenever c > 2 L delta, with L = ``tube_lipschitz(s)``, the largest R_base + R_elbow
+over both arms' links: a deviation of at most delta per joint moves each point of a link by at
+most delta (R_base + R_elbow) (integrate the point velocity along the straight joint-space segment
+between the two configurations; docs/model.md §12), so each arm's rectangles lie within L delta of
+the planned ones in Hausdorff distance and the distance between the arms drops by at most
+2 L delta. The obligation ``Tolerance.tube`` proves the lemma; ``tolerance_rad`` is the largest
+delta on a 1e-6 rad grid with 2 L delta <= c - EPS.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import MISSING, InputError
+from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
+                           Certificate, ContactDetail, link_rects, link_speeds, prove_motion)
+from ._grid import EPS, Grid, exact_tf, left_angles
+from ._kinematics import reach
+from ._polygon import polygon_distances
+from ._scenario import ANGLE_TOLERANCE, Scenario
+
+__all__ = ["COLUMNS", "JOINTS", "Trajectory", "csv_column_order", "load_trajectory",
+           "parse_trajectory_csv", "parse_trajectory_json", "certify_trajectory",
+           "executed_trajectory", "trajectory_csv", "tube_lipschitz", "tolerance_rad",
+           "TOLERANCE_STEP_RAD", "SPEED_TOLERANCE", "trajectory_distances", "validate"]
+
+#: The file columns, in the order of ``Trajectory.angles`` after t.
+COLUMNS = ("t", "left1", "left2", "right1", "right2")
+JOINTS = COLUMNS[1:]
+#: tolerance_rad is rounded down to a multiple of this.
+TOLERANCE_STEP_RAD = 1e-6
+#: A joint speed is refused when above omega * (1 + SPEED_TOLERANCE) (float rounding only).
+SPEED_TOLERANCE = 1e-9
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Waypoints: ``t`` (R,) strictly increasing, ``angles`` (R, 4) as JOINTS; ``lines`` the file
+    line of each row (None for JSON or a computed trajectory); ``source`` the file name."""
+
+    t: FloatArray
+    angles: FloatArray
+    source: str | None = None
+    lines: tuple[int, ...] | None = None
+
+    @property
+    def rows(self) -> int:
+        return len(self.t)
+
+    def line(self, k: int) -> int | None:
+        return None if self.lines is None else self.lines[k]
+
+    def at(self, t: npt.ArrayLike) -> FloatArray:
+        """The four joint angles at times ``t`` (at rest before the first, after the last row)."""
+        t = np.asarray(t, dtype=float)
+        if self.rows == 1:
+            return np.broadcast_to(self.angles[0], (*t.shape, 4)).copy()
+        k = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.rows - 2)
+        return self._interp(t, k)
+
+    def _interp(self, t: FloatArray, k: npt.NDArray[np.int64]) -> FloatArray:
+        t0, t1 = self.t[k], self.t[k + 1]
+        u = np.clip((t - t0) / (t1 - t0), 0.0, 1.0)[..., None]
+        a0, a1 = self.angles[k], self.angles[k + 1]
+        return a0 + u * (a1 - a0)
+
+
+def _fail(field: str, value: Any, message: str, source: str | None, line: int | None) -> InputError:
+    return InputError(field, value, message, source=source, line=line)
+
+
+def csv_column_order(header: str, source: str | None = None) -> list[int]:
+    """The field index of each of COLUMNS in a CSV header line (any order, exactly those five);
+    InputError at line 1 otherwise."""
+    if not header.strip():
+        raise _fail("header", MISSING, f"must be the first line: {','.join(COLUMNS)}", source, 1)
+    names = [x.strip() for x in header.strip().split(",")]
+    for name in COLUMNS:
+        if name not in names:
+            raise _fail("header", header.strip(), f"is missing the column {name!r} (need "
+                        f"{','.join(COLUMNS)})", source, 1)
+    if len(names) != len(COLUMNS) or len(set(names)) != len(names):
+        raise _fail("header", header.strip(), f"must have exactly the columns "
+                    f"{','.join(COLUMNS)}", source, 1)
+    return [names.index(c) for c in COLUMNS]
+
+
+def parse_trajectory_csv(text: str, s: Scenario, *, source: str | None = None,
+                         allow_speed: bool = False) -> Trajectory:
+    """A CSV trajectory, validated (``validate``); errors name the file and line."""
+    lines = text.splitlines()
+    order = csv_column_order(lines[0] if lines else "", source)
+    last = len(lines)
+    while last > 1 and not lines[last - 1].strip():
+        last -= 1                                   # trailing blank lines are no rows
+    rows: list[list[float]] = []
+    where: list[int] = []
+    for no in range(2, last + 1):
+        line = lines[no - 1]
+        if not line.strip():
+            raise _fail("row", line, "is blank (rows must follow one another)", source, no)
+        fields = line.split(",")
+        if len(fields) != len(COLUMNS):
+            raise _fail("row", line, f"must have {len(COLUMNS)} values, has {len(fields)}",
+                        source, no)
+        vals = []
+        for name, i in zip(COLUMNS, order):
+            try:
+                v = float(fields[i])
+            except ValueError:
+                raise _fail(name, fields[i].strip(), "must be a number", source, no) from None
+            if not math.isfinite(v):
+                raise _fail(name, v, "must be finite", source, no)
+            vals.append(v)
+        rows.append(vals)
+        where.append(no)
+    if not rows:
+        raise _fail("trajectory", MISSING, "must have at least one row", source, 1)
+    arr = np.asarray(rows, dtype=float)
+    traj = Trajectory(arr[:, 0].copy(), arr[:, 1:].copy(), source, tuple(where))
+    validate(traj, s, allow_speed=allow_speed)
+    return traj
+
+
+def parse_trajectory_json(doc: Any, s: Scenario, *, source: str | None = None,
+                          allow_speed: bool = False) -> Trajectory:
+    """A JSON trajectory ``{"t": [...], "left1": [...], ...}``, validated (``validate``)."""
+    if not isinstance(doc, dict):
+        raise _fail("trajectory", type(doc).__name__, "must be a JSON object of columns", source,
+                    None)
+    cols = []
+    for name in COLUMNS:
+        if name not in doc:
+            raise _fail(name, MISSING, "is a missing column", source, None)
+        col = doc[name]
+        if not isinstance(col, list):
+            raise _fail(name, type(col).__name__, "must be a list of numbers", source, None)
+        for k, v in enumerate(col):
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise _fail(f"{name}[{k}]", v, "must be a number", source, None)
+            if not math.isfinite(float(v)):
+                raise _fail(f"{name}[{k}]", v, "must be finite", source, None)
+        cols.append([float(v) for v in col])
+    extra = sorted(set(doc) - set(COLUMNS))
+    if extra:
+        raise _fail("trajectory", extra, f"has unknown keys (columns are {', '.join(COLUMNS)})",
+                    source, None)
+    counts = {len(c) for c in cols}
+    if len(counts) != 1:
+        raise _fail("trajectory", {n: len(c) for n, c in zip(COLUMNS, cols)},
+                    "columns must have the same count", source, None)
+    if not cols[0]:
+        raise _fail("trajectory", 0, "must have at least one row", source, None)
+    arr = np.asarray(cols, dtype=float).T
+    traj = Trajectory(arr[:, 0].copy(), arr[:, 1:].copy(), source, None)
+    validate(traj, s, allow_speed=allow_speed)
+    return traj
+
+
+def load_trajectory(path: str | Path, s: Scenario, *, allow_speed: bool = False) -> Trajectory:
+    """A trajectory file: JSON if it ends in .json (or starts with ``{``), else CSV."""
+    p = Path(path)
+    text = p.read_text(encoding="utf-8")
+    if p.suffix.lower() == ".json" or text.lstrip().startswith("{"):
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise _fail("JSON", exc.msg, "is not valid JSON", str(p), exc.lineno) from None
+        return parse_trajectory_json(doc, s, source=str(p), allow_speed=allow_speed)
+    return parse_trajectory_csv(text, s, source=str(p), allow_speed=allow_speed)
+
+
+def validate(traj: Trajectory, s: Scenario, *, allow_speed: bool = False) -> None:
+    """Strictly increasing t; joint speeds within the scenario's omega (unless ``allow_speed``);
+    the subordinate's angles within its limits. Raises InputError naming the row."""
+    src = traj.source
+
+    def where(k: int) -> tuple[str, int | None]:
+        line = traj.line(k)
+        return (f"row {k + 1}" if line is None else f"row {k + 1}"), line
+
+    dt = np.diff(traj.t)
+    bad = np.flatnonzero(dt <= 0)
+    if len(bad):
+        k = int(bad[0]) + 1
+        label, line = where(k)
+        raise _fail(f"t ({label})", float(traj.t[k]), f"must be greater than the previous time "
+                    f"{float(traj.t[k - 1])!r} (times strictly increase)", src, line)
+    for q in range(2):
+        lo, hi = s.right.limits[q]
+        col = traj.angles[:, 2 + q]
+        out = np.flatnonzero((col < lo - ANGLE_TOLERANCE) | (col > hi + ANGLE_TOLERANCE))
+        if len(out):
+            k = int(out[0])
+            label, line = where(k)
+            raise _fail(f"{JOINTS[2 + q]} ({label})", float(col[k]),
+                        f"must lie within the subordinate's limits [{lo!r}, {hi!r}]", src, line)
+    if allow_speed or traj.rows < 2:
+        return
+    omega = np.array([*s.left.omega, *s.right.omega])
+    speed = np.abs(np.diff(traj.angles, axis=0)) / dt[:, None]
+    over = speed > omega[None, :] * (1.0 + SPEED_TOLERANCE)
+    if np.any(over):
+        k, q = (int(x) for x in np.argwhere(over)[0])
+        label, line = where(k + 1)
+        raise _fail(f"{JOINTS[q]} speed ({label})", float(speed[k, q]),
+                    f"rad/s from the previous row exceeds omega = {float(omega[q])!r} rad/s "
+                    "(--allow-speed certifies it anyway)", src, line)
+
+
+def executed_trajectory(s: Scenario, g: Grid, path: Any) -> Trajectory:
+    """The certificate's executed motion of a grid path as waypoints: one row per step k dt,
+    k = 0 .. max(len - 1, ceil(Tf / dt)), plus a row at Tf when it falls inside a step."""
+    cells = np.asarray([tuple(c) for c in path], dtype=np.int64)
+    if len(cells) == 0:
+        raise InputError("path", [], "must have at least one cell")
+    dt, tf = g.dt, float(exact_tf(s))
+    last = len(cells) - 1
+    steps = max(last, math.ceil(tf / dt))
+    times = np.arange(steps + 1, dtype=np.int64) * dt
+    if tf > 0 and not np.any(times == tf) and tf < times[-1]:
+        times = np.sort(np.append(times, tf))
+    right = np.stack([g.lo[0] + cells[:, 0] * g.h[0], g.lo[1] + cells[:, 1] * g.h[1]], axis=1)
+    k = np.minimum(np.floor(times / dt + 1e-9).astype(np.int64), max(last - 1, 0))
+    # At step times use the cells' own angles; at Tf (inside step k) interpolate as the
+    # certificate does.
+    on_step = np.isclose(times / dt, np.round(times / dt), rtol=0, atol=1e-9)
+    idx = np.minimum(np.round(times / dt).astype(np.int64), last)
+    ang_r = right[idx].copy()
+    if last > 0:
+        inside = ~on_step
+        u = np.clip((times[inside] - k[inside] * dt) / dt, 0.0, 1.0)[:, None]
+        ang_r[inside] = right[k[inside]] + u * (right[k[inside] + 1] - right[k[inside]])
+    ang_l = left_angles(s, times)
+    return Trajectory(times, np.concatenate([ang_l, ang_r], axis=1), None, None)
+
+
+def trajectory_csv(traj: Trajectory) -> str:
+    """The CSV text of ``traj`` (repr floats: reading it back gives the same doubles)."""
+    out = [",".join(COLUMNS)]
+    for t, a in zip(traj.t.tolist(), traj.angles.tolist()):
+        out.append(",".join(repr(float(x)) for x in (t, *a)))
+    return "\n".join(out) + "\n"
+
+
+def tube_lipschitz(s: Scenario) -> float:
+    """L: the largest R_base + R_elbow over both arms' links (m/rad): a max-norm joint deviation
+    delta moves any point of any link by at most L delta."""
+    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in (0, 1))
+
+
+def tolerance_rad(s: Scenario, cert: Certificate) -> float:
+    """The certified tube's radius: the largest multiple of TOLERANCE_STEP_RAD with
+    2 L delta <= c - EPS (so c > 2 L delta), c the proved clearance; 0.0 when not clear."""
+    if not cert.clear or cert.lower_bound_m <= EPS:
+        return 0.0
+    two_l = 2.0 * tube_lipschitz(s)
+    per = round(1 / TOLERANCE_STEP_RAD)
+    k = math.floor((cert.lower_bound_m - EPS) / two_l * per)
+    while k > 0 and two_l * (k / per) > cert.lower_bound_m - EPS:
+        k -= 1
+    return k / per
+
+
+def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
+    """d[k, a, b]: distance between left link a and right link b at configurations (K, 4)."""
+    angles = np.asarray(angles, dtype=float).reshape(-1, 4)
+    left = link_rects(s.left, angles[:, :2])
+    right = link_rects(s.right, angles[:, 2:])
+    return polygon_distances(left[:, :, None], right[:, None, :])
+
+
+@dataclass(frozen=True)
+class _TrajectoryMotion:
+    """A trajectory as the certificate's motion: pieces between rows (``seg`` = row index)."""
+
+    scenario: Scenario
+    traj: Trajectory
+
+    def pieces(self) -> tuple[FloatArray, FloatArray, npt.NDArray[np.int64], npt.NDArray[np.bool_]]:
+        tr = self.traj
+        if tr.rows == 1:
+            z = np.full(1, tr.t[0])
+            return z, z.copy(), np.full(1, -1, dtype=np.int64), np.zeros(1, dtype=bool)
+        seg = np.arange(tr.rows - 1, dtype=np.int64)
+        return tr.t[:-1].copy(), tr.t[1:].copy(), seg, np.ones(len(seg), dtype=bool)
+
+    def lipschitz(self, seg: npt.NDArray[np.int64], moving: npt.NDArray[np.bool_]) -> FloatArray:
+        tr = self.traj
+        if tr.rows == 1:
+            w = np.zeros((len(seg), 4))
+        else:
+            w = (np.abs(np.diff(tr.angles, axis=0)) / np.diff(tr.t)[:, None])[np.maximum(seg, 0)]
+            w = np.where(seg[:, None] >= 0, w, 0.0)
+        vl = link_speeds(self.scenario.left, w[:, :2])
+        vr = link_speeds(self.scenario.right, w[:, 2:])
+        return vl[:, :, None] + vr[:, None, :]
+
+    def angles(self, t: FloatArray, seg: npt.NDArray[np.int64]) -> FloatArray:
+        tr = self.traj
+        if tr.rows == 1:
+            return np.broadcast_to(tr.angles[0], (len(t), 4))
+        return np.where(seg[:, None] >= 0, tr._interp(t, np.maximum(seg, 0)), tr.angles[-1])
+
+    def distances(self, t: FloatArray, seg: npt.NDArray[np.int64]) -> FloatArray:
+        return trajectory_distances(self.scenario, self.angles(t, seg))
+
+    def detail(self, contact: tuple[float, tuple[int, int]], seg: int) -> ContactDetail:
+        t, links = contact
+        a = self.angles(np.array([t]), np.array([seg], dtype=np.int64))[0]
+        k = seg if seg >= 0 else None
+        # No grid cells for a trajectory: ``cells`` holds the waypoint rows (k, k + 1).
+        rows = (seg, seg + 1) if k is not None else (self.traj.rows - 1, self.traj.rows - 1)
+        return ContactDetail(t, links, (float(a[0]), float(a[1])), (float(a[2]), float(a[3])),
+                             k, ((rows[0], rows[0]), (rows[1], rows[1])))
+
+
+def certify_trajectory(s: Scenario, traj: Trajectory, *, max_depth: int = DEFAULT_MAX_DEPTH,
+                       bound_ratio: float = DEFAULT_BOUND_RATIO,
+                       max_intervals: int = DEFAULT_MAX_INTERVALS) -> Certificate:
+    """The continuous-time certificate (docs/model.md §7) of a trajectory, both arms from it.
+
+    The pieces are the rows' intervals; a contact reported is the first one (to within a
+    piece's length / 2^max_depth). ``contact_detail.step`` is the row index k of the piece
+    [t_k, t_{k+1}] (None at rest after the last row).
+    """
+    return prove_motion(_TrajectoryMotion(s, traj), max_depth=max_depth, bound_ratio=bound_ratio,
+                        max_intervals=max_intervals, first_contact=True)

@@ -1,0 +1,340 @@
+"""Witnesses of searchoptpath's answer and their checker (docs/model.md §11).
+
+A certifying search (McConnell, Mehlhorn, Näher, Schweitzer, "Certifying algorithms", 2011)
+returns, with its answer, a witness that this small checker verifies without trusting the search.
+
+**States.** ``(s, c, p)``: step ``s`` capped at N, cell ``c``, previous move ``p`` (an index
+into ``MOVES``; the start is ``(0, start, WAIT)``, the arm at rest). A state is free when ``c`` is
+free in layer ``s`` (``D_R[s][c] == 0``; from N on the layer is the rest layer R). A **free edge**
+is a move ``d`` from a free state ``(s, c, p)`` to the free state ``(min(s + 1, N), c + d, d)``,
+``c + d`` in the grid; it costs ``(|d|_1, |d - p|_1)``, what ``J1`` and ``J2`` add for that step.
+The **admissible goal states** are ``(N, goal, p)`` for every ``p`` when the goal is free in R:
+there the arm can hold the goal for ever, and stopping costs ``(0, |p|_1)`` more (J2's last term).
+
+A valid path (the fixed ``is_path``), padded with the goal to ``T + 1 = max(len, N + 1)`` cells, is
+a walk along free edges from the start to an admissible goal state, and its (J1, J2) is the walk's
+cost plus the stop term (padding with the goal changes neither cost).
+
+**Labels** (a path was found): arrays ``j1``, ``j2`` of shape ``(N + 1, 9, m, n)`` (step, previous
+move, cell), of one unsigned integer type; its largest value marks a state without a label. The
+checker's conditions, in order:
+
+- ``witness.form``: the shape, the type, a label in both arrays or in neither, and
+  ``j1 < 2**30``, ``j2 < 2**31`` (so that the checker's sums are exact in int64);
+- ``witness.start``: the start state's label is ``(0, 0)``;
+- ``witness.edge``: every free edge from a labelled state ends at a labelled state, and
+  ``label[s'] <= label[s] + cost(s, s')``, lexicographically on (J1, J2);
+- ``witness.path``: the returned path is valid (``is_path``);
+- ``witness.goal``: its (J1, J2) equals the least ``label + (0, |p|_1)`` over the labelled
+  admissible goal states.
+
+By induction over the prefixes of any valid path, every state on its walk is labelled at most the
+prefix's cost; so its (J1, J2) is at least the least goal label, which is the returned path's: the
+returned path is optimal (obligation ``Witness.labels_sound``).
+
+**Reachable set** (no path): a boolean array ``reachable`` of shape ``(N + 1, 9, m, n)``:
+
+- ``witness.form``: the shape and the type;
+- ``witness.start``: the start state is in the set when the start is free in layer 0;
+- ``witness.closure``: every free edge from a state of the set ends in the set;
+- ``witness.exclusion``: no admissible goal state is in the set.
+
+A valid path's walk would stay in the set and end at an admissible goal state: no valid path
+exists (obligation ``Witness.reachable_sound``).
+
+The checker shares no code with impl/; it reads each layer once, on the bounding box of the
+labelled (or reached) states, and names the first failing condition with its state, edge and
+labels.
+"""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import MISSING, InputError
+from ._paths import J1, J2, MOVES, SearchResult, SearchStatus, path_violations
+from ._triples import Failure
+
+__all__ = ["LABEL_LIMITS", "WITNESS_FORMAT", "Witness", "check_witness", "load_witness"]
+
+#: The tag a witness file carries (npz member ``format``).
+WITNESS_FORMAT = "cfmpa-witness-1"
+#: Labels must lie below these (J1, J2): then keys J1 * 2**32 + J2 and their sums are exact.
+LABEL_LIMITS = (1 << 30, 1 << 31)
+
+_WAIT = MOVES.index((0, 0))
+_DI = np.array([d[0] for d in MOVES], dtype=np.int64)
+_DJ = np.array([d[1] for d in MOVES], dtype=np.int64)
+_NORM = np.abs(_DI) + np.abs(_DJ)                                          # |d|_1
+_TURN = np.abs(_DI[:, None] - _DI[None, :]) + np.abs(_DJ[:, None] - _DJ[None, :])  # [p, d]
+_SHIFT = 32
+#: Above every finite key plus an edge cost, and far from overflowing int64.
+_NONE = np.int64((1 << 62) + (1 << 40))
+
+Array = npt.NDArray[Any]
+
+
+@dataclass(frozen=True, eq=False)
+class Witness:
+    """A search's certificate: labels ``j1``, ``j2`` (found) or a ``reachable`` set (no path),
+    each of shape ``(N + 1, 9, m, n)`` indexed (step, previous move, i, j); see the module."""
+
+    kind: str                       # "labels" | "reachable"
+    j1: Array | None = None
+    j2: Array | None = None
+    reachable: Array | None = None
+
+    @classmethod
+    def of_labels(cls, j1: Array, j2: Array) -> Witness:
+        return cls("labels", j1=j1, j2=j2)
+
+    @classmethod
+    def of_reachable(cls, reachable: Array) -> Witness:
+        return cls("reachable", reachable=reachable)
+
+    @property
+    def arrays(self) -> dict[str, Array]:
+        if self.kind == "labels":
+            return {"j1": self.j1, "j2": self.j2}
+        return {"reachable": self.reachable}
+
+    def npz_bytes(self) -> bytes:
+        """The witness file: an uncompressed npz with ``format``, ``kind`` and the arrays."""
+        buf = io.BytesIO()
+        np.savez(buf, format=np.array(WITNESS_FORMAT), kind=np.array(self.kind),
+                 **self.arrays)
+        return buf.getvalue()
+
+
+def load_witness(path: str | Path) -> Witness:
+    """A witness file written by ``Witness.npz_bytes``; InputError names what is wrong."""
+    source = str(path)
+
+    def bad(field: str, value: Any, message: str) -> InputError:
+        return InputError(field, value, message, source=source)
+
+    try:
+        z = np.load(path, allow_pickle=False)
+        if not isinstance(z, np.lib.npyio.NpzFile):
+            raise bad("witness", MISSING, "is not an .npz witness file (a single array)")
+        with z:
+            members = {k: z[k] for k in z.files}
+    except OSError as exc:
+        raise bad("witness", MISSING, f"cannot be read ({exc.strerror or exc})") from None
+    except (ValueError, zipfile.BadZipFile, EOFError) as exc:
+        raise bad("witness", MISSING, f"is not an .npz witness file ({exc})") from None
+    tag = members.get("format")
+    if tag is None or tag.shape != () or str(tag) != WITNESS_FORMAT:
+        raise bad("format", None if tag is None else str(tag), f"must be {WITNESS_FORMAT!r}")
+    kind = members.get("kind")
+    kind = None if kind is None or kind.shape != () else str(kind)
+    if kind == "labels" and {"j1", "j2"} <= set(members):
+        return Witness.of_labels(members["j1"], members["j2"])
+    if kind == "reachable" and "reachable" in members:
+        return Witness.of_reachable(members["reachable"])
+    raise bad("kind", kind, "must be 'labels' (with j1, j2) or 'reachable' (with reachable)")
+
+
+def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
+                  result: SearchResult, witness: Witness | None) -> list[Failure]:
+    """The first failing condition of the module docstring, or [] when the witness proves the
+    answer: a found path optimal, or no path valid. ``dr`` is a 0/1 array (N + 1, m, n)."""
+    free = np.asarray(dr) == 0
+    N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
+    start, goal = (int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))
+    found = result.status is SearchStatus.FOUND
+    want = "labels" if found else "reachable"
+    if witness is None or witness.kind != want:
+        return [_fail("form", f"a {'found path' if found else 'no-path answer'} needs a "
+                      f"'{want}' witness", ("witness", None if witness is None else witness.kind))]
+    shape = (N + 1, 9, m, n)
+    bad = [(k, a) for k, a in witness.arrays.items()
+           if not isinstance(a, np.ndarray) or a.shape != shape
+           or (a.dtype != np.bool_ if k == "reachable" else a.dtype.kind != "u")
+           or (k == "j2" and a.dtype != witness.j1.dtype)]
+    if bad:
+        k, a = bad[0]
+        return [_fail("form", f"the witness array {k} has the wrong shape or type",
+                      ("array", k), ("shape", list(getattr(a, "shape", ()))),
+                      ("dtype", str(getattr(a, "dtype", type(a).__name__))),
+                      ("expected shape", list(shape)),
+                      ("expected dtype", "bool" if k == "reachable" else "unsigned, as j1"))]
+    if found:
+        return _check_labels(free, start, goal, result, witness.j1, witness.j2)
+    return _check_reachable(free, start, goal, witness.reachable)
+
+
+# --- labels -------------------------------------------------------------------------------------
+
+
+def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
+                  result: SearchResult, j1: Array, j2: Array) -> list[Failure]:
+    N = free.shape[0] - 1
+    none = np.iinfo(j1.dtype).max
+    for s in range(N + 1):
+        a, b = j1[s] == none, j2[s] == none
+        if not np.array_equal(a, b):
+            p, i, j = _first(a != b)
+            return [_fail("form", "a state has a label in one array only",
+                          ("state", _state(s, (i, j), p)), ("j1", int(j1[s, p, i, j])),
+                          ("j2", int(j2[s, p, i, j])), ("no label", int(none)))]
+        big = ~a & ((j1[s] >= LABEL_LIMITS[0]) | (j2[s] >= LABEL_LIMITS[1]))
+        if big.any():
+            p, i, j = _first(big)
+            return [_fail("form", "a label is out of range (J1 < 2**30, J2 < 2**31)",
+                          ("state", _state(s, (i, j), p)),
+                          ("label", [int(j1[s, p, i, j]), int(j2[s, p, i, j])]))]
+    at = (0, _WAIT, *start)
+    if j1[at] != 0 or j2[at] != 0:
+        return [_fail("start", "the start state's label is not (0, 0)",
+                      ("state", _state(0, start, _WAIT)), ("label", _label(j1, j2, at)))]
+    edge = _check_edges(free, j1, j2)
+    if edge:
+        return edge
+    path = list(result.path)
+    bad = path_violations(path, free.astype(np.uint8) ^ 1, start, goal)
+    if bad:
+        return [_fail("path", f"the returned path is not valid: {bad[0].message}",
+                      ("clause", bad[0].clause), ("failed clauses", len(bad)))]
+    cost = (J1(path), J2(path))
+    keys = _keys(j1[N, :, goal[0], goal[1]], j2[N, :, goal[0], goal[1]]) + _NORM
+    p = int(np.argmin(keys))
+    least = None if keys[p] >= _NONE else (int(keys[p] >> _SHIFT), int(keys[p] & 0xFFFFFFFF))
+    if least != cost:
+        return [_fail("goal", "the path's (J1, J2) is not the least label over the goal's "
+                      "admissible states (plus the stop term |p|_1)",
+                      ("path's J1, J2 (recomputed)", list(cost)),
+                      ("least goal label + stop", None if least is None else list(least)),
+                      ("at state", _state(N, goal, p)))]
+    return []
+
+
+def _keys(j1: Array, j2: Array) -> Array:
+    """Lexicographic keys J1 * 2**32 + J2 (int64), _NONE where there is no label."""
+    none = np.iinfo(j1.dtype).max
+    k = (j1.astype(np.int64) << _SHIFT) | j2.astype(np.int64)
+    return np.where(j1 == none, _NONE, k)
+
+
+def _check_edges(free: Array, j1: Array, j2: Array) -> list[Failure]:
+    """witness.edge, layer by layer on the box of the labelled free states (plus one cell)."""
+    N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
+    none = np.iinfo(j1.dtype).max
+    first, count = None, 0
+    for s in range(N + 1):
+        t = min(s + 1, N)
+        src = (j1[s] != none) & free[s]                      # labelled free states (9, m, n)
+        box = _box(src.any(axis=0))
+        if box is None:
+            continue
+        r0, r1, c0, c1 = box
+        key = np.where(src[:, r0:r1, c0:c1], _keys(j1[s, :, r0:r1, c0:c1], j2[s, :, r0:r1, c0:c1]),
+                       _NONE)
+        for d in range(9):
+            # Sources in the box whose target c + d lies in the grid.
+            a0, a1 = max(r0, -_DI[d]), min(r1, m - _DI[d])
+            b0, b1 = max(c0, -_DJ[d]), min(c1, n - _DJ[d])
+            if a0 >= a1 or b0 >= b1:
+                continue
+            sub = key[:, a0 - r0:a1 - r0, b0 - c0:b1 - c0]
+            bound = np.min(sub + _TURN[:, d, None, None], axis=0)     # least label + |d - p|
+            ti, tj = slice(a0 + _DI[d], a1 + _DI[d]), slice(b0 + _DJ[d], b1 + _DJ[d])
+            target = _keys(j1[t, d, ti, tj], j2[t, d, ti, tj])
+            bad = ((bound < _NONE) & free[t, ti, tj]
+                   & (target > bound + (int(_NORM[d]) << _SHIFT)))
+            if bad.any():
+                count += int(bad.sum())
+                if first is None:
+                    i, j = (int(x) for x in np.argwhere(bad)[0])
+                    first = (s, t, d, a0 + i, b0 + j)
+    if first is None:
+        return []
+    s, t, d, i, j = first
+    p = int(np.argmin(_keys(j1[s, :, i, j], j2[s, :, i, j]) + _TURN[:, d]))
+    to = (i + int(_DI[d]), j + int(_DJ[d]))
+    cost = [int(_NORM[d]), int(_TURN[p, d])]
+    have = _label(j1, j2, (s, p, i, j))
+    return [_fail("edge", "a free edge breaks label[s'] <= label[s] + cost(s, s')",
+                  ("state", _state(s, (i, j), p)), ("label", have), ("move", list(MOVES[d])),
+                  ("edge cost", cost), ("to state", _state(t, to, d)),
+                  ("its label", _label(j1, j2, (t, d, *to))),
+                  ("bound", [have[0] + cost[0], have[1] + cost[1]]), count=count)]
+
+
+# --- reachable set ------------------------------------------------------------------------------
+
+
+def _check_reachable(free: Array, start: tuple[int, int], goal: tuple[int, int],
+                     reach: Array) -> list[Failure]:
+    N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
+    if free[0][start] and not reach[0, _WAIT, start[0], start[1]]:
+        return [_fail("start", "the start state is free but not in the set",
+                      ("state", _state(0, start, _WAIT)))]
+    first, count = None, 0
+    for s in range(N + 1):
+        t = min(s + 1, N)
+        src = reach[s].any(axis=0) & free[s]    # the moves from a cell do not depend on p
+        box = _box(src)
+        if box is None:
+            continue
+        r0, r1, c0, c1 = box
+        for d in range(9):
+            a0, a1 = max(r0, -_DI[d]), min(r1, m - _DI[d])
+            b0, b1 = max(c0, -_DJ[d]), min(c1, n - _DJ[d])
+            if a0 >= a1 or b0 >= b1:
+                continue
+            ti, tj = slice(a0 + _DI[d], a1 + _DI[d]), slice(b0 + _DJ[d], b1 + _DJ[d])
+            bad = src[a0:a1, b0:b1] & free[t, ti, tj] & ~reach[t, d, ti, tj]
+            if bad.any():
+                count += int(bad.sum())
+                if first is None:
+                    i, j = (int(x) for x in np.argwhere(bad)[0])
+                    first = (s, t, d, a0 + i, b0 + j)
+    if first is not None:
+        s, t, d, i, j = first
+        p = int(np.flatnonzero(reach[s, :, i, j])[0])
+        to = (i + int(_DI[d]), j + int(_DJ[d]))
+        return [_fail("closure", "a free edge leaves the set",
+                      ("state", _state(s, (i, j), p)), ("move", list(MOVES[d])),
+                      ("to state", _state(t, to, d)), count=count)]
+    if free[N][goal] and reach[N, :, goal[0], goal[1]].any():
+        p = int(np.flatnonzero(reach[N, :, goal[0], goal[1]])[0])
+        return [_fail("exclusion", "an admissible goal state is in the set (the goal can be "
+                      "held from it)", ("state", _state(N, goal, p)))]
+    return []
+
+
+# --- helpers ------------------------------------------------------------------------------------
+
+
+def _box(mask: Array) -> tuple[int, int, int, int] | None:
+    """Rows [r0, r1) and columns [c0, c1) holding every True of a 2-d mask; None if none."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if rows.size == 0:
+        return None
+    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+
+
+def _first(mask: Array) -> tuple[int, ...]:
+    return tuple(int(x) for x in np.argwhere(mask)[0])
+
+
+def _state(s: int, cell: tuple[int, int], p: int) -> dict[str, Any]:
+    return {"step": int(s), "cell": [int(cell[0]), int(cell[1])], "previous move": list(MOVES[p])}
+
+
+def _label(j1: Array, j2: Array, at: tuple[int, ...]) -> list[int] | None:
+    none = np.iinfo(j1.dtype).max
+    return None if j1[at] == none else [int(j1[at]), int(j2[at])]
+
+
+def _fail(name: str, message: str, *values: tuple[str, Any], count: int = 1) -> Failure:
+    return Failure(f"witness.{name}", message, tuple(values), count)

@@ -1,0 +1,346 @@
+"""Safety.* (docs/model.md §10): every obligation is proved, none by its Boolean skeleton, and
+each fails, with Z3 answering sat, once a key premise is dropped or a constant is mutated: the
+margin lemma's 1/8 -> 1/16, sweep_margin's 1/8 -> 1/16, the modified box's sign flipped, the
+subordinate allowed to jump two cells, N dt < Tf. The box rules are spec.left_box's and
+spec.right_box's on the bundled scenarios, and the margin read from impl is impl's formula."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+import z3
+from cfmpa.impl import SNAP, link_reach, sweep_margin
+from cfmpa.proofs import FIXED_IDS, collect_obligations
+from cfmpa.proofs import _obl_safety as S
+from cfmpa.proofs._obligation import VC
+from cfmpa.spec import (exact_n, exact_tf, left_angles, left_box, load_scenario, make_grid,
+                        right_box)
+
+REPO = Path(__file__).resolve().parents[2]
+IDS = [f"Safety.{v}.principal_in_layer_box" for v in S.VARIANTS] + [
+    "Safety.subordinate_in_cell_box", "Safety.region_soundness", "Safety.separation"] + [
+    f"Safety.{v}.composition" for v in S.VARIANTS]
+
+
+def _check(hyps, goal=None, pins=(), seeds=3, timeout=20_000) -> z3.CheckSatResult:
+    """Z3 on hyps (and not goal): an unknown is retried under other seeds (only sat or unsat
+    is an answer), as tests/proofs/test_negative.py does."""
+    answer = z3.unknown
+    for seed in range(seeds):
+        ctx = z3.Context()
+        s = z3.Solver(ctx=ctx)
+        s.set("timeout", timeout)
+        s.set("random_seed", seed)
+        s.add([h.translate(ctx) for h in hyps])
+        if goal is not None:
+            s.add(z3.Not(goal.translate(ctx)))
+        s.add([c.translate(ctx) == v.translate(ctx) for c, v in pins])
+        answer = s.check()
+        if answer != z3.unknown:
+            return answer
+    return answer
+
+
+def _hyps(vc: VC, drop: str | None = None) -> list[z3.BoolRef]:
+    return [h for n, h in vc.hypotheses if n != drop]
+
+
+def _proved(vc: VC) -> bool:
+    return (_check(_hyps(vc), pins=vc.witness, seeds=1) == z3.sat
+            and _check(_hyps(vc), vc.goal, seeds=1) == z3.unsat)
+
+
+def _refuted(vc: VC, drop: str | None = None, pins=None) -> bool:
+    return _check(_hyps(vc, drop), vc.goal,
+                  pins=vc.counter_witness if pins is None else pins) == z3.sat
+
+
+@pytest.fixture(scope="module")
+def queries() -> dict[str, tuple[VC, ...]]:
+    obs = {o.id: o for o in collect_obligations("/nonexistent", ["Safety"])}
+    return {i: obs[i].build().vcs for i in IDS}
+
+
+def test_the_safety_ids_are_registered_and_pinned():
+    obs = [o.id for o in collect_obligations("/nonexistent", ["Safety"])]
+    assert obs == IDS
+    assert all(i in FIXED_IDS for i in IDS)
+
+
+def test_every_safety_vc_is_proved_with_satisfiable_hypotheses(queries):
+    for ident, vcs in queries.items():
+        for vc in vcs:
+            assert _proved(vc), f"{ident}/{vc.name}"
+
+
+# --- not by the Boolean skeleton -----------------------------------------------------------------
+
+_CONNECTIVES = {z3.Z3_OP_AND, z3.Z3_OP_OR, z3.Z3_OP_NOT, z3.Z3_OP_IMPLIES, z3.Z3_OP_XOR,
+                z3.Z3_OP_TRUE, z3.Z3_OP_FALSE}
+
+
+def _skeleton(f: z3.ExprRef, atoms: dict[int, z3.BoolRef]) -> z3.BoolRef:
+    """f with every atom (a Boolean term whose head is not a connective: a comparison, an
+    application, a quantifier) replaced by a fresh Boolean, equal atoms by the same one."""
+    if z3.is_quantifier(f) or not z3.is_app(f):
+        key = f.get_id()
+    else:
+        k = f.decl().kind()
+        if k in _CONNECTIVES:
+            return f.decl()(*[_skeleton(c, atoms) for c in f.children()]) if f.num_args() else f
+        if k == z3.Z3_OP_ITE and z3.is_bool(f):
+            return z3.If(_skeleton(f.arg(0), atoms), _skeleton(f.arg(1), atoms),
+                         _skeleton(f.arg(2), atoms))
+        if k == z3.Z3_OP_EQ and z3.is_bool(f.arg(0)):
+            return _skeleton(f.arg(0), atoms) == _skeleton(f.arg(1), atoms)
+        key = f.get_id()
+    if key not in atoms:
+        atoms[key] = z3.Bool(f"atom!{len(atoms)}")
+    return atoms[key]
+
+
+def test_no_safety_vc_is_proved_by_its_boolean_skeleton(queries):
+    for ident, vcs in queries.items():
+        for vc in vcs:
+            atoms: dict[int, z3.BoolRef] = {}
+            hyps = [_skeleton(h, atoms) for h in _hyps(vc)]
+            goal = _skeleton(vc.goal, atoms)
+            s = z3.Solver()
+            s.add(hyps)
+            s.add(z3.Not(goal))
+            assert s.check() == z3.sat, f"{ident}/{vc.name} holds by its Boolean skeleton"
+
+
+def test_the_skeleton_test_catches_a_propositional_vc():
+    a, b = z3.Ints("a b")
+    vc = VC("p", (("a < b", a < b), ("a < b implies b > a", z3.Implies(a < b, b > a))), b > a)
+    atoms: dict[int, z3.BoolRef] = {}
+    s = z3.Solver()
+    s.add([_skeleton(h, atoms) for h in _hyps(vc)])
+    s.add(z3.Not(_skeleton(vc.goal, atoms)))
+    assert s.check() == z3.unsat
+
+
+# --- (a) the principal -------------------------------------------------------------------------
+
+@pytest.mark.parametrize("variant", S.VARIANTS)
+def test_principal_needs_its_step_window(variant):
+    motion, rest = S.principal_lemmas(variant)
+    assert _refuted(motion.vc, motion.vc.key_premise)
+    assert _refuted(rest.vc, rest.vc.key_premise)      # N's definition dropped
+
+
+@pytest.mark.parametrize("variant", S.VARIANTS)
+def test_principal_rest_fails_when_N_dt_falls_short_of_Tf(variant):
+    P = S.Principal.named()
+    short = ("N >= 1, N dt < Tf", z3.And(P.N >= 1, z3.ToReal(P.N) * P.dt < P.Tf))
+    _, rest = S.principal_lemmas(variant, n_def=short)
+    assert _refuted(rest.vc)
+
+
+@pytest.mark.parametrize("variant", S.VARIANTS)
+def test_principal_motion_needs_the_speed_bound(variant):
+    # Without Tf = max_q |goal_q - start_q| / omega_q a joint may outrun its box.
+    motion, _ = S.principal_lemmas(variant)
+    tf = S.Principal.named().tf_def()[0]
+    if variant == "tight":
+        # The tight box follows the motion itself: it holds for any Tf >= 0.
+        assert not _refuted(motion.vc, tf)
+    else:
+        assert _refuted(motion.vc, tf)
+
+
+def test_the_modified_box_with_its_sign_flipped_misses_the_motion():
+    motion, rest = S.principal_lemmas("modified", sign_flip=True)
+    assert _refuted(motion.vc)
+    assert _refuted(rest.vc)
+
+
+def _scenarios():
+    return sorted((REPO / "scenarios").glob("*.toml"))
+
+
+def _q(x) -> z3.ArithRef:
+    f = Fraction(x)
+    return z3.RealVal(f"{f.numerator}/{f.denominator}")
+
+
+def _num(e: z3.ExprRef) -> float:
+    v = z3.simplify(e)
+    assert z3.is_rational_value(v), v
+    return float(v.as_fraction())
+
+
+@pytest.mark.parametrize("path", _scenarios(), ids=lambda p: p.stem)
+def test_the_box_rules_are_spec_left_box_and_right_box(path):
+    s = load_scenario(path)
+    P = S.Principal.named()
+    pins = [(P.start[q], _q(s.left.start[q])) for q in range(2)]
+    pins += [(P.goal[q], _q(s.left.goal[q])) for q in range(2)]
+    pins += [(P.omega[q], _q(s.left.omega[q])) for q in range(2)]
+    pins += [(P.dt, _q(s.dt)), (P.Tf, _q(exact_tf(s))), (P.N, z3.IntVal(exact_n(s)))]
+
+    def sub(e: z3.ExprRef) -> z3.ExprRef:
+        return z3.substitute(e, *pins)
+    N = exact_n(s)
+    for variant in S.VARIANTS:
+        for k in sorted({0, 1, N // 2, N - 1}):
+            box = P.box(variant, z3.RealVal(k))
+            want = left_box(s, variant, k)
+            for q in range(2):
+                for side in range(2):
+                    assert _num(sub(box[q][side])) == pytest.approx(want[q][side], abs=1e-12)
+        rest = P.rest_box(variant)
+        want = (tuple((g, g) for g in s.left.goal) if variant == "tight"
+                else left_box(s, variant, N - 1))
+        for q in range(2):
+            for side in range(2):
+                assert _num(sub(rest[q][side])) == pytest.approx(want[q][side], abs=1e-12)
+    # The PTP formula is spec.left_angles'.
+    for t in (0.0, s.dt / 3, 0.5 * float(exact_tf(s)), 2.0 * float(exact_tf(s)) + 1):
+        th = P.theta(_q(t))
+        a = left_angles(s, t)
+        for q in range(2):
+            assert _num(sub(th[q])) == pytest.approx(float(a[q]), abs=1e-12)
+    # The subordinate's box is spec.right_box's.
+    g = make_grid(s)
+    R = S.Subordinate.named()
+    rpins = [(R.lo[q], _q(g.lo[q])) for q in range(2)] + [(R.h[q], _q(g.h[q])) for q in range(2)]
+    for cell in ((0, 0), (g.m - 1, g.n - 1), (g.m // 2, 1)):
+        box = R.box((z3.IntVal(cell[0]), z3.IntVal(cell[1])))
+        want = right_box(g, cell)
+        for q in range(2):
+            for side in range(2):
+                assert (_num(z3.substitute(box[q][side], *rpins))
+                        == pytest.approx(want[q][side], abs=1e-12))
+
+
+# --- (b) the subordinate -----------------------------------------------------------------------
+
+def test_a_jump_of_two_cells_leaves_the_box():
+    move, _ = S.subordinate_lemmas(reach=2)
+    assert _refuted(move.vc)
+    move, on_path = S.subordinate_lemmas()
+    assert _refuted(move.vc, move.vc.key_premise)
+    assert _refuted(on_path.vc, on_path.vc.key_premise)
+
+
+# --- (c) region soundness ------------------------------------------------------------------------
+
+def _sixteenth(arm, link, g, moving=(True, True)):
+    """sweep_margin with g^2/16 for g^2/8: a margin too small for the lemma."""
+    reach = link_reach(arm, link)
+    delta = 0.0
+    for q in range(2):
+        if moving[q]:
+            delta += g[q] ** 2 / 16.0 * reach[q]
+        delta += SNAP * g[q] * reach[q]
+    return delta
+
+
+def _arc_with(constant: int) -> VC:
+    """Margin.arc_chord's VC with its bound r g^2/8 written r g^2/constant."""
+    arc = S.arc_chord()
+    goal = z3.substitute(arc.vc.goal, (arc.delta, arc.r * arc.g * arc.g / constant))
+    assert not z3.eq(goal, arc.vc.goal)
+    return VC(arc.vc.name, arc.vc.hypotheses, goal, arc.vc.key_premise)
+
+
+def test_region_soundness_instantiates_the_proved_arc_lemma(queries):
+    from cfmpa.proofs import collect_obligations as all_obs
+    arc = next(o for o in all_obs("/nonexistent", ["Margin.arc_chord"])).build().vcs[0]
+    first = queries["Safety.region_soundness"][0]
+    assert first.name == "Margin.arc_chord" and z3.eq(first.goal, arc.goal)
+    assert [n for n, _ in first.hypotheses] == [n for n, _ in arc.hypotheses]
+
+
+def test_a_margin_lemma_with_1_16_is_refuted():
+    kit = S.region_kit(arc_vc=_arc_with(16))
+    q = S.region_query(kit)
+    assert q.vcs[0].name == "Margin.arc_chord"
+    assert _refuted(q.vcs[0], pins=())
+
+
+def test_a_weaker_margin_lemma_no_longer_covers_sweep_margin():
+    # r g^2/4 is true of an arc, but more than sweep_margin adds: margin_covers fails.
+    kit = S.region_kit(arc_vc=_arc_with(4))
+    assert not _refuted(S.region_query(kit).vcs[0], pins=())
+    for name in ("margin_covers_link1", "margin_covers_link2"):
+        assert _refuted(kit[name].vc, pins=())
+
+
+def test_sweep_margin_with_1_16_fails_the_margin_comparison():
+    kit = S.region_kit(margin=_sixteenth)
+    for name in ("margin_covers_link1", "margin_covers_link2"):
+        assert _refuted(kit[name].vc, pins=())
+    # ... and the composition reads the same mutant: its margin hypothesis changed.
+    good = S.region_kit()
+    for name in ("link1_in_region", "link2_in_region"):
+        key = good[name].vc.key_premise
+        mutated = dict(kit[name].vc.hypotheses)[key]
+        assert not z3.eq(mutated, dict(good[name].vc.hypotheses)[key])
+
+
+def test_the_margin_read_from_impl_is_its_formula():
+    g1, g2, rb, re = z3.Reals("g1 g2 Rb Re")
+    for link in (0, 1):
+        for flags in ((True, True), (True, False), (False, True), (False, False)):
+            if link == 0 and flags[1]:
+                continue
+            read = S.impl_margin_term(link, (g1, g2), (rb, re), flags)
+            reach = (rb, re if link == 1 else z3.RealVal(0))
+            want = sum((g * g / 8 * r if f else 0) + S.SNAP_Q * g * r
+                       for g, r, f in zip((g1, g2), reach, flags))
+            s = z3.Solver()
+            s.add(read != want)
+            assert s.check() == z3.unsat, (link, flags)
+    # A margin function the reading cannot follow is refused, not read wrong.
+    with pytest.raises(ValueError):
+        S.impl_margin_term(1, (g1, g2), (rb, re), (True, True),
+                           lambda arm, link, g, moving: sweep_margin(arm, link, (0.5, 0.5), moving))
+
+
+def test_the_lattice_model_is_lattice_range():
+    S.check_lattice_reading()
+
+
+def test_region_lemmas_need_their_key_premises():
+    kit = S.region_kit()
+    for name, L in kit.lemmas.items():
+        assert _refuted(L.vc, L.vc.key_premise), name
+
+
+# --- (d), (e) ------------------------------------------------------------------------------------
+
+def test_separation_needs_the_distance():
+    L = S.separation_lemma()
+    assert _refuted(L.vc, L.vc.key_premise)
+    assert _refuted(L.vc, "(c) link a of the principal at theta_L lies in A (at p)")
+
+
+@pytest.mark.parametrize("variant", S.VARIANTS)
+def test_composition_needs_the_postcondition_and_the_regions(variant):
+    vc = S.composition_vc(variant)
+    assert _refuted(vc, vc.key_premise)
+    # Without (c), nothing puts the links in the regions D_R was decided on.
+    stripped = VC(vc.name, tuple(h for h in vc.hypotheses
+                                 if not h[0].startswith("(c) Safety.region_soundness")),
+                  vc.goal, counter_witness=vc.counter_witness)
+    assert len(stripped.hypotheses) == len(vc.hypotheses) - 6
+    assert _refuted(stripped)
+
+
+def test_the_time_step_needs_t_nonnegative():
+    L = S._step_lemma()
+    assert _refuted(L.vc, L.vc.key_premise)
+
+
+def test_composition_rests_on_the_proved_parts(queries):
+    # The (a), (b), (d) lemmas and Def4.is_path_fixed_safe enter by substitution of their VCs.
+    vc = S.composition_vc("modified")
+    names = " | ".join(n for n, _ in vc.hypotheses)
+    for part in ("by motion at", "by rest at", "by on_path at", "by neighbour_move at",
+                 "by no_common_point at", "by Def4.is_path_fixed_safe at", "by time_step at"):
+        assert part in names

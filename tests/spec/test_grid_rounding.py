@@ -1,0 +1,255 @@
+"""Grids satisfy their contracts by construction: valid round-number workcells never
+get a false ``pre.grid.*`` violation, their per-scenario obligations hold, and a joint that
+cannot be gridded safely is refused by the loader (exit 2, the field named).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import hypothesis.strategies as st
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+import factory
+from cfmpa import cli
+from cfmpa.errors import InputError
+from cfmpa.proofs._obl_scenario import _cspace_grid, _margin_side, _time_grid
+from cfmpa.spec import (Grid, Variant, builtdr_triple, decimal, exact_n, grid_failures,
+                        joint_grid, load_scenario, make_grid, parse_scenario)
+from cfmpa.spec import _counts
+from cfmpa.spec._counts import ceil_fraction, min_points
+
+SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
+
+# What users write (the issue's lists).
+DTS = [0.01, 0.02, 0.025, 0.03, 0.04, 0.05, 0.1]
+OMEGAS = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0]
+SPANS = [2.5, 3.0, 4.0, math.pi, 2 * math.pi]
+LOWS = [-3.0, -2.5, -2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, -math.pi,
+        -math.pi / 2, 0.25, -0.25, 0.1]
+
+
+def old_grid(lo: float, hi: float, omega: float, dt: float) -> tuple[int, float]:
+    """The former construction: the exact binary count, then the float spacing."""
+    m = ceil_fraction((Fraction(hi) - Fraction(lo)) / (Fraction(omega) * Fraction(dt))) + 1
+    return m, (hi - lo) / (m - 1)
+
+
+def unsafe(lo: float, hi: float, omega: float, dt: float, m: int, h: float) -> bool:
+    """Whether m points spaced h break h <= omega dt (float h and both readings) or the span."""
+    step_b = Fraction(omega) * Fraction(dt)
+    return (Fraction(h) > step_b or (Fraction(hi) - Fraction(lo)) / (m - 1) > step_b
+            or (decimal(hi) - decimal(lo)) / (m - 1) > decimal(omega) * decimal(dt)
+            or abs(lo + (m - 1) * h - hi) > 1e-9)
+
+
+def workcell(dt: float, omega_r: tuple[float, float], spans: tuple[float, float],
+             lows: tuple[float, float], omega_l: tuple[float, float] = (1.0, 1.0),
+             start: tuple[float, float] = (0.3, 0.8), goal: tuple[float, float] = (1.6, 2.2),
+             cells: tuple[float, float, float, float] = (0.2, 0.7, 0.8, 0.3)) -> dict[str, Any]:
+    """A workcell document; start and goal cells at the given fractions of each joint's grid."""
+    limits = [[lows[q], lows[q] + spans[q]] for q in range(2)]
+    ms = [joint_grid(limits[q][0], limits[q][1], omega_r[q], dt)[0] for q in range(2)]
+    idx = [min(int(f * ms[q % 2]), ms[q % 2] - 1) for q, f in enumerate(cells)]
+    return factory.doc(dt=dt, left__omega=list(omega_l), left__start=list(start),
+                       left__goal=list(goal), right__omega=list(omega_r), right__limits=limits,
+                       right__start_cell=idx[:2], right__goal_cell=idx[2:])
+
+
+def assert_sound(doc: dict[str, Any]) -> None:
+    s = parse_scenario(doc, check_budget=False)
+    g = make_grid(s)
+    # pre.grid.* is the same condition in Theorems 1, 3 and 3 (tight).
+    assert {c.id for c in builtdr_triple(Variant.TIGHT).precondition} >= {"pre.grid.N",
+                                                                         "pre.grid.h"}
+    assert grid_failures(s, g) == []
+    for check in (_time_grid, _cspace_grid, _margin_side):
+        outcome = check(s)
+        assert outcome.holds, outcome.detail
+
+
+# --- one joint at a time: the construction adds a point exactly where the old one was unsafe --
+
+
+def test_new_construction_adds_a_point_exactly_where_the_old_was_unsafe() -> None:
+    combos = list(itertools.product(DTS, OMEGAS, SPANS, LOWS))
+    old_bad = added = 0
+    for dt, w, span, lo in combos:
+        hi = lo + span
+        mo, ho = old_grid(lo, hi, w, dt)
+        mn, hn = joint_grid(lo, hi, w, dt)
+        was_unsafe = unsafe(lo, hi, w, dt, mo, ho)
+        old_bad += was_unsafe
+        added += mn != mo
+        assert not unsafe(lo, hi, w, dt, mn, hn), (dt, w, span, lo)
+        assert mn == mo + was_unsafe, (dt, w, span, lo, mo, mn)
+    assert len(combos) == 6300
+    assert old_bad == added == 289   # measured: the old construction is unsafe on 289
+
+
+def test_the_issues_example_gets_one_point_more() -> None:
+    m, h = joint_grid(0.0, 2.5, 2.5, 0.02)
+    assert old_grid(0.0, 2.5, 2.5, 0.02) == (51, 0.05)
+    assert (m, h) == (52, 2.5 / 51)
+    assert Fraction(0.05) > Fraction(2.5) * Fraction(0.02)   # why 51 points were unsafe
+
+
+# --- regression files on the boundary ----------------------------------------------------------
+
+BOUNDARY = [  # (dt, omega, span, lo): integer span / (omega dt) in decimal, unsafe before
+    (0.02, 2.5, 2.5, 0.0),
+    (0.02, 2.5, 3.0, 0.0),
+    (0.04, 5.0, 3.0, 0.0),
+    (0.04, 5.0, 4.0, -2.0),
+    (0.04, 5.0, 3.0, -math.pi),
+    (0.04, 5.0, 4.0, 0.5),
+]
+
+
+@pytest.mark.parametrize("dt, w, span, lo", BOUNDARY)
+def test_boundary_workcells_satisfy_their_contracts(dt: float, w: float, span: float,
+                                                    lo: float) -> None:
+    assert unsafe(lo, lo + span, w, dt, *old_grid(lo, lo + span, w, dt))
+    assert_sound(workcell(dt, (w, w), (span, span), (lo, lo)))
+
+
+def test_time_grid_covers_tf_in_both_readings() -> None:
+    # Tf = 0.352 / 1.1 = 0.32 = 8 * 0.04 in decimal; in binary the goal's double is past it.
+    doc = factory.doc(dt=0.04, left__omega=[1.1, 1.1], left__start=[0.0, 0.0],
+                      left__goal=[0.35200000000000004, 0.0])
+    s = parse_scenario(doc, check_budget=False)
+    times = Grid.time_readings(s)
+    n = exact_n(s)
+    assert n == 9
+    assert all(n * dt >= tf for dt, tf in times.values())
+    assert any((n - 1) * dt < tf for dt, tf in times.values())
+    assert grid_failures(s, make_grid(s)) == [] and _time_grid(s).holds
+
+
+def test_bundled_grids_did_not_change() -> None:
+    for f in SCENARIOS:
+        s = load_scenario(f)
+        g = make_grid(s)
+        R = s.right
+        old = [old_grid(R.limits[q][0], R.limits[q][1], R.omega[q], s.dt) for q in range(2)]
+        assert (g.m, g.n, g.h) == (old[0][0], old[1][0], (old[0][1], old[1][1])), f.name
+        tf = max(abs(Fraction(s.left.goal[q]) - Fraction(s.left.start[q]))
+                 / Fraction(s.left.omega[q]) for q in range(2))
+        assert g.N == max(1, ceil_fraction(tf / Fraction(s.dt))), f.name
+
+
+# --- the property ------------------------------------------------------------------------------
+
+ANGLES = st.integers(-30, 30).map(lambda k: k / 10)
+
+
+@st.composite
+def round_workcells(draw: st.DrawFn) -> dict[str, Any]:
+    dt = draw(st.sampled_from(DTS))
+    omega_r = (draw(st.sampled_from(OMEGAS)), draw(st.sampled_from(OMEGAS)))
+    spans = (draw(st.sampled_from(SPANS)), draw(st.sampled_from(SPANS)))
+    lows = (draw(st.sampled_from(LOWS)), draw(st.sampled_from(LOWS)))
+    omega_l = (draw(st.sampled_from(OMEGAS)), draw(st.sampled_from(OMEGAS)))
+    start = (draw(ANGLES), draw(ANGLES))
+    goal = (draw(ANGLES), draw(ANGLES))
+    cells = tuple(draw(st.floats(0, 1)) for _ in range(4))
+    return workcell(dt, omega_r, spans, lows, omega_l, start, goal, cells)  # type: ignore[arg-type]
+
+
+@settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(round_workcells())
+def test_round_number_workcells_never_violate_pre_grid(doc: dict[str, Any]) -> None:
+    assert_sound(doc)
+
+
+@pytest.mark.slow
+@settings(max_examples=5000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(round_workcells())
+def test_round_number_workcells_never_violate_pre_grid_long(doc: dict[str, Any]) -> None:
+    assert_sound(doc)
+
+
+def test_the_strategy_hits_the_boundary() -> None:
+    """About one workcell in six the strategy draws has a joint on the boundary."""
+    hits = 0
+
+    @settings(max_examples=300, deadline=None, database=None)
+    @given(round_workcells())
+    def count(doc: dict[str, Any]) -> None:
+        nonlocal hits
+        R = doc["right"]
+        hits += any(joint_grid(lo, hi, R["omega"][q], doc["dt"])[0]
+                    > old_grid(lo, hi, R["omega"][q], doc["dt"])[0]
+                    for q, (lo, hi) in enumerate(R["limits"]))
+
+    count()
+    assert hits >= 10
+
+
+# --- planning coarse boundary workcells --------------------------------------------------------
+
+
+@pytest.mark.parametrize("dt, w, span, lo", BOUNDARY[2:])
+def test_coarse_boundary_workcells_plan_in_every_variant(tmp_path: Path, dt: float, w: float,
+                                                         span: float, lo: float) -> None:
+    doc = workcell(dt, (w, w), (span, span), (lo, lo), cells=(0.1, 0.2, 0.9, 0.8))
+    f = tmp_path / "boundary.toml"
+    f.write_text(factory.toml(doc))
+    for v in Variant:
+        code = cli.main(["plan", str(f), "--variant", v.value, "--out", str(tmp_path / v.value),
+                         "--contracts", "sampled"])
+        assert code == 0, v
+
+
+# --- refusals: exit 2 naming the field, never a contract violation -----------------------------
+
+
+def test_a_joint_that_cannot_be_confirmed_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    doc = workcell(0.02, (1.0, 2.5), (3.0, 2.5), (0.0, 0.0))
+    parse_scenario(doc, check_budget=False)   # accepted, with a point added to joint 2
+    # Seeded fault: allow no extra point, so the boundary joint cannot be made safe.
+    monkeypatch.setattr(_counts, "MAX_EXTRA_POINTS", 0)
+    with pytest.raises(InputError) as info:
+        parse_scenario(doc, check_budget=False)
+    assert info.value.field == "right.limits[1]"
+    assert "cannot be gridded safely" in str(info.value)
+
+
+def test_a_start_off_the_shifted_grid_is_refused_with_the_reason() -> None:
+    doc = workcell(0.02, (2.5, 2.5), (2.5, 2.5), (0.0, 0.0))
+    del doc["right"]["start_cell"]
+    doc["right"]["start"] = [1.25, 1.25]
+    with pytest.raises(InputError) as info:
+        parse_scenario(doc, check_budget=False)
+    msg = str(info.value)
+    assert info.value.field == "right.start[0]"
+    assert "nearest are index 25" in msg and "index 26" in msg
+    assert "52 points, not 51" in msg and "a point was added" in msg
+
+
+def test_a_start_on_the_grid_is_placed_with_make_grids_spacing() -> None:
+    doc = workcell(0.02, (2.5, 2.5), (2.5, 2.5), (0.0, 0.0))
+    del doc["right"]["start_cell"]
+    doc["right"]["start"] = [30 * (2.5 / 51), 2.5]
+    s = parse_scenario(doc, check_budget=False)
+    assert s.right.start_cell == (30, 51)
+    g = make_grid(s)
+    assert g.angles(s.right.start_cell) == (30 * (2.5 / 51), 2.5)
+
+
+def test_omega_dt_just_over_the_margin_bound_is_refused() -> None:
+    # The double 3.14 is above 157/50: margin_side would fail, so the loader refuses it.
+    with pytest.raises(InputError) as info:
+        parse_scenario(factory.doc(dt=1.0, left__omega=[3.14, 1.0]), check_budget=False)
+    assert info.value.field == "left.omega[0]"
+    assert "157/50" in str(info.value)
+
+
+def test_min_points_needs_no_float() -> None:
+    assert min_points(0.0, 2.5, 2.5, 0.02) == 51
+    assert min_points(0.0, 1.0, 1.0, 5e-324 * 2**60) > 2**53
