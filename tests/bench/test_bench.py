@@ -8,12 +8,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from cfmpa.spec import Variant
 
 ROOT = Path(__file__).resolve().parents[2]
 TIMING = {"median_s", "min_s", "max_s", "runs", "peak_rss_mb"}
 
 
+# Slow: the whole quick bench, cfmpa prove included (minutes); make test-slow runs it.
+@pytest.mark.slow
 def test_bench_quick_writes_results_with_every_section(tmp_path):
     proc = subprocess.run([sys.executable, str(ROOT / "bench" / "run.py"), "--quick", "--out",
                            str(tmp_path)], capture_output=True, text=True, cwd=ROOT)

@@ -48,6 +48,8 @@ def _prove(only: list[str], out: Path) -> tuple[int, dict[str, dict]]:
     return rc, {o["id"]: o for o in doc["obligations"]}
 
 
+# Slow: the default run keeps the same mutant through cfmpa prove's exit code.
+@pytest.mark.slow
 def test_a_smaller_margin_constant_fails_the_margin_lemma(monkeypatch, tmp_path):
     # r g^2/8 -> r g^2/16 in Lemma.sweep_margin: the lemma's margins R g^2/16.
     m = mutant(monkeypatch, "_obl_margin", "/ 8", "/ 16", within="_sweep_margin")

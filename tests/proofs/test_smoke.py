@@ -76,6 +76,8 @@ def _assume_found(monkeypatch) -> None:
     monkeypatch.setattr(paths, "Assume", lambda c: real(z3.And(c, z3.Bool("found"))))
 
 
+# Slow: the default run keeps the same mutant through cfmpa prove (and test_mutants.py's).
+@pytest.mark.slow
 def test_assuming_found_in_the_search_wrapper_fails_theorems_2_and_4(monkeypatch, tmp_path):
     _assume_found(monkeypatch)
     only = ["Thm2.searchoptpath", "Thm4.searchoptpath", "Thm4.searchoptpath_tight",
