@@ -29,10 +29,10 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                           Cell, SearchResult, check_search_inputs)
+from ..spec import (MOVES, REASON_UNREACHABLE,
+                           Cell, SearchResult)
 from ._progress import progress_bar
-from ._search import INF, J2_MASK, SHIFT, WAIT, WitnessLabels, _check_size, _unwind, hold_waits
+from ._search import INF, J2_MASK, SHIFT, WAIT, _prepare, _unwind, hold_waits
 
 __all__ = ["search_opt_path_fast"]
 
@@ -47,16 +47,10 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
                          ) -> SearchResult:
     """The same result as ``search_opt_path`` (least (J1, J2), its path, or why none), and with
     ``with_witness`` the same witness."""
-    N, m, n, start, goal = check_search_inputs(dr, start, goal)
-    free = np.ascontiguousarray(np.asarray(dr) == 0)
-    reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
-              REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
-    if reason is not None and not with_witness:
-        return SearchResult.no_path(reason)
-    _check_size(N, m, n)
-    labels = WitnessLabels(N, m, n) if with_witness else None
-    if reason == REASON_START_BLOCKED:
-        return replace(SearchResult.no_path(reason), witness=labels.witness(found=False))
+    setup, early = _prepare(dr, start, goal, with_witness)
+    if early is not None:
+        return early
+    N, m, n, start, goal, free, reason, labels = setup
     dag_pred = np.zeros((N, 9, m, n), dtype=np.int8)   # read only at reachable states
     keys = np.full((9, m, n), INF, dtype=np.int64)
     spare = np.full((9, m, n), INF, dtype=np.int64)

@@ -34,6 +34,24 @@ WAIT = MOVES.index((0, 0))
 _STEP_J1 = np.add.outer(np.abs(np.arange(-1, 2)), np.abs(np.arange(-1, 2))).astype(np.int64)
 
 
+def _prepare(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness: bool
+             ) -> tuple[tuple[Any, ...], SearchResult | None]:
+    """What both searches do first: the checked inputs, the free mask (C-contiguous), the
+    blocked-end reason and the witness labels; or the early answer when an end is blocked (the
+    goal's only without a witness: with one, the search still settles the reachable states)."""
+    N, m, n, start, goal = check_search_inputs(dr, start, goal)
+    free = np.ascontiguousarray(np.asarray(dr) == 0)
+    reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
+              REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
+    if reason is not None and not with_witness:
+        return (), SearchResult.no_path(reason)
+    _check_size(N, m, n)
+    labels = WitnessLabels(N, m, n) if with_witness else None
+    if reason == REASON_START_BLOCKED:
+        return (), replace(SearchResult.no_path(reason), witness=labels.witness(found=False))
+    return (N, m, n, start, goal, free, reason, labels), None
+
+
 def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
                     with_witness: bool = False) -> SearchResult:
     """The least (J1, J2), lexicographically, over all valid paths of any length (exact), or why none.
@@ -66,16 +84,10 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
     otherwise), and a wait at step N gets the label of the state it holds plus |p|_1 (waits
     are left out of the search, being never better). The path and costs are the same either way.
     """
-    N, m, n, start, goal = check_search_inputs(dr, start, goal)
-    free = np.asarray(dr) == 0
-    reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
-              REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
-    if reason is not None and not with_witness:
-        return SearchResult.no_path(reason)
-    _check_size(N, m, n)
-    labels = WitnessLabels(N, m, n) if with_witness else None
-    if reason == REASON_START_BLOCKED:
-        return replace(SearchResult.no_path(reason), witness=labels.witness(found=False))
+    setup, early = _prepare(dr, start, goal, with_witness)
+    if early is not None:
+        return early
+    N, m, n, start, goal, free, reason, labels = setup
     keys, dag_pred = _dag_phase(free, start, labels)
     found = _static_phase(free[N], keys, goal, labels)
     if found is None:

@@ -1,9 +1,14 @@
-"""Hypothesis strategies for random D_R arrays, shared by the search and path tests."""
+"""Hypothesis strategies shared by the tests: random D_R arrays (search and path tests) and random
+workcells with coarse grids (the BuiltDR kernels' agreement tests)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from hypothesis import strategies as st
+
+from cfmpa.spec import Scenario, joint_points, parse_scenario
 
 Cell = tuple[int, int]
 
@@ -26,3 +31,33 @@ def random_dr(draw: st.DrawFn, *, max_n: int, max_side: int, density: st.SearchS
         dr[0][start] = 0
         dr[N][goal] = 0
     return dr, start, goal
+
+
+@st.composite
+def random_workcells(draw: st.DrawFn, *, dts: tuple[float, ...]) -> Scenario:
+    """Random workcells with coarse grids (a time step drawn from ``dts``): bases, links, widths,
+    speeds, start and goal all vary; the right base is near enough for the arms to meet."""
+    dt = draw(st.sampled_from(dts))
+    f = st.floats
+
+    def arm(base):
+        return {"base": base,
+                "links": [draw(f(0.05, 0.5)), draw(f(0.05, 0.5))],
+                "width": draw(f(0.005, 0.15)),
+                "omega": [draw(f(1.2, 3.0)), draw(f(1.2, 3.0))]}
+
+    left = arm([draw(f(-0.2, 0.2)), draw(f(-0.2, 0.2))])
+    start = [draw(f(-3.2, 3.2)), draw(f(-3.2, 3.2))]
+    left["start"] = start
+    left["goal"] = [start[q] + draw(f(-1.5, 1.5)) for q in range(2)]
+    right = arm([draw(f(0.0, 0.9)), draw(f(-0.4, 0.4))])
+    limits = []
+    for q in range(2):
+        lo = draw(f(-math.pi, 0.0))
+        limits.append([lo, lo + draw(f(0.5, 2 * math.pi))])
+    right["limits"] = limits
+    size = [joint_points(limits[q][0], limits[q][1], right["omega"][q], dt) for q in range(2)]
+    right["start_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
+    right["goal_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
+    return parse_scenario({"name": "random", "purpose": "hypothesis", "dt": dt, "left": left,
+                           "right": right}, check_budget=False)

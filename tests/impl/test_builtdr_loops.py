@@ -3,7 +3,6 @@ and build_dr_fast's D_R bit for bit: random small workcells and the bundled scen
 
 from __future__ import annotations
 
-import math
 import tomllib
 from pathlib import Path
 
@@ -12,8 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from dr_strategies import random_workcells
 from cfmpa.impl import build_dr, build_dr_fast, build_dr_loops, builtdr_loop_nest, right_regions
-from cfmpa.spec import Variant, joint_points, make_grid, parse_scenario
+from cfmpa.spec import Variant, make_grid, parse_scenario
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 
@@ -45,32 +45,9 @@ def test_bit_identical_on_bundled_scenarios_at_a_coarse_dt(path, variant):
     assert 0 < dr.mean() < 1                          # both decisions occur
 
 
-@st.composite
-def random_scenarios(draw):
-    """Random workcells with small grids (dt 0.25 .. 0.5): bases, links, widths, speeds, start
-    and goal vary; the right base is near enough for the arms to meet."""
-    dt = draw(st.sampled_from([0.25, 0.3, 0.4, 0.5]))
-    f = st.floats
-
-    def arm(base):
-        return {"base": base, "links": [draw(f(0.05, 0.5)), draw(f(0.05, 0.5))],
-                "width": draw(f(0.005, 0.15)), "omega": [draw(f(1.2, 3.0)), draw(f(1.2, 3.0))]}
-
-    left = arm([draw(f(-0.2, 0.2)), draw(f(-0.2, 0.2))])
-    start = [draw(f(-3.2, 3.2)), draw(f(-3.2, 3.2))]
-    left["start"] = start
-    left["goal"] = [start[q] + draw(f(-1.5, 1.5)) for q in range(2)]
-    right = arm([draw(f(0.0, 0.9)), draw(f(-0.4, 0.4))])
-    limits = []
-    for q in range(2):
-        lo = draw(f(-math.pi, 0.0))
-        limits.append([lo, lo + draw(f(0.5, 2 * math.pi))])
-    right["limits"] = limits
-    size = [joint_points(limits[q][0], limits[q][1], right["omega"][q], dt) for q in range(2)]
-    right["start_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
-    right["goal_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
-    return parse_scenario({"name": "random", "purpose": "hypothesis", "dt": dt, "left": left,
-                           "right": right}, check_budget=False)
+def random_scenarios():
+    """Small random workcells (dt 0.25 .. 0.5), so that the Python loop nest stays quick."""
+    return random_workcells(dts=(0.25, 0.3, 0.4, 0.5))
 
 
 @settings(max_examples=25, deadline=None)

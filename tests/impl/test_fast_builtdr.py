@@ -14,9 +14,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import factory
+from dr_strategies import random_workcells
 from cfmpa.impl import _fast_builtdr, _progress, build_dr, right_regions
 from cfmpa.impl._fast_builtdr import build_dr_fast
-from cfmpa.spec import Variant, joint_points, load_scenario, make_grid, parse_scenario
+from cfmpa.spec import Variant, load_scenario, make_grid, parse_scenario
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 SMALL = [p for p in SCENARIOS if p.stem != "default"]
@@ -80,34 +81,9 @@ def test_kernel_decides_default_pairs_itself(monkeypatch):
     assert calls == []
 
 
-@st.composite
-def random_scenarios(draw):
-    """Random workcells with coarse grids (m, n <= ~40, N <= ~15): bases, links, widths, speeds,
-    start and goal all vary; the right base is near enough for the arms to meet."""
-    dt = draw(st.sampled_from([0.1, 0.125, 0.2, 0.25]))
-    f = st.floats
-
-    def arm(base):
-        return {"base": base,
-                "links": [draw(f(0.05, 0.5)), draw(f(0.05, 0.5))],
-                "width": draw(f(0.005, 0.15)),
-                "omega": [draw(f(1.2, 3.0)), draw(f(1.2, 3.0))]}
-
-    left = arm([draw(f(-0.2, 0.2)), draw(f(-0.2, 0.2))])
-    start = [draw(f(-3.2, 3.2)), draw(f(-3.2, 3.2))]
-    left["start"] = start
-    left["goal"] = [start[q] + draw(f(-1.5, 1.5)) for q in range(2)]
-    right = arm([draw(f(0.0, 0.9)), draw(f(-0.4, 0.4))])
-    limits = []
-    for q in range(2):
-        lo = draw(f(-math.pi, 0.0))
-        limits.append([lo, lo + draw(f(0.5, 2 * math.pi))])
-    right["limits"] = limits
-    size = [joint_points(limits[q][0], limits[q][1], right["omega"][q], dt) for q in range(2)]
-    right["start_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
-    right["goal_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
-    return parse_scenario({"name": "random", "purpose": "hypothesis", "dt": dt, "left": left,
-                           "right": right}, check_budget=False)
+def random_scenarios():
+    """Coarse random workcells (m, n <= ~40, N <= ~15)."""
+    return random_workcells(dts=(0.1, 0.125, 0.2, 0.25))
 
 
 @settings(max_examples=40, deadline=None)
