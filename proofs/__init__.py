@@ -39,9 +39,7 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
     ``out_dir/results.json``; 0 iff every verdict is the pinned one and no id is missing, extra
     or repeated, 1 otherwise. Raises InputError (exit 2) for a ``--scenarios`` that is not a
     folder, a folder other than the bundled one with no scenario file, or an ``--only``
-    pattern that selects no expected obligation.
-    ``repin`` (``--repin``): rewrite proofs/obligations.lock with the statements of the
-    obligations run and print what changed (``_pins``), instead of failing on a change."""
+    pattern that selects no expected obligation."""
     picks = None if only is None else list(only)
     sdir = BUNDLED_DIR if scenarios_dir is None else Path(scenarios_dir)
     if not sdir.is_dir():

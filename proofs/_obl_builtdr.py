@@ -187,9 +187,7 @@ def builtdr_obligations() -> list[Obligation]:
                      "nesting (Thm3.box_nesting) and the per-scenario containment check "
                      "(Scenario.*.containment).")
         out.append(Obligation(f"{ident}.builtdr{suffix}", GROUP, ref, statement, Z, P,
-                              lambda v=variant: _query(v, "correctness"),
-                              label="" if variant == "original"
-                              else "Thm1.builtdr's proof, another region function"))
+                              lambda v=variant: _query(v, "correctness")))
         out.append(Obligation(f"{ident}.termination{suffix}", GROUP, ref, term, Z, P,
                               lambda v=variant: _query(v, "termination"), label="syntactic"))
     out.append(Obligation(

@@ -297,22 +297,19 @@ def path_obligations() -> list[Obligation]:
                    "Under Theorem 1's postcondition, P[k,i,j] = 0 implies SLarm_k ∩ SRarm_ij = Φ "
                    "(no common point) and P[k,i,j] = 1 implies a common point.", Z, P, _prop1),
         Obligation("Prop2.endpoints", G, "Property 2",
-                   "is_path(L) implies L_0 = startp and L_{LENGTH(L)-1} = goalp.", Z, P, _prop2,
-                   label="by is_path's definition (propositional)"),
+                   "is_path(L) implies L_0 = startp and L_{LENGTH(L)-1} = goalp.", Z, P, _prop2),
         Obligation("Prop3.layer_free", G, "Property 3",
                    "is_path(L), k < N and the cell held at step k is (i, j) imply P[k,i,j] = 0 "
                    "(L_k read as the cell held at step k: the goal once the list has ended).",
-                   Z, P, lambda: _prop34(False), label="an instance of is_path's step clause"),
+                   Z, P, lambda: _prop34(False)),
         Obligation("Prop4.rest_free", G, "Property 4",
                    "is_path(L), k >= N and the cell held at step k is (i, j) imply P[N,i,j] = 0 "
                    "(rest layer) and, where R is layer N-1 (original, modified), P[N-1,i,j] = 0; "
-                   "for every k >= N, not only k < LENGTH(L).", Z, P, lambda: _prop34(True),
-                   label="an instance of is_path's step clause"),
+                   "for every k >= N, not only k < LENGTH(L).", Z, P, lambda: _prop34(True)),
         Obligation("Prop5.optpath_is_path", G, "Property 5",
                    "If some path exists, optpath(startp, goalp) is a path: from Hilbert choice "
                    "(instance at the optimum named) and the well-foundedness of (J1, J2) on N x N "
-                   "(an optimum exists once a path does; assumed, see the ledger).", Z, P, _prop5,
-                   label="from the assumed instances of A7 (propositional)"),
+                   "(an optimum exists once a path does; assumed, see the ledger).", Z, P, _prop5),
         Obligation("Prop5.printed", G, "Property 5 as printed",
                    "For all startp, goalp, optpath(startp, goalp) is a path: refuted when no path "
                    "exists (start blocked at step 0): Hilbert choice then picks a non-path. "
@@ -323,13 +320,12 @@ def path_obligations() -> list[Obligation]:
                    Z, R, _prop5_printed),
         Obligation("Prop6.opt_layer_free", G, "Property 6",
                    "optpath = O (a path existing), k < N and O holds (i, j) at step k imply "
-                   "P[k,i,j] = 0.", Z, P, lambda: _prop67(False),
-                   label="an instance of is_path's step clause"),
+                   "P[k,i,j] = 0.", Z, P, lambda: _prop67(False)),
         Obligation("Prop7.opt_rest_free", G, "Property 7",
                    "optpath = O (a path existing), k >= N and O holds (i, j) at step k imply "
                    "P[N,i,j] = 0 (the rest layer) and, where R is layer N-1 (original, "
                    "modified: P[N] = P[N-1] on every cell), P[N-1,i,j] = 0.",
-                   Z, P, lambda: _prop67(True), label="an instance of is_path's step clause"),
+                   Z, P, lambda: _prop67(True)),
         Obligation("Def4.is_path_printed", G, "Definition 4 as printed",
                    "Definition 4 as printed keeps the subordinate safe until the principal "
                    "arrives: refuted, a list that ends early and waits at a goal blocked in a "

@@ -271,27 +271,12 @@ class Proof:
 # --- discharging --------------------------------------------------------------------------------
 
 def discharge(ob: Obligation) -> Proof:
-    """Run one obligation to a verdict (cvc5's replay included, waited for, skipping the
-    statements the lock records cvc5 could not decide); any exception is a FAILED verdict that
-    says why. The cvc5 worker is shared by the calls of a process."""
-    from ._pins import cvc5_skips, load_lock
+    """Run one obligation to a verdict (cvc5's replay included, waited for); any exception is
+    a FAILED verdict that says why."""
+    from ._cvc5 import Cvc5Pool
 
-    return discharge_pending(ob, _shared_pool(), cvc5_skips(load_lock())).settle()
-
-
-_POOL: list[Any] = []
-
-
-def _shared_pool() -> Any:
-    """One cvc5 pool for the process (started on first use, closed at exit)."""
-    if not _POOL:
-        import atexit
-
-        from ._cvc5 import Cvc5Pool
-
-        _POOL.append(Cvc5Pool())
-        atexit.register(_POOL[0].close)
-    return _POOL[0]
+    with Cvc5Pool() as pool:
+        return discharge_pending(ob, pool).settle()
 
 
 #: Per smoke-test check (with the pins, the ground abstraction, without the pins).
