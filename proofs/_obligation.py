@@ -27,7 +27,7 @@ import signal
 import threading
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -398,10 +398,35 @@ def standard_smtlib(vc: VC) -> tuple[str | None, str, str]:
                 f"no standard SMT-LIB rendering ({exc})")
 
 
-def _solver(timeout_ms: int, ctx: z3.Context | None = None) -> z3.Solver:
+def _solver(timeout_ms: int, ctx: z3.Context | None = None,
+            formulas: Sequence[z3.BoolRef] = ()) -> z3.Solver:
+    """A solver with a timeout; given ``formulas``, in a context of its own holding them, rebuilt
+    from their SMT-LIB text.
+
+    Z3's search on quantified VCs depends on the order of the terms it holds: a VC proved in
+    0.1 s ran out of its 20 s once a vacuity check had run in the same context, or after other
+    proofs in the process. Rebuilt from text in a new context, a check's answer depends on its
+    statement alone, wherever and whenever it runs.
+    """
+    if formulas:
+        ctx = z3.Context()
+        text = _text_of(formulas)
+        parsed = list(z3.parse_smt2_string(text, ctx=ctx))
+        if len(parsed) != len(formulas):
+            raise AssertionError(f"re-read {len(parsed)} assertions of {len(formulas)}")
     s = z3.Solver(ctx=ctx)
     s.set("timeout", timeout_ms)
+    if formulas:
+        s.add(parsed)
     return s
+
+
+def _text_of(formulas: Sequence[z3.BoolRef]) -> str:
+    """Z3's SMT-LIB text of ``formulas`` (declarations, then one assert each, in order)."""
+    s = z3.Solver()
+    for f in formulas:
+        s.add(f)
+    return s.sexpr()
 
 
 def _stats(s: z3.Solver, into: dict[str, float]) -> None:
@@ -507,14 +532,9 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
     refuted: list[tuple[str, str]] = []
     want = "sat" if ob.expected is Verdict.REFUTED_AS_EXPECTED else "unsat"
     for vc in q.vcs:
-        # Each check runs in a fresh Z3 context, so its answer does not depend on what ran
-        # before it in this process (the run order, or a selection with ``only``).
-        ctx = z3.Context()
-        hyps = [h.translate(ctx) for _, h in vc.hypotheses]
+        hyps = [h for _, h in vc.hypotheses]
         # Vacuity: the hypotheses (with the optional witness pinned) must have a model.
-        s = _solver(ob.timeout_ms, ctx)
-        s.add(hyps)
-        s.add([c.translate(ctx) == v.translate(ctx) for c, v in vc.witness])
+        s = _solver(ob.timeout_ms, formulas=hyps + [c == v for c, v in vc.witness])
         vac = s.check()
         _stats(s, stats)
         if vac == z3.unsat:
@@ -522,9 +542,7 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
         elif vac == z3.unknown:
             unknowns.append(f"{vc.name} (vacuity check): {s.reason_unknown()}")
         # The proof: hypotheses and the negated goal must have no model.
-        s = _solver(ob.timeout_ms, ctx)
-        s.add(hyps)
-        s.add(z3.Not(vc.goal.translate(ctx)))
+        s = _solver(ob.timeout_ms, formulas=hyps + [z3.Not(vc.goal)])
         ans = s.check()
         _stats(s, stats)
         if ans == z3.sat:
@@ -542,7 +560,7 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
                          std.replace("(exit)\n", "(reset)\n")]
         depth = None
         if ans == z3.unsat and ob.expected is Verdict.PROVED:
-            depth = vc_depth([h for _, h in vc.hypotheses], vc.goal, ctx=ctx)
+            depth = vc_depth(hyps, vc.goal)
         replay = std is not None and ans != z3.unknown and sha not in skip
         futures.append(pool.submit(std) if replay else None)
         certs.append(vc if vc.certificate is not None else None)
@@ -553,9 +571,7 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
         results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
                                 cvc5=cvc5, cvc5_reason=why,
                                 solvers=("z3",) if str(ans) == want else (), note=note))
-    # One context for the smoke tests of an obligation (each has its own solver).
-    sctx = z3.Context() if q.smoke else None
-    smoke = [_smoke(sm, stats, sctx) for sm in q.smoke]
+    smoke = [_smoke(sm, stats) for sm in q.smoke]      # each in a context of its own
     dead = [r.name for r in smoke if r.answer == "unsat"]
     undecided = [r.name for r in smoke if r.answer == "unknown"]
     cex = "\n".join(f"[{name}]\n{text}" if len(q.vcs) > 1 else text for name, text in refuted)

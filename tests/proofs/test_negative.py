@@ -11,6 +11,7 @@ from __future__ import annotations
 import pytest
 import z3
 
+from z3answer import answer
 from cfmpa.proofs import Method, Verdict, collect_obligations, discharge
 from cfmpa.proofs._obl_builtdr import _query as builtdr_query
 from cfmpa.proofs._obligation import VC, Obligation
@@ -29,22 +30,9 @@ SYNTACTIC = {(ident, f"BuiltDR.{v}.main") for ident, v in (
 
 
 def _answer(vc: VC, goal: z3.BoolRef | None = None) -> z3.CheckSatResult:
-    # Quantified queries: Z3 may give up (unknown) on one search path and find the model on
-    # another, so an unknown is retried under other seeds; only sat passes a negative test.
-    answer = z3.unknown
-    for seed in range(3):
-        ctx = z3.Context()
-        s = z3.Solver(ctx=ctx)
-        s.set("timeout", 20_000)
-        s.set("random_seed", seed)
-        s.add([h.translate(ctx) for _, h in vc.hypotheses])
-        s.add(z3.Not((vc.goal if goal is None else goal).translate(ctx)))
-        # Pins under which Z3 finds the counter-model (e.g. a convex set it cannot invent).
-        s.add([c.translate(ctx) == v.translate(ctx) for c, v in vc.counter_witness])
-        answer = s.check()
-        if answer != z3.unknown:
-            return answer
-    return answer
+    # Pins under which Z3 finds the counter-model (e.g. a convex set it cannot invent).
+    return answer([h for _, h in vc.hypotheses] + [z3.Not(vc.goal if goal is None else goal)]
+                  + [c == v for c, v in vc.counter_witness])
 
 
 KEYED = [(i, vc) for i, vc in ALL_VCS if (i, vc.name) not in NO_HYPOTHESES | SYNTACTIC]

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 import z3
+from z3answer import answer
+from z3answer import answer
 from cfmpa.impl import SNAP, link_reach, sweep_margin
 from cfmpa.proofs import FIXED_IDS, collect_obligations
 from cfmpa.proofs import _obl_safety as S
@@ -25,22 +27,9 @@ IDS = [f"Safety.{v}.principal_in_layer_box" for v in S.VARIANTS] + [
 
 
 def _check(hyps, goal=None, pins=(), seeds=3, timeout=20_000) -> z3.CheckSatResult:
-    """Z3 on hyps (and not goal): an unknown is retried under other seeds (only sat or unsat
-    is an answer), as tests/proofs/test_negative.py does."""
-    answer = z3.unknown
-    for seed in range(seeds):
-        ctx = z3.Context()
-        s = z3.Solver(ctx=ctx)
-        s.set("timeout", timeout)
-        s.set("random_seed", seed)
-        s.add([h.translate(ctx) for h in hyps])
-        if goal is not None:
-            s.add(z3.Not(goal.translate(ctx)))
-        s.add([c.translate(ctx) == v.translate(ctx) for c, v in pins])
-        answer = s.check()
-        if answer != z3.unknown:
-            return answer
-    return answer
+    """Z3 on hyps (and not goal), with the pins: sat, unsat, or unknown after the seeds."""
+    return answer(list(hyps) + ([z3.Not(goal)] if goal is not None else [])
+                  + [c == v for c, v in pins], seeds=seeds, timeout_ms=timeout)
 
 
 def _hyps(vc: VC, drop: str | None = None) -> list[z3.BoolRef]:
