@@ -1,12 +1,15 @@
 """`make bench` in smoke mode (--quick): every section is written with timings, and the
-benchmark peers agree with our D_R. The structure is tested, never the speed."""
+benchmark peers agree with our D_R. The structure is tested, never the speed; the targets'
+list, limits and verdicts are tested on made-up results."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -16,15 +19,26 @@ ROOT = Path(__file__).resolve().parents[2]
 TIMING = {"median_s", "min_s", "max_s", "runs", "peak_rss_mb"}
 
 
-# Slow: the whole quick bench, cfmpa prove included (minutes); make test-slow runs it.
+def bench_module():
+    """bench/run.py as a module (it is not part of the package)."""
+    if "cfmpa_bench_run" not in sys.modules:
+        spec = importlib.util.spec_from_file_location("cfmpa_bench_run", ROOT / "bench" / "run.py")
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules["cfmpa_bench_run"] = mod      # dataclasses look their module up
+        spec.loader.exec_module(mod)
+    return sys.modules["cfmpa_bench_run"]
+
+
+# Slow: the whole quick bench, cfmpa prove --audit included (minutes); make test-slow runs it.
 @pytest.mark.slow
 def test_bench_quick_writes_results_with_every_section(tmp_path):
-    proc = subprocess.run([sys.executable, str(ROOT / "bench" / "run.py"), "--quick", "--out",
-                           str(tmp_path)], capture_output=True, text=True, cwd=ROOT)
+    proc = subprocess.run([sys.executable, str(ROOT / "bench" / "run.py"), "--quick", "--prove",
+                           "--out", str(tmp_path)], capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     res = json.loads((tmp_path / "results.json").read_text())
-    assert set(res) == {"meta", "builtdr", "search", "shapely", "scaling", "plan", "prove",
-                        "contracts", "one_degree", "monitor", "targets"}
+    assert set(res) == {"meta", "builtdr", "builtdr_profile", "search", "shapely", "scaling",
+                        "plan", "dr_cli", "check", "prove", "contracts", "one_degree", "monitor",
+                        "targets", "informational"}
     for v in Variant:
         assert set(res["builtdr"][v.value]) == {"reference", "fast", "fast_regions_given"}
         assert set(res["search"][v.value]) == {"reference", "fast"}
@@ -37,22 +51,139 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     assert res["shapely"]["vectorised_dwithin"]["info"]["disagree_with_ours"] == 0
     assert [s["dt"] for s in res["scaling"]] == [0.32, 0.16, 0.08]
     assert res["scaling"][0]["cells"] < res["scaling"][1]["cells"] < res["scaling"][2]["cells"]
-    for section in (res["plan"]["cli_sampled"], res["prove"],
-                    res["one_degree"]["plan_cli_sampled"]):
+    for section in (res["plan"]["cli_sampled"], res["plan"]["cli_full"], res["prove"],
+                    res["one_degree"]["plan_cli_sampled"], res["dr_cli"], res["check"]):
         assert "error" not in section, section
         assert "skipped" in section or TIMING <= set(section)
+    # --prove: make prove timed once, and its obligations alone from its results.json.
+    assert res["prove"]["runs"] == 1 and res["prove"]["obligations_s"] > 0
+    assert res["plan"]["cli_default_contracts"] in ("off", "sampled", "full")
+    assert res["check"]["plan_contracts"] == res["plan"]["cli_default_contracts"]
     c = res["contracts"]
     for mode in ("off", "sampled", "full"):
         assert TIMING <= set(c["in_process"][mode])
         assert c["in_process"][mode]["info"]["contracts"] == mode
         assert c["in_process"][mode]["info"]["violations"] == 0
     assert c["ratios"]["full_over_off"] > 0 and c["ratios"]["sampled_over_off"] > 0
-    assert set(c["cli"]) == {"off", "sampled"} and "error" not in str(c["cli"])
+    assert set(c["cli"]) == {"off", "sampled", "full"} and "error" not in str(c["cli"])
+    # The profile splits the very computation timed as BuiltDR fast.
+    prof = res["builtdr_profile"]
+    for v in Variant:
+        p = prof[v.value]
+        assert p["same_as_build_dr_fast"] is True
+        stages = p["stages_median_s"]
+        assert set(stages) == set(prof["stages"]) | {"total"}
+        assert all(x >= 0 for x in stages.values())
+        assert sum(x for k, x in stages.items() if k != "total") <= stages["total"] * 1.01
     assert TIMING <= set(res["one_degree"]["plan_fast_in_process_sampled"])
     m = res["monitor"]
     assert "error" not in m, m
     if "skipped" not in m:
         for key in ("log", "log_tenth"):
             assert {"samples", "samples_per_s", "peak_rss_mb", "status"} <= set(m[key])
-    assert all({"target", "limit", "measured", "met"} <= set(t) for t in res["targets"])
-    assert "targets:" in proc.stdout and "results.json" in proc.stdout
+    rows = res["targets"] + res["informational"]
+    assert all({"target", "limit", "measured", "met", "note", "cmp"} <= set(t) for t in rows)
+    assert [t["limit"] for t in res["targets"]] == LIMITS
+    assert all(t["measured"] is not None for t in res["targets"]), res["targets"]
+    assert all(t["former_target"] for t in res["informational"])
+    assert "targets (" in proc.stdout and "informational (" in proc.stdout
+    assert "BuiltDR fast profile" in proc.stdout and "results.json" in proc.stdout
+
+
+#: The open issues' targets, in the table's order: issue 13 (check s, check MiB, full/off,
+#: BuiltDR s, peer/dr, plan s), issue 17 (monitor samples/s, its peak growth), issues 12/14
+#: (make prove s, obligations alone s).
+LIMITS = [5.0, 1024.0, 5.0, 0.15, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0]
+
+
+def made_up(default_mode: str = "full") -> dict[str, Any]:
+    """Results with every field targets() and informational() read; numbers chosen so that some
+    targets are met and some missed."""
+    run = bench_module()
+
+    def t(s: float, **kw: Any) -> dict[str, Any]:
+        return {"median_s": s, "min_s": s, "max_s": s, "runs": 1, "peak_rss_mb": 300.0, **kw}
+    stages = dict.fromkeys(run.PROFILE_STAGES, 0.01) | {"right_regions": 0.19, "total": 0.5}
+    return {
+        "builtdr": {v: {"fast": t(x)} for v, x in zip(run.VARIANTS, (0.5, 0.55, 0.45))},
+        "builtdr_profile": {v: {"stages_median_s": stages, "kernel_threads": 1,
+                                "unsure_pairs": 0, "same_as_build_dr_fast": True,
+                                "build_dr_fast_median_s": 0.5} for v in run.VARIANTS},
+        "search": {v: {"fast": t(0.1)} for v in run.VARIANTS},
+        "shapely": {"vectorised_intersects": t(4.0),
+                    "vectorised_dwithin": {"extrapolated_full_grid_s": 2.0},
+                    "ratios": {"loop_over_ours": 2000.0, "intersects_over_ours": 10.3}},
+        "plan": {"cli_sampled": t(3.0), "cli_default_contracts": default_mode},
+        "contracts": {"in_process": {"off": t(1.0), "sampled": t(1.5), "full": t(2.5)},
+                      "ratios": {"full_over_off": 2.5},
+                      "cli": {"off": t(1.7), "sampled": t(3.0),
+                              "full": t(4.5, timings_s={"build_dr": 0.6, "search": 0.6})}},
+        "dr_cli": t(2.0, variant="modified"),
+        "check": t(3.3, peak_rss_mb=1500.0, plan_contracts=default_mode),
+        "prove": t(90.0, obligations_s=70.0, ok=True, obligations=80),
+        "one_degree": {"plan_cli_sampled": t(5.0)},
+        "monitor": {"log": {"samples": 10**6, "bytes": 96 * 10**6, "cli": t(4.0),
+                            "cli_samples_per_s": 250_000.0, "samples_per_s": 300_000.0,
+                            "peak_rss_mb": 120.0, "status": "inside"},
+                    "log_tenth": {"peak_rss_mb": 118.0}, "peak_growth_mb": 2.0},
+    }
+
+
+def test_targets_are_the_issues_with_their_limits_and_verdicts():
+    run = bench_module()
+    cfg = run.Config.of(False, None)
+    rows = run.targets(made_up("full"), cfg)
+    assert [r["limit"] for r in rows] == LIMITS
+    assert [r["cmp"] for r in rows] == ["<=", "<=", "<=", "<=", ">=", "<=", ">=", "<=", "<=",
+                                        "<="]
+    assert [r["measured"] for r in rows] == [3.3, 1500.0, 2.5, 0.55, 2.0, 4.5, 250_000.0, 2.0,
+                                             90.0, 70.0]
+    assert [r["met"] for r in rows] == [True, False, True, False, False, False, True, True, True,
+                                        False]
+    assert "issue 13" in rows[0]["target"] and "issue 17" in rows[6]["target"]
+    assert "make prove" in rows[8]["target"]
+    # The BuiltDR miss is explained by the profile; the slowest variant is the one measured.
+    assert "modified" in rows[3]["note"] and "right regions 0.190 s" in rows[3]["note"]
+    # The monitor row reports wall time and peak memory of the whole process.
+    assert rows[6]["wall_s"] == 4.0 and rows[6]["peak_rss_mb"] == 120.0
+    assert all("quick run" not in r["note"] for r in rows)
+    lines = run.target_lines(rows)
+    assert sum(" MISSED" in line for line in lines) == 5
+
+
+def test_plan_target_follows_the_cli_default_contract_mode():
+    run = bench_module()
+    cfg = run.Config.of(False, None)
+    full = run.targets(made_up("full"), cfg)[5]
+    sampled = run.targets(made_up("sampled"), cfg)[5]
+    assert "--contracts full" in full["target"] and full["measured"] == 4.5
+    assert "--contracts sampled" in sampled["target"] and sampled["measured"] == 3.0
+    assert "build_dr 0.60" in full["note"]      # the miss with plan.json's stages
+
+
+def test_unmeasured_targets_are_not_applicable():
+    run = bench_module()
+    res = made_up()
+    res["prove"] = run.skipped("--prove not given (`make bench` passes it)")
+    res["dr_cli"] = {"error": "exit 2: boom", "argv": ["dr"]}
+    rows = {r["target"]: r for r in run.targets(res, run.Config.of(False, None))}
+    for name in ("issues 12/14: make prove, whole process (s)",
+                 "issue 12: make prove, obligations alone (s)",
+                 "issue 13: shapely-vectorised peer / cfmpa dr (x)"):
+        assert rows[name]["measured"] is None and rows[name]["met"] is None
+        assert rows[name]["note"].startswith("not measured")
+
+
+def test_cli_default_contracts_is_the_parsers():
+    from cfmpa.cli import _parser
+
+    default = _parser().parse_args(["plan", "default", "--out", "x"]).contracts
+    assert bench_module().cli_default_contracts() == default
+
+
+def test_informational_rows_are_former_targets_only():
+    run = bench_module()
+    rows = run.informational(made_up(), run.Config.of(False, None))
+    names = {r["target"] for r in rows}
+    assert all(r["former_target"] for r in rows)
+    assert not names & {r["target"] for r in run.targets(made_up(), run.Config.of(False, None))}
