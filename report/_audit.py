@@ -2,8 +2,10 @@
 
 Content, in order (docs/model.md §8): provenance; the obligations' summary table and each obligation;
 the assumptions ledger; the findings about the paper, drawn; the mutation self-check; per
-scenario the plans of the three variants with contracts, certificate and pictures; the seeded
-comparison campaign. Where a part's data is not available in this run, the part says so.
+scenario the plans of the three variants with contracts, certificate, each found plan's
+tolerance tube (docs/model.md §12) and pictures; one monitored simulated run of the default
+workcell's modified plan, with and without an injected excursion; the seeded comparison
+campaign. Where a part's data is not available in this run, the part says so.
 
 report.json holds every number of the HTML (not the pictures). For the same inputs and version
 it is the same apart from the provenance (date, git state, command line), the times (keys
@@ -15,6 +17,8 @@ given, else a fresh run).
 from __future__ import annotations
 
 import dataclasses
+import io
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -22,12 +26,14 @@ from pathlib import Path
 from typing import Any
 
 import jinja2
+import numpy as np
 
 from ..files import dumps_json, jsonable, write_bytes_atomic
 from ..errors import CfmpaError, InputError
 from ..scenarios import BUNDLED_DIR
 from ..impl import left_regions
-from ..spec import Scenario, SearchStatus, Variant, load_scenario
+from ..spec import (Scenario, SearchStatus, Variant, certify_trajectory, executed_trajectory,
+                    load_scenario, tolerance_rad, tube_lipschitz)
 from . import _figures as F
 from ._compare import campaign_json, format_campaign, run_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
@@ -36,16 +42,27 @@ from ._obligations import ProofData, load_proofs, load_selftest, summary_table
 from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
-           "render_html", "run_audit", "write_report", "default_scenarios_dir"]
+           "render_html", "run_audit", "write_report", "default_scenarios_dir",
+           "MONITOR_SCENARIO", "MONITOR_SIMULATION", "MONITOR_EXCURSION", "tube_problems",
+           "monitor_problems"]
 
 #: report.json's format name and version (bump the version when a key changes meaning).
 FORMAT = {"name": "cfmpa-audit-report", "version": 1}
 DEFAULT_COMPARE_N = 100
 #: plan.json keys a variant's entry copies when the plan has them (the schema allows them).
-_OPTIONAL_PLAN_KEYS = ("kernel", "dr_sha256")
+_OPTIONAL_PLAN_KEYS = ("kernel", "dr_sha256", "tolerance_rad")
 #: The scenarios the findings are shown on (file stems under the scenarios folder).
 FINDING_SCENARIOS = {"naive_hull": "default", "inconsistency": "original-fails",
                      "prop8_literal": "original-fails", "is_path_flaw": "early-arrival"}
+#: The monitored run (docs/model.md §8, §12): the modified plan of this scenario (a file stem
+#: under the scenarios folder), logged by the tracking model of `cfmpa simulate` with these
+#: settings, then again with the excursion added (the README's example).
+MONITOR_SCENARIO = "default"
+MONITOR_SIMULATION = {"lag_s": 0.001, "noise_rad": 0.002, "seed": 0, "period_s": 0.001,
+                      "tail_s": 0.2}
+MONITOR_EXCURSION = {"t_s": 0.6, "joint": "right1", "rad": 0.02, "duration_s": 0.05}
+#: cfmpa certify's proved bound on traj.csv agrees with the plan's to within this (m).
+BOUND_AGREEMENT_M = 1e-12
 
 
 @dataclass(frozen=True)
@@ -63,7 +80,7 @@ def default_scenarios_dir() -> Path:
 
 def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | None = None,
               proofs_json: str | None = None, scenarios_dir: str | None = None,
-              contracts: str = "sampled", compare_n: int = DEFAULT_COMPARE_N,
+              contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
               compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> int:
     """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
 
@@ -95,7 +112,7 @@ def write_report(result: AuditResult, out_dir: str | Path) -> tuple[Path, Path]:
 
 def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None = None,
                 proofs_json: str | None = None, scenarios_dir: str | None = None,
-                contracts: str = "sampled", compare_n: int = DEFAULT_COMPARE_N,
+                contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
                 compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> AuditResult:
     """Compute everything the report shows (no files written)."""
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
@@ -123,6 +140,7 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
         "findings": _findings(sdir, loaded, plans, figures),
         "selftest": load_selftest(),
         "scenarios": [_scenario_entry(s, plans, figures) for s in loaded],
+        "monitor": _monitor(sdir, loaded, plans, figures),
         "compare": _compare(compare_n, compare_seed, figures),
     }
     _relate(doc["findings"], proofs)
@@ -264,11 +282,13 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
         "parameters": {"dt": s.dt, "left": _arm_json(s.left), "right": _arm_json(s.right)},
         "grid": None if grid is None else {
             **grid, "cells": (grid["N"] + 1) * grid["m"] * grid["n"]},
-        "variants": variants, "contract_checks": checks, "figures": [],
+        "variants": variants, "contract_checks": checks, "figures": [], "tube": None,
     }
     if any_plan is None:
         return entry
-    entry["figures"] = _scenario_figures(s, ok, figures)
+    series = _clearance_series(s, ok)
+    entry["figures"] = _scenario_figures(s, ok, figures, series)
+    entry["tube"] = _tube_entry(s, ok, figures, series)
     return entry
 
 
@@ -340,8 +360,26 @@ def _primary(ok: dict[Variant, Any]) -> Variant:
     return Variant.MODIFIED if Variant.MODIFIED in ok else next(iter(ok))
 
 
-def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.Figure]
-                      ) -> list[dict[str, str]]:
+def _clearance_series(s: Scenario, ok: dict[Variant, Any]
+                      ) -> dict[Variant, tuple[Any, Any]]:
+    """The sampled clearance (t, d) along each found plan's executed motion (a picture)."""
+    return {v: sample_clearance(s, p.grid, p.search.path) for v, p in ok.items()
+            if p.search.status is SearchStatus.FOUND}
+
+
+def _same_paths(ok: dict[Variant, Any], found: Sequence[Variant]) -> dict[Variant, Variant]:
+    """Each found variant whose path equals an earlier one's, mapped to that earlier one."""
+    same: dict[Variant, Variant] = {}
+    for k, v in enumerate(found):
+        for u in found[:k]:
+            if u not in same and ok[u].search.path == ok[v].search.path:
+                same[v] = u
+                break
+    return same
+
+
+def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.Figure],
+                      clearance: Mapping[Variant, tuple[Any, Any]]) -> list[dict[str, str]]:
     slug = _anchor(s.name)
     v0 = _primary(ok)
     p0 = ok[v0]
@@ -356,15 +394,13 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
     made.append(F.variants_figure(
         f"fig-{slug}-variants", s, g, {v: p.dr for v, p in ok.items()},
         {v: left_regions(s, v, g).links[layer] for v in ok}, layer))
-    series, minima, same, bounds = {}, {}, {}, {}
+    series, minima, bounds = {}, {}, {}
+    # Identical paths are drawn once, and said so.
+    same = _same_paths(ok, list(clearance))
     for v, p in ok.items():
         if p.search.status is not SearchStatus.FOUND:
             continue
-        for u in series:                       # identical paths are drawn once, and said so
-            if ok[u].search.path == p.search.path:
-                same[v] = u
-                break
-        series[v] = sample_clearance(s, g, p.search.path)
+        series[v] = clearance[v]
         if p.certificate is not None:
             minima[v] = (p.certificate.t_min_s, p.certificate.min_clearance_m)
             # The proved figure is a bound only when every interval was proved clear.
@@ -381,6 +417,179 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
 
 def _arm_json(arm: Any) -> dict[str, Any]:
     return jsonable(dataclasses.asdict(arm))
+
+
+# --- the tolerance tube (docs/model.md §12) ------------------------------------------------------
+
+#: The keys of `cfmpa certify`'s JSON a tube entry keeps (runs.certify_json).
+_CERTIFY_KEYS = ("clear", "lower_bound_m", "min_m", "t_s", "tolerance_rad", "intervals")
+
+
+def _tube_entry(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.Figure],
+                clearance: Mapping[Variant, tuple[Any, Any]]) -> dict[str, Any] | None:
+    """Per found plan: its tolerance_rad (plan.json's), the proved clearance c, the tube's margin
+    2 L delta, and `cfmpa certify` on its executed motion (traj.csv) for comparison; a figure."""
+    from ..runs import certify_json, plan_json
+
+    found = [v for v in clearance if ok[v].certificate is not None]
+    if not found:
+        return None
+    lip = tube_lipschitz(s)
+    plans, panels = [], []
+    same = _same_paths(ok, found)
+    for v in found:
+        p = ok[v]
+        cert = p.certificate
+        tol = plan_json(p)["tolerance_rad"]
+        # What `cfmpa certify SCENARIO --traj DIR/traj.csv` computes on the plan's traj.csv
+        # (written with 17 digits, so it reads back as these doubles).
+        traj = executed_trajectory(s, p.grid, p.search.path)
+        again = certify_json(s, traj, certify_trajectory(s, traj))
+        plans.append({"variant": v.value, "clear": cert.clear,
+                      "lower_bound_m": cert.lower_bound_m, "min_m": cert.min_clearance_m,
+                      "t_s": cert.t_min_s, "tolerance_rad": tol, "margin_m": 2.0 * lip * tol,
+                      "same_path_as": same[v].value if v in same else None,
+                      "certify": {"rows": traj.rows,
+                                  **{k: again[k] for k in _CERTIFY_KEYS}}})
+        if v in same:
+            continue
+        names = " = ".join(u.value for u in [v, *(u for u in found if same.get(u) is v)])
+        t, d = clearance[v]
+        panels.append(F.TubePanel(names, t, d, cert.clear, cert.lower_bound_m, tol,
+                                  2.0 * lip * tol, cert.t_min_s, cert.min_clearance_m))
+    fig = F.tube_figure(f"fig-{_anchor(s.name)}-tube", s, panels)
+    figures[fig.id] = fig
+    return {"lipschitz_m_per_rad": lip, "plans": plans,
+            "figure": {"id": fig.id, "caption": fig.caption}}
+
+
+def tube_problems(doc: Mapping[str, Any]) -> list[str]:
+    """What disagrees in report.json's tubes: per found plan, plan.json's tolerance_rad against
+    the tube's and `cfmpa certify`'s, the proved bound against certify's, the margin against
+    2 L delta, and the tolerance lemma's premise c > 2 L delta (a plan not clear: delta = 0)."""
+    out = []
+    for s in doc["scenarios"]:
+        tube = s.get("tube") or {"plans": [], "lipschitz_m_per_rad": None}
+        by_variant = {pl["variant"]: pl for pl in tube["plans"]}
+        for v in s["variants"]:
+            if v["status"] != "found":
+                continue
+            name = f"{s['name']}/{v['variant']}"
+            pl = by_variant.get(v["variant"])
+            if pl is None:
+                out.append(f"{name}: no tube entry")
+                continue
+            tol, c, cert = pl["tolerance_rad"], pl["lower_bound_m"], pl["certify"]
+            if v.get("tolerance_rad") != tol:
+                out.append(f"{name}: plan.json's tolerance_rad {v.get('tolerance_rad')!r}, "
+                           f"the tube's {tol!r}")
+            if cert["tolerance_rad"] != tol:
+                out.append(f"{name}: cfmpa certify gives tolerance_rad {cert['tolerance_rad']!r}, "
+                           f"the plan {tol!r}")
+            if v["clearance"] is None or v["clearance"]["lower_bound_m"] != c:
+                out.append(f"{name}: the tube's proved bound {c!r} is not the plan's")
+            if cert["clear"] != pl["clear"] or abs(cert["lower_bound_m"] - c) > BOUND_AGREEMENT_M:
+                out.append(f"{name}: cfmpa certify proves {cert['lower_bound_m']!r} m "
+                           f"(clear: {cert['clear']}), the plan {c!r} m (clear: {pl['clear']})")
+            lip = tube["lipschitz_m_per_rad"]
+            if lip is None or not math.isclose(pl["margin_m"], 2.0 * lip * tol, rel_tol=1e-12,
+                                               abs_tol=0.0):
+                out.append(f"{name}: margin {pl['margin_m']!r} m is not 2 L delta")
+            if pl["clear"] and not pl["margin_m"] < c:
+                out.append(f"{name}: 2 L delta = {pl['margin_m']!r} m is not below the proved "
+                           f"clearance {c!r} m (Tolerance.tube's premise)")
+            if not pl["clear"] and tol != 0:
+                out.append(f"{name}: not clear, yet tolerance_rad {tol!r}")
+    return out
+
+
+# --- the monitored run ------------------------------------------------------------------------
+
+def _monitor(sdir: Path, loaded: Sequence[Scenario], plans: _Plans,
+             figures: dict[str, F.Figure]) -> dict[str, Any]:
+    """`cfmpa simulate` then `cfmpa monitor` in process, on MONITOR_SCENARIO's modified plan:
+    the tracking log, and the same log with MONITOR_EXCURSION added."""
+    from ..runs import Excursion, log_csv, monitor_json, monitor_log, simulate_log
+
+    path = sdir / f"{MONITOR_SCENARIO}.toml"
+    by_path = {Path(x.source).resolve(): x for x in loaded}
+    variant = Variant.MODIFIED
+    try:
+        s = by_path.get(path.resolve()) or load_scenario(path)
+        p = plans.require(s, variant)
+    except CfmpaError as exc:
+        return {"available": False, "note": f"not available in this run: {exc}"}
+    if p.search.status is not SearchStatus.FOUND:
+        return {"available": False, "note": f"not available in this run: {s.name} has no "
+                f"{variant.value} path ({p.search.reason})"}
+    traj = executed_trajectory(s, p.grid, p.search.path)
+    cert = certify_trajectory(s, traj)          # as `cfmpa monitor` does: its own tube
+    if not cert.clear:
+        return {"available": False, "note": f"not available in this run: the {variant.value} "
+                f"plan of {s.name} is not certified clear, so there is no tube to monitor"}
+    tol = tolerance_rad(s, cert)
+    sim = MONITOR_SIMULATION
+    exc = Excursion(**MONITOR_EXCURSION)
+    runs, traces = [], []
+    for name, excursions in (("tracking", ()), ("excursion", (exc,))):
+        t, a = simulate_log(traj, lag=sim["lag_s"], noise=sim["noise_rad"], seed=sim["seed"],
+                            excursions=excursions, period=sim["period_s"], tail=sim["tail_s"])
+        log = f"{name}.csv"
+        res = monitor_log(s, traj, tol, io.StringIO(log_csv(t, a).decode()), source=log)
+        mj = monitor_json(s, traj, tol, res, log)
+        window = (t >= exc.t_s) & (t <= exc.t_s + exc.duration_s)
+        expected: dict[str, Any] = {"status": "inside", "first_outside_t": None,
+                                    "first_outside_joint": None, "outside": 0}
+        if excursions:
+            expected = {"status": "outside", "first_outside_t": float(t[window][0]),
+                        "first_outside_joint": exc.joint, "outside": int(window.sum())}
+        runs.append({"name": name, "excursion": dict(MONITOR_EXCURSION) if excursions else None,
+                     "expected": expected,
+                     "result": {k: mj[k] for k in _MONITOR_KEYS}})
+        # The picture's per-sample deviation (the monitor itself keeps only counts).
+        dev = np.abs(a - traj.at(t)).max(axis=1)
+        first = None
+        if res.first is not None:
+            first = (res.first["t_s"], float(dev[int(np.searchsorted(t, res.first["t_s"]))]))
+        traces.append(F.MonitorTrace(
+            f"{name}: {res.status}, {res.outside} of {res.samples} samples outside",
+            t, dev, first))
+    fig = F.monitor_figure("fig-monitor", f"{s.name}, {variant.value} plan: monitored simulated "
+                           f"runs", tol, traces)
+    figures[fig.id] = fig
+    return {"available": True, "note": "", "scenario": s.name, "variant": variant.value,
+            "tolerance_rad": tol, "plan_tolerance_rad": tolerance_rad(s, p.certificate),
+            "trajectory": {"rows": traj.rows, "t_start_s": float(traj.t[0]),
+                           "t_end_s": float(traj.t[-1])},
+            "simulation": dict(sim), "runs": runs,
+            "figure": {"id": fig.id, "caption": fig.caption}}
+
+
+#: The keys of `cfmpa monitor`'s JSON a monitored run keeps (runs.monitor_json).
+_MONITOR_KEYS = ("status", "samples", "outside", "outside_in_contact", "max_deviation_rad",
+                 "t_first_s", "t_last_s", "first_outside_t", "first_outside_line",
+                 "first_outside_joint", "first_outside_deviation_rad", "contact",
+                 "tolerance_rad")
+
+
+def monitor_problems(mon: Mapping[str, Any]) -> list[str]:
+    """What in report.json's monitored run is not as expected: the monitor's tube is the plan's;
+    the tracking log inside (its largest deviation within the tolerance); the excursion's log
+    outside first at the excursion's first sample, on its joint, and only in its window."""
+    out = []
+    if mon["tolerance_rad"] != mon["plan_tolerance_rad"]:
+        out.append(f"the monitor's tolerance {mon['tolerance_rad']!r} is not the plan's "
+                   f"{mon['plan_tolerance_rad']!r}")
+    for r in mon["runs"]:
+        res, exp = r["result"], r["expected"]
+        if res["tolerance_rad"] != mon["tolerance_rad"]:
+            out.append(f"{r['name']}: monitored against {res['tolerance_rad']!r} rad")
+        for k in ("status", "first_outside_t", "first_outside_joint", "outside"):
+            if res[k] != exp[k]:
+                out.append(f"{r['name']}: {k} {res[k]!r}, expected {exp[k]!r}")
+        if res["status"] == "inside" and res["max_deviation_rad"] > res["tolerance_rad"]:
+            out.append(f"{r['name']}: inside, yet a deviation of {res['max_deviation_rad']!r} rad")
+    return out
 
 
 # --- campaign -----------------------------------------------------------------------------------
@@ -444,6 +653,23 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
                            + (f"; missed: {', '.join(map(str, missed))}" if missed else "")))
     else:
         items.append(_item("self-check faults caught (full mode)", None, st["source"]))
+    tubes = [pl for s in doc["scenarios"] for pl in (s["tube"] or {}).get("plans", [])]
+    problems = tube_problems(doc)
+    items.append(_item("tolerance tubes agree with certify",
+                       (not problems) if found else None,
+                       f"{len(tubes)} found plans' tubes (c > 2 L delta; tolerance_rad as "
+                       f"plan.json and cfmpa certify give it)"
+                       + (f"; {'; '.join(problems)}" if problems else "")))
+    mon = doc["monitor"]
+    if mon["available"]:
+        bad_runs = monitor_problems(mon)
+        items.append(_item("monitored run as expected", not bad_runs,
+                           "; ".join(f"{r['name']}: {r['result']['status']}, "
+                                     f"{r['result']['outside']} of {r['result']['samples']} "
+                                     f"samples outside" for r in mon["runs"])
+                           + (f"; not as expected: {'; '.join(bad_runs)}" if bad_runs else "")))
+    else:
+        items.append(_item("monitored run as expected", None, mon["note"]))
     cmp_ = doc["compare"]
     if cmp_["available"]:
         bad = {k: v for k, v in cmp_["checks"].items() if v}

@@ -39,6 +39,10 @@ __all__ = [
     "cspace_figure",
     "variants_figure",
     "clearance_figure",
+    "TubePanel",
+    "tube_figure",
+    "MonitorTrace",
+    "monitor_figure",
     "naive_hull_figure",
     "inconsistency_figure",
     "prop8_figure",
@@ -436,6 +440,104 @@ def clearance_figure(fid: str, s: Scenario, g: Grid,
                  f"times per dt); variants that plan the same path share one curve. Triangles: "
                  f"the certificate's least sampled clearance; dotted: its proved lower bound over "
                  f"the whole motion.", f"Clearance over time for {s.name}")
+
+
+@dataclass(frozen=True)
+class TubePanel:
+    """One plan's panel of the tube figure: the sampled clearance ``d_m`` at ``t_s`` along its
+    executed motion, the certificate's proved lower bound and least sampled point, the plan's
+    tolerance_rad and the tube's margin 2 L delta (all from the report's data)."""
+
+    title: str
+    t_s: FloatArray
+    d_m: FloatArray
+    clear: bool
+    lower_bound_m: float
+    tolerance_rad: float
+    margin_m: float
+    t_min_s: float
+    d_min_m: float
+
+
+#: The tube figure's clearance axis ends at this many times the proved bound (the margin is the
+#: point of the picture; the clearance curve's far parts are in the clearance figure above it).
+TUBE_AXIS_BOUNDS = 8.0
+
+
+def tube_figure(fid: str, s: Scenario, panels: Sequence[TubePanel]) -> Figure:
+    """Per plan, the clearance along its executed motion with the proved lower bound c and the
+    tube's margin 2 L delta shaded below c: what a deviation of delta per joint may eat."""
+    k = max(1, len(panels))
+    fig, axes = plt.subplots(1, k, figsize=(4.2 * k + 0.4, 3.1), squeeze=False, sharey=True)
+    top = 0.0
+    for ax, p in zip(axes.flat, panels):
+        d = p.d_m * 1000
+        c, m = p.lower_bound_m * 1000, p.margin_m * 1000
+        top = max(top, min(float(d.max()), TUBE_AXIS_BOUNDS * c if p.clear and c > 0
+                           else float(d.max())))
+        ax.plot(p.t_s, d, color=RIGHT_COLOR, lw=1.2, label="sampled clearance")
+        if p.clear:
+            ax.axhspan(c - m, c, color=VARIANT_COLORS[Variant.TIGHT], alpha=0.18, lw=0,
+                       label=f"tube margin 2Lδ = {m:.2f} mm")
+            ax.axhline(c, color="black", lw=1.0, ls=(0, (1, 2)),
+                       label=f"proved bound c = {c:.2f} mm")
+        ax.plot([p.t_min_s], [p.d_min_m * 1000], marker="v", ms=6, color="black", ls="",
+                zorder=5, label=f"least sampled: {p.d_min_m * 1000:.2f} mm")
+        ax.axhline(0.0, color="black", lw=0.7)
+        ax.set_title(f"{p.title}: δ = {p.tolerance_rad:.6f} rad" if p.clear
+                     else f"{p.title}: not clear, no tube")
+        ax.set_xlabel("time t (s)")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.26), ncol=2, fontsize=7,
+                  frameon=False)
+    axes.flat[0].set_ylabel("distance between the arms (mm)")
+    if top > 0:
+        axes.flat[0].set_ylim(-0.04 * top, 1.05 * top)
+    fig.suptitle(f"{s.name}: clearance and the tolerance tube's margin", fontsize=9.5)
+    fig.tight_layout()
+    return _save(fig, fid, f"{s.name}, per found plan (plans with the same path share a panel): "
+                 f"the least distance between the arms along the executed motion (sampled 16 "
+                 f"times per dt; triangle: the certificate's least sampled point), the proved "
+                 f"lower bound c (dotted) and, shaded below it, the tube's margin 2 L δ: how much "
+                 f"of c a deviation of δ = tolerance_rad per joint may eat (Tolerance.tube: "
+                 f"c > 2 L δ, docs/model.md §12). The axis ends at {TUBE_AXIS_BOUNDS:g} times "
+                 f"c.", f"Clearance with the tolerance tube's margin for {s.name}")
+
+
+@dataclass(frozen=True)
+class MonitorTrace:
+    """One simulated log seen by the monitor: per sample the largest joint deviation from the
+    trajectory (rad), and the first sample the monitor flagged (None when all are inside)."""
+
+    label: str
+    t_s: FloatArray
+    deviation_rad: FloatArray
+    first_outside: tuple[float, float] | None
+
+
+def monitor_figure(fid: str, title: str, tolerance_rad: float,
+                   traces: Sequence[MonitorTrace]) -> Figure:
+    """The monitored runs: each sample's max-norm deviation against the tube's radius."""
+    fig, ax = plt.subplots(figsize=(7.5, 2.8))
+    colors = [LEFT_COLOR, VARIANT_COLORS[Variant.ORIGINAL]]
+    for k, tr in reversed(list(enumerate(traces))):
+        ax.plot(tr.t_s, tr.deviation_rad * 1000, color=colors[k % 2], lw=0.8 if k else 1.0,
+                label=tr.label, zorder=3 if k == 0 else 2)
+        if tr.first_outside is not None:
+            t0, d0 = tr.first_outside
+            ax.plot([t0], [d0 * 1000], marker="X", ms=8, color="black", ls="", zorder=5,
+                    label=f"first sample outside: t = {t0:.3f} s")
+    ax.axhline(tolerance_rad * 1000, color=VARIANT_COLORS[Variant.TIGHT], lw=1.2, ls="--",
+               label=f"tube radius δ = {tolerance_rad * 1000:.3f} mrad")
+    ax.set_ylim(bottom=0.0)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("max joint deviation (mrad)")
+    ax.set_title(title)
+    ax.legend(loc="upper right", fontsize=7, framealpha=0.9)
+    fig.tight_layout()
+    return _save(fig, fid, f"{title}: for each logged sample, the largest deviation over the four "
+                 "joints from the trajectory at its time, against the tube's radius "
+                 "tolerance_rad; a sample above the line is outside the certified tube.",
+                 "Monitored simulated runs against the tolerance tube")
 
 
 # --- findings -----------------------------------------------------------------------------------

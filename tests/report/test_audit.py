@@ -506,9 +506,12 @@ def _results(report):
 
 
 def _figure_refs(doc):
-    """Every figure report.json refers to (findings, scenarios, the campaign's two)."""
+    """Every figure report.json refers to (findings, scenarios and their tubes, the monitored
+    run, the campaign's two)."""
     refs = [f["figure"] for f in doc["findings"] if f.get("figure")]
     refs += [f for s in doc["scenarios"] for f in s["figures"]]
+    refs += [s["tube"]["figure"] for s in doc["scenarios"] if s["tube"]]
+    refs += [doc["monitor"]["figure"]] if doc["monitor"]["available"] else []
     return refs + [doc["compare"][k] for k in ("figure", "rate_figure") if doc["compare"].get(k)]
 
 
