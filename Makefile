@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: prove test test-slow bench clean
+.PHONY: prove test test-slow bench mutants clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,7 +22,11 @@ test-slow: $(STAMP)
 	$(PY) -m pytest -m slow
 
 bench: $(STAMP)
-	$(PY) bench/run.py
+	$(PY) bench/run.py --prove
+
+# Seeded source mutations of a copy of the packages: which of prove, contracts, tests catch each.
+mutants: $(STAMP)
+	$(VENV)/bin/cfmpa selftest --code --json build/mutants.json
 
 clean:
 	rm -rf build .pytest_cache

@@ -142,10 +142,23 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_selftest(args: argparse.Namespace) -> int:
-    """Seed faults and show which contract check catches each."""
-    from .runs import run_selftest
+    """Seed faults and show which contract check catches each; with --code, seeded mutations
+    of a copy of the source, and which of prove, the contracts and the tests catch each."""
+    if not args.code:
+        for flag in ("mutant", "checks", "json", "prove_only"):
+            value = getattr(args, flag)
+            if value:
+                raise InputError("--" + flag.replace("_", "-"),
+                                 value[0] if isinstance(value, list) else value,
+                                 "is an option of --code")
+        from .runs import run_selftest
 
-    return run_selftest()
+        return run_selftest()
+    from .runs import CODE_CHECKS, run_code_selftest
+
+    checks = tuple(c.strip() for c in args.checks.split(",")) if args.checks else CODE_CHECKS
+    return run_code_selftest(args.mutant or None, checks=checks,
+                             prove_only=args.prove_only or (), json_out=args.json)
 
 
 def cmd_prove(args: argparse.Namespace) -> int:
@@ -285,8 +298,9 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--variant", type=_variant, default="modified",
                     help="original | modified | tight (default: modified)")
     pl.add_argument("--out", required=True, help="output folder")
-    pl.add_argument("--contracts", choices=["off", "sampled", "full"], default="sampled",
-                    help="contract checking of BuiltDR and searchoptpath (default: sampled)")
+    pl.add_argument("--contracts", choices=["off", "sampled", "full"], default="full",
+                    help="contract checking of BuiltDR and searchoptpath (default: full, every "
+                         "cell and optimality through the witness)")
     pl.add_argument("--seed", type=int, default=0, help="seed of the sampled contracts")
     pl.add_argument("--sample", type=int, default=None,
                     help="cells checked by sampled contracts (default: the mode's own)")
@@ -316,6 +330,17 @@ def _parser() -> argparse.ArgumentParser:
     c.set_defaults(func=cmd_check)
 
     st = sub.add_parser("selftest", help="seed faults; show which check catches each")
+    st.add_argument("--code", action="store_true",
+                    help="mutate a copy of the source instead (minutes): which of cfmpa prove, "
+                         "the contracts and the tests catch each mutant; exit 1 unless prove "
+                         "catches every one")
+    st.add_argument("--mutant", action="append", metavar="NAME",
+                    help="with --code: only this mutant (repeatable)")
+    st.add_argument("--checks", metavar="LIST",
+                    help="with --code: comma-separated, of prove,contracts,tests (default all)")
+    st.add_argument("--prove-only", action="append", metavar="ID",
+                    help="with --code: cfmpa prove on these obligations only (as its --only)")
+    st.add_argument("--json", metavar="OUT", help="with --code: the table as JSON")
     st.set_defaults(func=cmd_selftest)
 
     pr = sub.add_parser("prove", help="discharge every obligation (make prove)")

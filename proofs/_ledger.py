@@ -73,7 +73,10 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "invariants generated, so the assumption there is that Python runs that subset (counted "
         "range loops, if/else, stores) as the while-language means it; the loop form's agreement "
         "with build_dr and build_dr_fast is checked on data (bit for bit, in the tests), not "
-        "proved. searchoptpath's top level is written by hand: the two early exits (start "
+        "proved; and cfmpa prove itself checks the D_R that build_dr_fast makes for every "
+        "scenario it proves, every variant, against Theorem 1/3's postcondition at every cell "
+        "(Scenario.*.translation_*), so for those workcells the bytes that run are checked, not "
+        "modelled. searchoptpath's top level is written by hand: the two early exits (start "
         "blocked in layer 0, goal blocked in the rest layer) and the call, the search by its "
         "contract (A6); the model has no loop to match. The "
         "run-time contracts (docs/model.md §7) check the Python code against the same triples "
@@ -83,7 +86,9 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "A6.search_contract",
         "The search that searchoptpath calls returns null iff no valid path exists, and "
         "otherwise a valid path of least (J1, J2) (Definition 5). Assumed only for runs that "
-        "do not check it: in contract mode 'full' and in `cfmpa check` the answer comes with a "
+        "do not check it: in contract mode 'full', in `cfmpa check` and in cfmpa prove's "
+        "Scenario.*.translation_* (the fast search on each proved workcell) the answer comes "
+        "with a "
         "witness that spec.check_witness verifies (docs/model.md §11), and the run records "
         "that the checker ran and held (post.optimal); its acceptance implies the contract "
         "(Witness.labels_sound, Witness.reachable_sound), so there it is not assumed.",

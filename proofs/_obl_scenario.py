@@ -24,12 +24,18 @@ from collections.abc import Callable, Sequence
 from fractions import Fraction
 from pathlib import Path
 
-from ..spec import Grid, Scenario, decimal, load_scenario, make_grid
+from ..spec import Grid, Scenario, Variant, decimal, load_scenario, make_grid
 from ._obligation import CheckOutcome, CheckQuery, Method, Obligation, Verdict, check_source
 
 __all__ = ["CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations"]
 
-CHECKS = ("time_grid", "cspace_grid", "margin_side", "containment")
+#: Translation validation, one per variant: the bytes cfmpa plan would use, checked at every cell.
+TRANSLATION_CHECKS = tuple(f"translation_{v.value}" for v in Variant)
+CHECKS = ("time_grid", "cspace_grid", "margin_side", "containment") + TRANSLATION_CHECKS
+
+#: Translation validation builds and checks a whole D_R: a larger wall-clock limit than the
+#: other data checks (a default-sized grid takes about 3 s; a user's grid may be much larger).
+TRANSLATION_TIMEOUT_MS = 600_000
 
 #: The margin lemma's bound on a lattice spacing (Margin.arc_chord, Lemma.sweep_margin: g <= 3.14).
 G_MAX = Fraction(157, 50)
@@ -128,16 +134,64 @@ def _containment(s: Scenario) -> CheckOutcome:
     return CheckOutcome(rep.ok, detail, None if rep.ok else detail)
 
 
+def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
+    """The fast kernels' D_R and answer, as cfmpa plan computes them, against Theorems 1-4's
+    postconditions, decided by the spec alone: every cell, the path, and the search's witness."""
+    import hashlib
+
+    from ..impl import kernels
+    from ..spec import check_witness, dr_cell_failures, dr_shape_failures, search_failures
+
+    build, search = kernels("fast")
+    g = make_grid(s)
+    start, goal = s.right.start_cell, s.right.goal_cell
+    dr = build(s, variant, g)
+    fails = dr_shape_failures(g, dr)
+    checked = 0
+    if not fails:
+        checked, fails = dr_cell_failures(s, variant, g, dr)
+    answer = None
+    if not fails:
+        answer = search(dr, start, goal, with_witness=True)
+        fails = (search_failures(dr, start, goal, answer)
+                 or check_witness(dr, start, goal, answer, answer.witness))
+    digest = hashlib.sha256(dr.tobytes()).hexdigest()[:16]
+    if answer is None:
+        said = "not searched"
+    elif answer.path:
+        said = f"path found, J1 = {answer.J1}, J2 = {answer.J2}, optimal by its witness"
+    else:
+        said = f"no path ({answer.reason}), shown by the reachable set"
+    detail = (f"{variant.value}: D_R {list(dr.shape)} sha256 {digest}; {checked} cells checked "
+              f"against the spec's regions; {said}")
+    if fails:
+        f = fails[0]
+        lines = [f"{f.condition}: {f.message}"] + [f"{k} was {v!r}" for k, v in f.values]
+        return CheckOutcome(False, detail + "; FAILS " + lines[0], "\n".join(lines))
+    return CheckOutcome(True, detail)
+
+
 def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
            ) -> CheckQuery:
     s = load_scenario(path)
-    src = check_source(check, Grid.time_readings, Grid.spacing_readings, decimal, make_grid)
+    if what.startswith("translation_"):
+        from ..impl import kernels
+        from ..spec import check_witness, dr_cell_failures, search_failures
+        # The checkers' sources (hashed: editing them is a change); the kernels' output is
+        # judged by them, and its digest is in the detail.
+        src = check_source(_translation, make_grid, kernels, dr_cell_failures, search_failures,
+                           check_witness)
+    else:
+        src = check_source(check, Grid.time_readings, Grid.spacing_readings, decimal, make_grid)
     if check is _containment:
         from ..impl import check_containment, contained_exactly, containment_slack
         src += "\n" + check_source(check_containment, contained_exactly, containment_slack)
     content = f"scenario {path.name} sha256 {s.sha256}\ncheck {what}\n\n{src}\n"
     return CheckQuery(lambda: check(s), content)
 
+
+#: How the translation validations are labelled in the summary and the report.
+EVERY_CELL = "every cell"
 
 _READINGS = ("binary = the doubles the code computes with, as exact rationals; decimal = the "
              "numbers as written in the file (Fraction(repr(x)) of each double)")
@@ -183,4 +237,20 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "polygons are reported.",
                        D, P, lambda f=f: _query(f, _containment, "containment")),
         ]
+        for v in Variant:
+            what = f"translation_{v.value}"
+            out.append(Obligation(
+                scenario_check_id(f.stem, what), group,
+                "docs/model.md §7 (translation validation)",
+                f"{f.name}, {v.value}: the D_R that cfmpa plan uses (impl's fast BuiltDR) meets "
+                f"Theorem {1 if v is Variant.ORIGINAL else 3}'s postcondition at every cell "
+                "(its shape, and each cell's value against the spec's own regions and "
+                "distances), and the fast searchoptpath's answer on it meets Theorem "
+                f"{2 if v is Variant.ORIGINAL else 4}'s (a found path valid under the fixed "
+                "is_path, its costs its own) with a witness that spec.check_witness accepts "
+                "(the path optimal, or no valid path at all). A check of the code that runs, on "
+                "this workcell's data: not a proof for other workcells.",
+                D, P, lambda f=f, v=v, what=what: _query(
+                    f, lambda s: _translation(s, v), what),
+                label=EVERY_CELL, timeout_ms=TRANSLATION_TIMEOUT_MS))
     return out

@@ -31,6 +31,9 @@ from ._plan import CERTIFICATE, PlanResult, plan, plan_json, versions, write_pla
 from ._trajectory_runs import (BLOCK_ROWS, Excursion, MonitorResult, certify_json, log_csv,
                                monitor_json, monitor_log, parse_excursion, run_certify,
                                run_monitor, run_simulate, simulate_log)
+from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
+                            code_mutation_rows, code_mutation_table, mutated_copy,
+                            run_code_selftest)
 from ._selftest import (FAULTS, SAMPLE, WORKCELLS, Fault, SelftestRow, run_fault, run_selftest,
                         selftest_rows, selftest_table, workcell)
 
@@ -51,4 +54,7 @@ __all__ = [
     # seeded faults
     "FAULTS", "Fault", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault", "run_selftest",
     "selftest_rows", "selftest_table", "workcell",
+    # seeded mutations of the source (cfmpa selftest --code)
+    "CODE_CHECKS", "CODE_MUTANTS", "CodeMutant", "CodeRow", "code_mutation_rows",
+    "code_mutation_table", "mutated_copy", "run_code_selftest",
 ]

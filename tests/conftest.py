@@ -1,1 +1,11 @@
 """Shared test set-up: tests/ is on sys.path, so test modules can `import factory`."""
+
+import os
+
+from hypothesis import settings
+
+# CI runs one fixed set of examples (CFMPA_HYPOTHESIS=ci, set by .ci/run), so a red run there is
+# a property of the commit, not of the draw; elsewhere each run draws new examples.
+settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("CFMPA_HYPOTHESIS") == "ci":
+    settings.load_profile("ci")

@@ -28,7 +28,9 @@ def test_the_lock_pins_every_expected_obligation_and_is_shipped():
     lock = load_lock()
     assert set(lock) == {pin_key(i) for i in expected_ids()}
     assert {k for k in lock if k.startswith("Scenario.")} == {
-        f"Scenario.*.{c}" for c in ("time_grid", "cspace_grid", "margin_side", "containment")}
+        f"Scenario.*.{c}" for c in ("time_grid", "cspace_grid", "margin_side", "containment",
+                                    "translation_original", "translation_modified",
+                                    "translation_tight")}
     text = LOCK.read_text()
     assert text == json.dumps(json.loads(text), indent=1, sort_keys=True,
                               ensure_ascii=False) + "\n"         # sorted, as repin writes it

@@ -43,7 +43,8 @@ def test_scenario_ids_come_from_the_files_found(tmp_path: Path):
     assert ids[: len(FIXED_IDS)] == FIXED_IDS
     assert ids[len(FIXED_IDS):] == tuple(f"Scenario.{s}.{c}" for s in ("a", "b")
                                          for c in ("time_grid", "cspace_grid", "margin_side",
-                                                   "containment"))
+                                                   "containment", "translation_original",
+                                                   "translation_modified", "translation_tight"))
     assert [o.id for o in collect_obligations(tmp_path, ["Scenario"])] == list(ids[len(FIXED_IDS):])
 
 
@@ -104,7 +105,9 @@ def test_a_scenario_that_does_not_load_fails_instead_of_vanishing(tmp_path: Path
     doc = json.loads((tmp_path / "out" / "results.json").read_text())
     verdicts = {o["id"]: o["verdict"] for o in doc["obligations"]}
     assert verdicts == {f"Scenario.broken.{c}": "failed"
-                        for c in ("time_grid", "cspace_grid", "margin_side", "containment")}
+                        for c in ("time_grid", "cspace_grid", "margin_side", "containment",
+                                  "translation_original", "translation_modified",
+                                  "translation_tight")}
 
 
 def test_full_run_discharges_everything_as_expected(tmp_path: Path):
@@ -196,7 +199,8 @@ def test_another_scenarios_folder_says_what_it_expects(tmp_path: Path):
     assert rc == 0
     line = out.getvalue().splitlines()[2]
     assert line == (f"scenarios: the 1 workcell(s) in {tmp_path}, expecting "
-                    "Scenario.mine.{time_grid,cspace_grid,margin_side,containment}")
+                    "Scenario.mine.{time_grid,cspace_grid,margin_side,containment,"
+                    "translation_original,translation_modified,translation_tight}")
     assert "not the bundled" not in out.getvalue()
 
 
@@ -204,7 +208,8 @@ def test_the_bundled_folder_says_what_it_expects():
     from cfmpa.proofs import BUNDLED_DIR
     note = scenarios_note(BUNDLED_DIR)
     assert note.startswith("scenarios: the 5 bundled workcells, expecting "
-                           "Scenario.default.{time_grid,cspace_grid,margin_side,containment}, ")
+                           "Scenario.default.{time_grid,cspace_grid,margin_side,containment,"
+                           "translation_original,translation_modified,translation_tight}, ")
     assert "\n" not in note and "Scenario.original-fails.{" in note
 
 

@@ -21,7 +21,8 @@ from cfmpa.report._audit import _proofs_of_this_tree
 from cfmpa.report._obligations import audited_ids, load_proofs
 
 ROOT = Path(__file__).resolve().parents[2]
-CHECKS = ("time_grid", "cspace_grid", "margin_side", "containment")
+CHECKS = ("time_grid", "cspace_grid", "margin_side", "containment",
+          "translation_original", "translation_modified", "translation_tight")
 MINE = [f"Scenario.mine.{c}" for c in CHECKS]
 
 
@@ -83,9 +84,8 @@ def test_results_json_rows_of_other_workcells_are_left_out_and_named(mine: Path,
     data = load_proofs(str(out / "results.json"), ROOT / "scenarios", files=[mine])
     assert [r.id for r in data.rows] == ["Scenario.mine.time_grid", "Scenario.mine.cspace_grid"]
     assert "left out" in data.note and "early-arrival" in data.note
-    # --proofs must cover the file's ids: the two not run are missing.
-    assert set(data.missing_ids) == set(FIXED_IDS) | {"Scenario.mine.margin_side",
-                                                      "Scenario.mine.containment"}
+    # --proofs must cover the file's ids: those not run are missing.
+    assert set(data.missing_ids) == set(FIXED_IDS) | {f"Scenario.mine.{c}" for c in CHECKS[2:]}
     assert data.run is not None and "mine.toml" in data.run["scenarios"]
 
 

@@ -1,0 +1,308 @@
+"""`cfmpa selftest --code`: seeded mutations of the source, and what catches each.
+
+Each mutant is one edit of a copy of the installed packages (impl's code: the D_R builder, the
+regions, the search). The copy is laid out as the installed ``cfmpa`` package in a temporary
+folder and run in fresh processes that import it (``PYTHONPATH``), never the original: ``cfmpa
+prove`` in full, the contracts (``cfmpa plan``'s modes on every bundled scenario and variant) and,
+in a checkout, the tests of impl and runs. A mutant is *caught* by a check when that check fails
+on it; every mutant must be caught by ``cfmpa prove`` (docs/model.md §7.3).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = ["CODE_CHECKS", "CODE_MUTANTS", "CodeMutant", "CodeRow", "code_mutation_table",
+           "code_mutation_rows", "mutated_copy", "run_code_selftest"]
+
+
+@dataclass(frozen=True)
+class CodeMutant:
+    """One seeded source edit: in package file ``file`` (e.g. ``impl/_regions.py``), each
+    ``old`` text, which must occur exactly once, becomes its ``new`` text."""
+
+    name: str
+    what: str
+    file: str
+    edits: tuple[tuple[str, str], ...]
+
+
+CODE_MUTANTS: tuple[CodeMutant, ...] = (
+    CodeMutant("rest_layer_free", "the fast BuiltDR leaves the rest layer free",
+               "impl/_fast_builtdr.py",
+               (("            bar.advance()\n    return P\n",
+                 "            bar.advance()\n    P[-1] = 0  # mutant\n    return P\n"),)),
+    CodeMutant("margin_halved", "the regions grown by half the margin the lemma needs",
+               "impl/_regions.py",
+               (("    grow = margin_scale * sweep_margin(arm, link, g, moving)",
+                 "    grow = 0.5 * margin_scale * sweep_margin(arm, link, g, moving)"),)),
+    CodeMutant("lattice_coarsened", "the regions sampled at twice the spacing their margin is "
+               "computed for", "impl/_regions.py",
+               (("        i_lo, i_hi = lattice_range(box[q][0], box[q][1], anchor[q], g[q])\n"
+                 "        axes.append(anchor[q] + np.arange(i_lo, i_hi + 1) * g[q])",
+                 "        i_lo, i_hi = lattice_range(box[q][0], box[q][1], anchor[q], 2 * g[q])\n"
+                 "        axes.append(anchor[q] + np.arange(i_lo, i_hi + 1) * (2 * g[q]))"),)),
+    CodeMutant("box_sign_flipped", "the principal's box per layer swept backwards (mirrored "
+               "about theta_L(k dt))", "impl/_builtdr.py",
+               (("        box = left_box(s, v, k)\n        anchor = left_angles(s, k * s.dt)\n",
+                 "        anchor = left_angles(s, k * s.dt)\n"
+                 "        box = tuple((2 * a - hi, 2 * a - lo)\n"
+                 "                    for (lo, hi), a in zip(left_box(s, v, k), anchor))\n"),)),
+    CodeMutant("search_skips_rest_layer", "both searches take the rest layer as free",
+               "impl/_search.py",
+               (("    free = np.ascontiguousarray(np.asarray(dr) == 0)\n",
+                 "    free = np.ascontiguousarray(np.asarray(dr) == 0)\n"
+                 "    free[N] = True  # mutant\n"),)),
+    CodeMutant("layer_count_off_by_one", "the principal's regions for N - 1 layers, not N",
+               "impl/_builtdr.py",
+               (("    for k in range(g.N):\n        box = left_box(s, v, k)\n",
+                 "    for k in range(g.N - 1):\n        box = left_box(s, v, k)\n"),)),
+)
+
+#: The checks a mutant is run through, in this order.
+CODE_CHECKS: tuple[str, ...] = ("prove", "contracts", "tests")
+
+#: The packages copied, as (import name, folder under the copy's ``cfmpa``).
+_PACKAGES = (("cfmpa", ""), ("cfmpa.spec", "spec"), ("cfmpa.impl", "impl"),
+             ("cfmpa.proofs", "proofs"), ("cfmpa.runs", "runs"), ("cfmpa.report", "report"),
+             ("cfmpa.scenarios", "scenarios"))
+
+#: The tests that exercise impl and the checked runs (a checkout's ``tests/``).
+TEST_FOLDERS = ("impl", "runs")
+
+#: Run in the copy: every bundled scenario and variant planned in both contract modes; prints
+#: one JSON line of {"mode": [the plans with a violation, each "scenario/variant: condition"]}.
+_CONTRACTS_SCRIPT = """
+import json, sys
+from cfmpa.runs import plan
+from cfmpa.scenarios import BUNDLED_DIR, bundled_names
+from cfmpa.spec import Variant, load_scenario
+out = {}
+for mode in ("sampled", "full"):
+    bad = []
+    for name in bundled_names():
+        s = load_scenario(BUNDLED_DIR / f"{name}.toml")
+        for v in Variant:
+            try:
+                r = plan(s, v, contracts=mode, seed=0, stop=False)
+                found = [str(x).splitlines()[0] for x in r.violations]
+            except Exception as e:  # a failed precondition stops the run: caught as well
+                found = [f"{type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"]
+            if found:
+                bad.append(f"{name}/{v.value}: {found[0]}")
+    out[mode] = bad
+print(json.dumps(out))
+"""
+
+
+@dataclass(frozen=True)
+class CodeRow:
+    """What each check said of one mutant: per check, caught (True), passed (False) or not run
+    (None), with a one-line reason; and the seconds it took."""
+
+    mutant: str
+    what: str
+    caught: dict[str, bool | None]
+    detail: dict[str, str]
+    seconds: dict[str, float]
+
+
+def _package_dir(name: str) -> Path:
+    import importlib
+
+    return Path(importlib.import_module(name).__file__).parent   # type: ignore[arg-type]
+
+
+def mutated_copy(mutant: CodeMutant | None, dest: Path) -> Path:
+    """The installed packages copied to ``dest``/cfmpa (the layout ``import cfmpa`` finds with
+    ``dest`` on the path), with ``mutant``'s edits made; returns ``dest``. Raises InputError
+    when an edit's text is not in the file exactly once (the mutant could not be made)."""
+    for name, sub in _PACKAGES:
+        src = _package_dir(name)
+        to = dest / "cfmpa" / sub
+        to.mkdir(parents=True, exist_ok=True)
+        for f in sorted(src.iterdir()):
+            if f.is_file() and f.suffix in (".py", ".toml", ".lock", ".json", ".html", ".typed"):
+                shutil.copy2(f, to / f.name)
+    if mutant is not None:
+        target = dest / "cfmpa" / mutant.file
+        text = target.read_text()
+        for old, new in mutant.edits:
+            count = text.count(old)
+            if count != 1:
+                raise InputError("mutant", mutant.name,
+                                 f"its edit of {mutant.file} matches {count} times, not once: "
+                                 f"{old.strip().splitlines()[0]!r}")
+            text = text.replace(old, new)
+        target.write_text(text)
+    return dest
+
+
+def _env(copy: Path) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(copy)] + [p for p in env.get("PYTHONPATH", "").split(
+        os.pathsep) if p])
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    env.pop("NUMBA_CACHE_DIR", None)
+    return env
+
+
+def _run(cmd: Sequence[str], copy: Path, cwd: Path, timeout_s: float) -> tuple[int, str]:
+    try:
+        p = subprocess.run(list(cmd), cwd=cwd, env=_env(copy), capture_output=True, text=True,
+                           timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        return -1, f"timed out after {timeout_s:.0f} s"
+    return p.returncode, p.stdout + p.stderr
+
+
+def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool | None, str]:
+    out = work / "proofs"
+    select = [a for i in only for a in ("--only", i)]
+    code, text = _run([sys.executable, "-m", "cfmpa", "prove", "--out", str(out), *select],
+                      copy, work, 1800)
+    if code not in (0, 1):
+        return None, f"cfmpa prove exited {code}: {text.strip().splitlines()[-1:]}"
+    failed = []
+    try:
+        doc = json.loads((out / "results.json").read_text())
+        failed = [o["id"] for o in doc["obligations"] if not o.get("as_expected", True)]
+    except (OSError, ValueError, KeyError):
+        pass
+    if code == 0:
+        return False, "every verdict as expected"
+    return True, (f"exit 1; {len(failed)} obligation(s) not as expected: "
+                  + ", ".join(failed[:4]) + (", ..." if len(failed) > 4 else ""))
+
+
+def _check_contracts(copy: Path, work: Path) -> tuple[bool | None, str]:
+    code, text = _run([sys.executable, "-c", _CONTRACTS_SCRIPT], copy, work, 1800)
+    try:
+        found = json.loads(text.strip().splitlines()[-1])
+    except (ValueError, IndexError):
+        return None, f"the contract runs did not finish (exit {code}): {text.strip()[-200:]}"
+    parts = [f"{mode}: {len(bad)} of 15 plans" + (f" (first {bad[0]})" if bad else "")
+             for mode, bad in found.items()]
+    return bool(found.get("sampled") or found.get("full")), "; ".join(parts)
+
+
+def _check_tests(copy: Path, work: Path, tests_dir: Path | None) -> tuple[bool | None, str]:
+    if tests_dir is None:
+        return None, "not run: no tests/ folder (not a checkout)"
+    folders = [str(tests_dir / f) for f in TEST_FOLDERS]
+    code, text = _run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+                       "--rootdir", str(tests_dir.parent), *folders], copy, tests_dir.parent,
+                      3600)
+    lines = text.strip().splitlines()
+    failing = [ln for ln in lines if ln.startswith(("FAILED", "ERROR"))]
+    if code == 0:
+        return False, lines[-1] if lines else "passed"
+    if code == 1 and failing:
+        return True, failing[0][:160]
+    return None, f"pytest exited {code}: {lines[-1] if lines else ''}"
+
+
+def _tests_dir() -> Path | None:
+    from ..gitstate import repo_root
+
+    root = repo_root()
+    t = None if root is None else Path(root) / "tests"
+    return t if t is not None and (t / "impl").is_dir() else None
+
+
+def _chosen(names: Sequence[str] | None, checks: Sequence[str]) -> list[CodeMutant]:
+    known = {m.name: m for m in CODE_MUTANTS}
+    for n in names or ():
+        if n not in known:
+            raise InputError("--mutant", n, f"is not one of {', '.join(known)}")
+    for c in checks:
+        if c not in CODE_CHECKS:
+            raise InputError("--checks", c, f"is not one of {', '.join(CODE_CHECKS)}")
+    return [known[n] for n in names] if names else list(CODE_MUTANTS)
+
+
+def code_mutation_rows(names: Sequence[str] | None = None, *,
+                       checks: Sequence[str] = CODE_CHECKS, prove_only: Sequence[str] = (),
+                       stream: Any = None) -> tuple[CodeRow, ...]:
+    """Run each mutant (all, or those named) through ``checks``; one row each, in order.
+    ``prove_only`` runs cfmpa prove on those obligations alone (``--only``), for a quick look."""
+    chosen = _chosen(names, checks)
+    tests_dir = _tests_dir()
+    rows = []
+    for m in chosen:
+        caught: dict[str, bool | None] = {}
+        detail: dict[str, str] = {}
+        seconds: dict[str, float] = {}
+        with tempfile.TemporaryDirectory(prefix=f"cfmpa-mutant-{m.name}-") as tmp:
+            copy = mutated_copy(m, Path(tmp) / "src")
+            work = Path(tmp) / "work"
+            work.mkdir()
+            for c in checks:
+                t0 = time.perf_counter()
+                if c == "prove":
+                    caught[c], detail[c] = _check_prove(copy, work, prove_only)
+                elif c == "contracts":
+                    caught[c], detail[c] = _check_contracts(copy, work)
+                else:
+                    caught[c], detail[c] = _check_tests(copy, work, tests_dir)
+                seconds[c] = round(time.perf_counter() - t0, 1)
+                if stream is not None:
+                    word = {True: "caught", False: "NOT caught", None: "undecided"}[caught[c]]
+                    print(f"  {m.name}: {c}: {word} ({seconds[c]} s) {detail[c]}", file=stream,
+                          flush=True)
+        rows.append(CodeRow(m.name, m.what, caught, detail, seconds))
+    return tuple(rows)
+
+
+def code_mutation_table(rows: Sequence[CodeRow]) -> str:
+    """The mutation table: one line per mutant, caught / not caught / not run per check."""
+    checks = [c for c in CODE_CHECKS if any(c in r.caught for r in rows)]
+    word = {True: "caught", False: "MISSED", None: "-"}
+    width = max([len(r.mutant) for r in rows] + [6])
+    out = [f"{'mutant':<{width}}  " + "  ".join(f"{c:<9}" for c in checks),
+           "-" * (width + 11 * len(checks))]
+    for r in rows:
+        out.append(f"{r.mutant:<{width}}  " + "  ".join(
+            f"{word[r.caught[c]] if c in r.caught else '':<9}" for c in checks))
+    score = sum(1 for r in rows if r.caught.get("prove"))
+    out.append(f"cfmpa prove caught {score} of {len(rows)} mutants")
+    return "\n".join(out)
+
+
+def run_code_selftest(names: Sequence[str] | None = None, *,
+                      checks: Sequence[str] = CODE_CHECKS, prove_only: Sequence[str] = (),
+                      json_out: str | None = None) -> int:
+    """`cfmpa selftest --code`: the table, and JSON if asked; 0 iff cfmpa prove caught every
+    mutant run (1 otherwise)."""
+    from ..files import write_bytes_atomic
+
+    _chosen(names, checks)
+    print(f"seeded source mutations of a copy of the packages; checks: {', '.join(checks)}",
+          flush=True)
+    if prove_only:
+        print(f"cfmpa prove on {', '.join(prove_only)} only (not the whole run)")
+    rows = code_mutation_rows(names, checks=checks, prove_only=prove_only, stream=sys.stdout)
+    print(code_mutation_table(rows))
+    if json_out is not None:
+        doc = {"checks": list(checks), "prove_only": list(prove_only), "mutants": [{"mutant": r.mutant, "what": r.what, "caught": r.caught,
+                            "detail": r.detail, "seconds": r.seconds} for r in rows]}
+        write_bytes_atomic(json_out, (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode())
+    if "prove" not in checks:
+        return 0
+    missed = [r.mutant for r in rows if not r.caught.get("prove")]
+    if missed:
+        print(f"NOT CAUGHT by cfmpa prove: {', '.join(missed)}")
+        return 1
+    return 0

@@ -1,0 +1,74 @@
+"""`cfmpa selftest --code`: source mutations of a copy, run in processes that import the copy."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cfmpa.cli import main
+from cfmpa.errors import InputError
+from cfmpa.runs import CODE_MUTANTS, CodeMutant, code_mutation_rows, mutated_copy
+from cfmpa.runs._code_mutants import _check_prove, _env
+
+REPO = Path(__file__).resolve().parents[2]
+#: The smallest bundled workcell's translation checks: seconds, where the whole prove is a minute.
+QUICK = ["Scenario.narrow-gap.translation_original"]
+
+
+@pytest.mark.parametrize("m", CODE_MUTANTS, ids=[m.name for m in CODE_MUTANTS])
+def test_each_mutant_is_one_real_edit_of_todays_source(m: CodeMutant, tmp_path: Path):
+    copy = mutated_copy(m, tmp_path)
+    original = (REPO / m.file).read_text()
+    mutated = (copy / "cfmpa" / m.file).read_text()
+    assert mutated != original
+    for old, new in m.edits:
+        assert original.count(old) == 1 and new in mutated
+    compile(mutated, m.file, "exec")          # still Python: the checks must judge it
+
+
+def test_the_copy_is_what_the_processes_import(tmp_path: Path):
+    copy = mutated_copy(CODE_MUTANTS[0], tmp_path)
+    p = subprocess.run([sys.executable, "-c", "import cfmpa.impl, cfmpa.spec; "
+                        "print(cfmpa.impl.__file__); print(cfmpa.spec.__file__)"],
+                       env=_env(copy), cwd=tmp_path, capture_output=True, text=True, check=True)
+    files = [Path(x) for x in p.stdout.split()]
+    assert all(f.is_relative_to(copy) for f in files), files
+
+
+def test_an_edit_that_does_not_match_once_is_refused(tmp_path: Path):
+    ghost = CodeMutant("ghost", "no such text", "impl/_regions.py", (("no such text", "x"),))
+    with pytest.raises(InputError, match="matches 0 times"):
+        mutated_copy(ghost, tmp_path)
+
+
+@pytest.mark.slow     # two prove runs in fresh copies, each compiling the kernels: about a minute
+def test_prove_passes_on_the_unmutated_copy_and_catches_the_free_rest_layer(tmp_path: Path):
+    # The same check on the copy with no edit passes: what it catches is the mutant's doing.
+    clean = mutated_copy(None, tmp_path / "clean")
+    (tmp_path / "w1").mkdir()
+    assert _check_prove(clean, tmp_path / "w1", QUICK) == (False, "every verdict as expected")
+    rows = code_mutation_rows(["rest_layer_free"], checks=("prove",), prove_only=QUICK)
+    assert rows[0].caught == {"prove": True}
+    assert "Scenario.narrow-gap.translation_original" in rows[0].detail["prove"]
+
+
+def test_bad_options_exit_2_naming_the_field(capsys: pytest.CaptureFixture[str]):
+    assert main(["selftest", "--code", "--mutant", "nope"]) == 2
+    assert "--mutant is not one of rest_layer_free" in capsys.readouterr().err
+    assert main(["selftest", "--code", "--checks", "prove,bogus"]) == 2
+    assert "--checks is not one of prove, contracts, tests, got 'bogus'" in capsys.readouterr().err
+    assert main(["selftest", "--json", "x.json"]) == 2
+    assert "--json is an option of --code" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_cfmpa_prove_catches_every_mutant(tmp_path: Path):
+    out = tmp_path / "mutants.json"
+    assert main(["selftest", "--code", "--checks", "prove", "--json", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert [r["mutant"] for r in doc["mutants"]] == [m.name for m in CODE_MUTANTS]
+    assert all(r["caught"]["prove"] for r in doc["mutants"])
