@@ -61,3 +61,14 @@ def edited(text: str, *pairs: tuple[str, str]) -> str:
         assert old in text, f"{old!r} is not in the text being edited"
         text = text.replace(old, new)
     return text
+
+
+def tiny_default(folder: Path) -> Path:
+    """folder/tiny.toml: the former default at dt = 0.125 s (a grid planned in a blink), for
+    report tests that need a workcell of their own."""
+    text = edited(FORMER_DEFAULT.read_text(), ('name = "former-default"', 'name = "tiny-default"'),
+                  ("dt = 0.02", "dt = 0.125"), ("start_cell = [40, 100]", "start_cell = [6, 16]"),
+                  ("goal_cell = [150, 60]", "goal_cell = [24, 10]"))
+    p = folder / "tiny.toml"
+    p.write_text(text)
+    return p

@@ -58,13 +58,7 @@ EXPECTED = [i for i in expected_ids(ROOT / "scenarios") if selected(i, OBLIGATIO
 
 @pytest.fixture(scope="module")
 def tiny_file(tmp_path_factory):
-    text = factory.FORMER_DEFAULT.read_text()
-    p = tmp_path_factory.mktemp("scen") / "tiny.toml"
-    p.write_text(factory.edited(text, ('name = "former-default"', 'name = "tiny-default"'),
-                                ("dt = 0.02", "dt = 0.125"),
-                                ("start_cell = [40, 100]", "start_cell = [6, 16]"),
-                                ("goal_cell = [150, 60]", "goal_cell = [24, 10]")))
-    return p
+    return factory.tiny_default(tmp_path_factory.mktemp("scen"))
 
 
 @pytest.fixture(scope="module")
