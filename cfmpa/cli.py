@@ -6,9 +6,10 @@ Exit codes: 0 success, 1 a check failed (a violation, a failed proof), 2 bad inp
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -168,17 +169,59 @@ def cmd_prove(args: argparse.Namespace) -> int:
     if args.only and args.audit is not None:
         # A report a reviewer trusts is of a whole run: a selection would show the rest missing.
         raise InputError("--audit", args.audit, "needs every obligation; run it without --only")
-    code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
-                     repin=args.repin)
     if args.audit is None:
-        return code
+        return run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
+                         repin=args.repin)
+    import multiprocessing
+
+    from .impl import progress_silenced
     from .report import run_audit
 
-    print()
-    audit = run_audit(None, args.audit, argv=["cfmpa", *args.argv],
-                      proofs_json=str(Path(args.out) / "results.json"),
-                      scenarios_dir=args.scenarios)
-    return code or audit
+    # The report's plans, pictures and campaign need no proof: a second process (forked, so it
+    # starts at once with everything imported) computes them while this one discharges the
+    # obligations, and reads results.json only once the gate opens. If the prove run stops with
+    # an error, the gate opens with `stopped` set and the report process ends writing nothing.
+    results = str(Path(args.out) / "results.json")
+    mp = multiprocessing.get_context("fork")
+    gate, stopped = mp.Event(), mp.Event()
+
+    def proofs_ready() -> str:
+        gate.wait()
+        if stopped.is_set():
+            raise InputError("--audit", args.audit, "not written: the prove run stopped")
+        return results
+
+    def audit() -> None:
+        try:
+            code = run_audit(None, args.audit, argv=["cfmpa", *args.argv],
+                             proofs_json=proofs_ready, scenarios_dir=args.scenarios)
+        except BaseException as exc:   # said after the proofs, or not at all if they stopped
+            gate.wait()
+            if stopped.is_set():
+                os._exit(1)
+
+            def again() -> int:
+                raise exc
+            code = _handled(again)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+
+    with progress_silenced():          # two processes' bars would cut up the summary
+        worker = mp.Process(target=audit, name="cfmpa-audit", daemon=True)
+        worker.start()
+        try:
+            code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
+                             repin=args.repin)
+        except BaseException:
+            stopped.set()
+            gate.set()
+            worker.join(timeout=5)
+            raise
+        print(flush=True)
+        gate.set()
+        worker.join()
+    return code or worker.exitcode or 0
 
 
 def cmd_audit(args: argparse.Namespace) -> int:
@@ -433,8 +476,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     # The provenance records what this call was given, not the process's sys.argv.
     args.argv = list(sys.argv[1:] if argv is None else argv)
+    return _handled(lambda: args.func(args))
+
+
+def _handled(run: Callable[[], int]) -> int:
+    """``run()``'s exit code; an error becomes its message on stderr and its exit code."""
     try:
-        return int(args.func(args))
+        return int(run())
     except InputError as exc:
         print(exc.render(), file=sys.stderr)
         return exc.exit_code

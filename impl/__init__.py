@@ -8,6 +8,7 @@ from ._fast_builtdr import build_dr_fast
 from ._fast_search import search_opt_path_fast
 from ._kernels import KERNELS, kernel_name, kernels
 from ._kinematics import link_reach, link_rectangles
+from ._progress import progress_default, progress_silenced
 from ._search import search_opt_path
 from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
 
@@ -15,6 +16,6 @@ __all__ = [
     "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "RightRegions", "build_dr",
     "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly", "containment_slack", "convex_hull",
     "kernel_name", "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
-    "naive_hull", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
+    "naive_hull", "progress_default", "progress_silenced", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
     "swept_region",
 ]

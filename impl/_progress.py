@@ -6,12 +6,15 @@ pipes and tests stay clean; ``progress=True`` forces it, ``False`` silences it.
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
+from collections.abc import Iterator
 from types import TracebackType
 from typing import TextIO
 
-__all__ = ["PROGRESS_MIN_CELLS", "Progress", "progress_bar"]
+__all__ = ["PROGRESS_MIN_CELLS", "Progress", "progress_bar", "progress_default",
+           "progress_silenced"]
 
 #: Grids of at least this many cells ((N + 1) * m * n) get a bar when stderr is a terminal. The
 #: default scenario (about 7.2 million cells) is just above it; small test grids stay silent.
@@ -67,11 +70,34 @@ class Progress:
         self.close()
 
 
+#: What ``progress=None`` means while ``progress_silenced`` is in force (False), else None.
+_DEFAULT: list[bool | None] = [None]
+
+
+def progress_default() -> bool | None:
+    """False inside ``progress_silenced`` (every bar asked with progress=None stays silent)."""
+    return _DEFAULT[0]
+
+
+@contextlib.contextmanager
+def progress_silenced() -> Iterator[None]:
+    """No bar drawn unless asked for with progress=True, in every thread: for runs whose output
+    a bar would cut up (`cfmpa prove --audit`, where the report is computed beside the proofs)."""
+    before = _DEFAULT[0]
+    _DEFAULT[0] = False
+    try:
+        yield
+    finally:
+        _DEFAULT[0] = before
+
+
 def progress_bar(label: str, total: int, cells: int, progress: bool | None = None,
                  stream: TextIO | None = None) -> Progress:
     """A bar on ``stream`` (default stderr): drawn if ``progress`` is True, or if it is None and
     the stream is a terminal and ``cells >= PROGRESS_MIN_CELLS``; silent otherwise."""
     out = sys.stderr if stream is None else stream
+    if progress is None:
+        progress = _DEFAULT[0]
     if progress is None:
         isatty = getattr(out, "isatty", None)
         progress = bool(isatty is not None and isatty()) and cells >= PROGRESS_MIN_CELLS

@@ -145,14 +145,14 @@ def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
     build, search = kernels("fast")
     g = make_grid(s)
     start, goal = s.right.start_cell, s.right.goal_cell
-    dr = build(s, variant, g)
+    dr = build(s, variant, g, progress=False)
     fails = dr_shape_failures(g, dr)
     checked = 0
     if not fails:
         checked, fails = dr_cell_failures(s, variant, g, dr)
     answer = None
     if not fails:
-        answer = search(dr, start, goal, with_witness=True)
+        answer = search(dr, start, goal, with_witness=True, progress=False)
         fails = (search_failures(dr, start, goal, answer)
                  or check_witness(dr, start, goal, answer, answer.witness))
     digest = hashlib.sha256(dr.tobytes()).hexdigest()[:16]

@@ -79,7 +79,8 @@ def default_scenarios_dir() -> Path:
 
 
 def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | None = None,
-              proofs_json: str | None = None, scenarios_dir: str | None = None,
+              proofs_json: str | Callable[[], str] | None = None,
+              scenarios_dir: str | None = None,
               contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
               compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> int:
     """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
@@ -111,10 +112,12 @@ def write_report(result: AuditResult, out_dir: str | Path) -> tuple[Path, Path]:
 
 
 def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None = None,
-                proofs_json: str | None = None, scenarios_dir: str | None = None,
+                proofs_json: str | Callable[[], str] | None = None,
+              scenarios_dir: str | None = None,
                 contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
                 compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> AuditResult:
-    """Compute everything the report shows (no files written)."""
+    """Compute everything the report shows (no files written). A callable ``proofs_json`` is
+    called for the results.json path once everything else is computed."""
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
     paths = _scenario_paths(scenarios, sdir)
     loaded = [load_scenario(p) for p in paths]          # input errors before any work
@@ -128,20 +131,24 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
         raise InputError("compare_n", compare_n, "must be an integer >= 0 (0: no campaign)")
     plans = _Plans(contracts)
     figures: dict[str, F.Figure] = {}
-
-    # The user's workcells are the ones to prove: given files bring their own per-scenario
-    # obligations (the bundled set, by default, its pinned ones).
-    proofs = load_proofs(proofs_json, sdir, expected_ids,
-                         files=paths if scenarios else None)
-    doc = {
-        "format": FORMAT,
-        "provenance": provenance(argv, loaded),
-        **_proof_sections(proofs),
+    # The plans, pictures and campaign first: they do not need the proofs, so `cfmpa prove
+    # --audit` computes them while the obligations are discharged (``proofs_json`` callable).
+    parts = {
         "findings": _findings(sdir, loaded, plans, figures),
         "selftest": load_selftest(),
         "scenarios": [_scenario_entry(s, plans, figures) for s in loaded],
         "monitor": _monitor(sdir, loaded, plans, figures),
         "compare": _compare(compare_n, compare_seed, figures),
+    }
+    # The user's workcells are the ones to prove: given files bring their own per-scenario
+    # obligations (the bundled set, by default, its pinned ones).
+    proofs = load_proofs(proofs_json() if callable(proofs_json) else proofs_json, sdir,
+                         expected_ids, files=paths if scenarios else None)
+    doc = {
+        "format": FORMAT,
+        "provenance": provenance(argv, loaded),
+        **_proof_sections(proofs),
+        **parts,
     }
     _relate(doc["findings"], proofs)
     doc["triples"] = _triples(plans)

@@ -32,7 +32,7 @@ from ._trajectory_runs import (BLOCK_ROWS, Excursion, MonitorResult, certify_jso
                                monitor_json, monitor_log, parse_excursion, run_certify,
                                run_monitor, run_simulate, simulate_log)
 from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
-                            code_mutation_rows, code_mutation_table, mutated_copy,
+                            code_mutation_rows, code_mutation_table, imports_copy, mutated_copy,
                             run_code_selftest)
 from ._selftest import (FAULTS, SAMPLE, WORKCELLS, Fault, SelftestRow, run_fault, run_selftest,
                         selftest_rows, selftest_table, workcell)
@@ -56,5 +56,5 @@ __all__ = [
     "selftest_rows", "selftest_table", "workcell",
     # seeded mutations of the source (cfmpa selftest --code)
     "CODE_CHECKS", "CODE_MUTANTS", "CodeMutant", "CodeRow", "code_mutation_rows",
-    "code_mutation_table", "mutated_copy", "run_code_selftest",
+    "code_mutation_table", "imports_copy", "mutated_copy", "run_code_selftest",
 ]

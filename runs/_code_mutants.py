@@ -22,10 +22,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..errors import InputError
+from ..errors import CfmpaError, InputError
 
 __all__ = ["CODE_CHECKS", "CODE_MUTANTS", "CodeMutant", "CodeRow", "code_mutation_table",
-           "code_mutation_rows", "mutated_copy", "run_code_selftest"]
+           "code_mutation_rows", "imports_copy", "mutated_copy", "run_code_selftest"]
 
 
 @dataclass(frozen=True)
@@ -159,6 +159,21 @@ def _env(copy: Path) -> dict[str, str]:
     return env
 
 
+def _python(copy: Path) -> list[str]:
+    """The interpreter, with -P: the working folder is not put first on the path, so a process
+    started in a checkout imports the copy, not the checkout's cfmpa/ folder."""
+    return [sys.executable, "-P"]
+
+
+def imports_copy(copy: Path, cwd: Path) -> bool:
+    """Whether a process started as the checks start theirs (in ``cwd``) imports the copy's
+    cfmpa and cfmpa.impl."""
+    code, text = _run([*_python(copy), "-c", "import cfmpa, cfmpa.impl; "
+                       "print(cfmpa.__file__); print(cfmpa.impl.__file__)"], copy, cwd, 120)
+    files = [Path(x) for x in text.split()]
+    return code == 0 and len(files) == 2 and all(f.is_relative_to(copy) for f in files)
+
+
 def _run(cmd: Sequence[str], copy: Path, cwd: Path, timeout_s: float) -> tuple[int, str]:
     try:
         p = subprocess.run(list(cmd), cwd=cwd, env=_env(copy), capture_output=True, text=True,
@@ -171,7 +186,7 @@ def _run(cmd: Sequence[str], copy: Path, cwd: Path, timeout_s: float) -> tuple[i
 def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool | None, str]:
     out = work / "proofs"
     select = [a for i in only for a in ("--only", i)]
-    code, text = _run([sys.executable, "-m", "cfmpa", "prove", "--out", str(out), *select],
+    code, text = _run([*_python(copy), "-m", "cfmpa", "prove", "--out", str(out), *select],
                       copy, work, 1800)
     if code not in (0, 1):
         return None, f"cfmpa prove exited {code}: {text.strip().splitlines()[-1:]}"
@@ -188,7 +203,7 @@ def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool
 
 
 def _check_contracts(copy: Path, work: Path) -> tuple[bool | None, str]:
-    code, text = _run([sys.executable, "-c", _CONTRACTS_SCRIPT], copy, work, 1800)
+    code, text = _run([*_python(copy), "-c", _CONTRACTS_SCRIPT], copy, work, 1800)
     try:
         found = json.loads(text.strip().splitlines()[-1])
     except (ValueError, IndexError):
@@ -202,9 +217,9 @@ def _check_tests(copy: Path, work: Path, tests_dir: Path | None) -> tuple[bool |
     if tests_dir is None:
         return None, "not run: no tests/ folder (not a checkout)"
     folders = [str(tests_dir / f) for f in TEST_FOLDERS]
-    code, text = _run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
-                       "--rootdir", str(tests_dir.parent), *folders], copy, tests_dir.parent,
-                      3600)
+    # Started in the work folder, not the checkout (whose cfmpa/ folder would be found first).
+    code, text = _run([*_python(copy), "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+                       "--rootdir", str(tests_dir.parent), *folders], copy, work, 3600)
     lines = text.strip().splitlines()
     failing = [ln for ln in lines if ln.startswith(("FAILED", "ERROR"))]
     if code == 0:
@@ -249,6 +264,9 @@ def code_mutation_rows(names: Sequence[str] | None = None, *,
             copy = mutated_copy(m, Path(tmp) / "src")
             work = Path(tmp) / "work"
             work.mkdir()
+            if not imports_copy(copy, work):
+                raise CfmpaError(f"a process started in {work} does not import the copy in "
+                                 f"{copy}: the mutant would not be what the checks run")
             for c in checks:
                 t0 = time.perf_counter()
                 if c == "prove":
@@ -276,8 +294,9 @@ def code_mutation_table(rows: Sequence[CodeRow]) -> str:
     for r in rows:
         out.append(f"{r.mutant:<{width}}  " + "  ".join(
             f"{word[r.caught[c]] if c in r.caught else '':<9}" for c in checks))
-    score = sum(1 for r in rows if r.caught.get("prove"))
-    out.append(f"cfmpa prove caught {score} of {len(rows)} mutants")
+    if "prove" in checks:
+        score = sum(1 for r in rows if r.caught.get("prove"))
+        out.append(f"cfmpa prove caught {score} of {len(rows)} mutants")
     return "\n".join(out)
 
 
@@ -296,9 +315,11 @@ def run_code_selftest(names: Sequence[str] | None = None, *,
     rows = code_mutation_rows(names, checks=checks, prove_only=prove_only, stream=sys.stdout)
     print(code_mutation_table(rows))
     if json_out is not None:
-        doc = {"checks": list(checks), "prove_only": list(prove_only), "mutants": [{"mutant": r.mutant, "what": r.what, "caught": r.caught,
+        doc = {"checks": list(checks), "prove_only": list(prove_only),
+               "mutants": [{"mutant": r.mutant, "what": r.what, "caught": r.caught,
                             "detail": r.detail, "seconds": r.seconds} for r in rows]}
-        write_bytes_atomic(json_out, (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode())
+        text = json.dumps(doc, indent=1, sort_keys=True) + "\n"
+        write_bytes_atomic(json_out, text.encode())
     if "prove" not in checks:
         return 0
     missed = [r.mutant for r in rows if not r.caught.get("prove")]

@@ -31,6 +31,7 @@ from typing import Any, TextIO
 from urllib.parse import urlsplit
 
 from ..errors import CfmpaError, InputError
+from ..impl import progress_default
 
 __all__ = ["CONNECT_TIMEOUT_S", "RETRIES", "SCHEMES", "Engine", "ProgressBar", "TaskLost",
            "check_scheduler_address", "error_message"]
@@ -104,6 +105,8 @@ class ProgressBar:
         """A bar on ``stream`` (default stderr) if ``progress`` is True, or None and the stream
         is a terminal; silent otherwise (logs, pipes and tests stay clean)."""
         out = sys.stderr if stream is None else stream
+        if progress is None:
+            progress = progress_default()
         if progress is None:
             isatty = getattr(out, "isatty", None)
             progress = bool(isatty is not None and isatty())

@@ -194,6 +194,15 @@ def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_pa
         assert plan_doc["contracts"]["violations"][-1]["triple"] == "continuous-time certificate"
 
 
+def test_prove_with_a_bad_scenarios_folder_writes_no_report(tmp_path, capsys):
+    # The report is computed beside the proofs; a prove run that stops leaves nothing written.
+    code = main(["prove", "--scenarios", str(tmp_path / "none"), "--out", str(tmp_path / "p"),
+                 "--audit", str(tmp_path / "a")])
+    err = capsys.readouterr().err
+    assert code == 2 and "--scenarios" in err and "Traceback" not in err
+    assert not (tmp_path / "a").exists()
+
+
 def test_prove_refuses_an_audit_of_a_partial_run(tmp_path, capsys):
     # --only with --audit would write a report of a selection: refused before any work.
     code = main(["prove", "--only", "Prop8", "--out", str(tmp_path / "p"), "--audit",

@@ -110,6 +110,9 @@ def test_a_scenario_that_does_not_load_fails_instead_of_vanishing(tmp_path: Path
                                   "translation_tight")}
 
 
+# A whole run (about a minute): `make prove` is this run, and CI runs it again from the wheel
+# (tests/test_wheel.py); kept behind the marker so that make test stays under ten minutes.
+@pytest.mark.slow
 def test_full_run_discharges_everything_as_expected(tmp_path: Path):
     out = io.StringIO()
     rc = run_prove(out_dir=tmp_path, scenarios_dir=REPO / "scenarios", stream=out)

@@ -11,7 +11,7 @@ import pytest
 
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.runs import CODE_MUTANTS, CodeMutant, code_mutation_rows, mutated_copy
+from cfmpa.runs import CODE_MUTANTS, CodeMutant, code_mutation_rows, imports_copy, mutated_copy
 from cfmpa.runs._code_mutants import _check_prove, _env
 
 REPO = Path(__file__).resolve().parents[2]
@@ -30,13 +30,18 @@ def test_each_mutant_is_one_real_edit_of_todays_source(m: CodeMutant, tmp_path: 
     compile(mutated, m.file, "exec")          # still Python: the checks must judge it
 
 
-def test_the_copy_is_what_the_processes_import(tmp_path: Path):
-    copy = mutated_copy(CODE_MUTANTS[0], tmp_path)
-    p = subprocess.run([sys.executable, "-c", "import cfmpa.impl, cfmpa.spec; "
-                        "print(cfmpa.impl.__file__); print(cfmpa.spec.__file__)"],
-                       env=_env(copy), cwd=tmp_path, capture_output=True, text=True, check=True)
-    files = [Path(x) for x in p.stdout.split()]
-    assert all(f.is_relative_to(copy) for f in files), files
+@pytest.mark.parametrize("where", ["work", "checkout"])
+def test_the_copy_is_what_the_processes_import(tmp_path: Path, where: str):
+    # Even started in the checkout, whose cfmpa/ folder a plain `python -c` would import first
+    # (the first version of the tests check ran there and judged the original).
+    copy = mutated_copy(CODE_MUTANTS[0], tmp_path / "copy")
+    cwd = REPO if where == "checkout" else tmp_path
+    assert imports_copy(copy, cwd)
+    p = subprocess.run([sys.executable, "-P", "-c", "import cfmpa.impl._fast_builtdr as f; "
+                        "print(f.__file__); print('# mutant' in open(f.__file__).read())"],
+                       env=_env(copy), cwd=cwd, capture_output=True, text=True, check=True)
+    file, mutated = p.stdout.split()
+    assert Path(file).is_relative_to(copy) and mutated == "True"
 
 
 def test_an_edit_that_does_not_match_once_is_refused(tmp_path: Path):
