@@ -7,9 +7,9 @@ Items slower than their time budget get fewer runs; the table says how many. --q
 run on a coarse grid (one run each, one process for all in-process items, so its memory column
 is that process's high-water mark so far; no warm-up). Never imported by the package.
 
-The table ends with the targets the open issues name (``targets``: issue 13's, issue 17's
-monitor throughput, issues 12/14's `make prove` time), each met or missed, and an informational
-section of former targets no issue names any more. ``builtdr_profile`` splits BuiltDR fast into
+The table ends with the project's performance targets (``targets``: full checking's,
+the monitor's throughput, `make prove`'s time), each met or missed, and an informational
+section of former targets. ``builtdr_profile`` splits BuiltDR fast into
 its stages (the numbers behind the 0.15 s target's note). `make prove` itself (`cfmpa prove
 --audit DIR`, one run, a minute or two) is measured only with --prove, which `make bench` passes.
 
@@ -54,7 +54,7 @@ class Config:
     scaling_dts: tuple[float, ...] = (0.04, 0.02, 0.01)
     one_degree: dict[str, Any] = field(default_factory=dict)
     prove: bool = False                    # time `make prove` (cfmpa prove --audit): one run
-    monitor_samples: int = 1_000_000       # the monitor's log (issue 17: 10^6 samples)
+    monitor_samples: int = 1_000_000       # the monitor's log (10^6 samples)
 
     @classmethod
     def of(cls, quick: bool, runs: int | None, prove: bool = False) -> Config:
@@ -221,7 +221,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
                "contracts": "sampled"}]
     # Contract overhead on the default grid itself, in process (imports and interpreter start
     # excluded, so the ratio is the checks' own cost). Every mode gets the same warm-up and
-    # runs: full checks through the witness in seconds now (issue 13), and a first run without
+    # runs: full checks through the witness in seconds now, and a first run without
     # warm-up would charge it the kernels' and the spec's first-call costs that off is spared.
     items += [{"kind": "plan_fast", "scenario": base, "variant": "modified", "contracts": mode}
               for mode in CONTRACT_MODES]
@@ -324,7 +324,7 @@ def check_section(cfg: Config, tmp: Path, toml: Path, default_mode: str | None,
     """`cfmpa check` of a good plan: the dr.npy and plan.json that `cfmpa plan` wrote in its
     default contract mode (the last run of that mode above), no witness given, so check
     computes one with the fast search and verifies it with the spec's checker, as for another
-    planner's files (issue 13). Fresh processes; exit 0 (every check holds) is required."""
+    planner's files. Fresh processes; exit 0 (every check holds) is required."""
     if not cli_has("check"):
         return skipped("no `cfmpa check` in this checkout")
     mode = default_mode if default_mode in plan_cli else "sampled"
@@ -602,47 +602,47 @@ def stage_note(timings: dict[str, float] | None, wall: float | None) -> str:
 
 
 def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
-    """The targets the open issues name, against this run's medians (meaningful on the full run
-    only): issue 13's, issue 17's monitor throughput and memory, issues 12/14's `make prove`."""
+    """The performance targets, against this run's medians (meaningful on the full run only):
+    full checking's, the monitor's throughput and memory, `make prove`'s time."""
     rows: list[dict[str, Any]] = []
     fresh = "fresh process"
 
-    # issue 13: cfmpa check of a good plan
+    # full checking: cfmpa check of a good plan
     chk = res.get("check", {})
     what = (f"`cfmpa check` of a good plan (`cfmpa plan --contracts "
             f"{chk.get('plan_contracts', '?')}`'s dr.npy and plan.json, no witness: check "
             "computes one and verifies it), default scenario, " + fresh)
-    rows.append(row("issue 13: cfmpa check, good plan (s)", med(chk), 5.0,
+    rows.append(row("full checking: cfmpa check, good plan (s)", med(chk), 5.0,
                     note=failed(chk) or what))
-    rows.append(row("issue 13: cfmpa check, good plan (peak MiB)",
+    rows.append(row("full checking: cfmpa check, good plan (peak MiB)",
                     chk.get("peak_rss_mb") if "median_s" in chk else None, GIB,
                     note=failed(chk) or what + "; peak resident memory (ru_maxrss)"))
 
-    # issue 13: full / off in process
+    # full checking: full / off in process
     c = res["contracts"]
     ip = c["in_process"]
     ratio = c.get("ratios", {}).get("full_over_off")
-    rows.append(row("issue 13: plan() contracts full / off, in process (x)", ratio, 5.0,
+    rows.append(row("full checking: plan() contracts full / off, in process (x)", ratio, 5.0,
                     note=(f"plan() in process, default scenario, modified: full "
                           f"{med(ip['full']):.3f} s / off {med(ip['off']):.3f} s (medians)"
                           if ratio is not None else failed(ip["full"]) or failed(ip["off"]))))
 
-    # issue 13: BuiltDR fast, slowest variant, in process
+    # full checking: BuiltDR fast, slowest variant, in process
     fast = {v: res["builtdr"][v]["fast"].get("median_s") for v in VARIANTS}
     slowest = max(fast, key=lambda v: fast[v] or -1.0)
-    rows.append(row("issue 13: BuiltDR fast, slowest variant, in process (s)", fast[slowest],
+    rows.append(row("full checking: BuiltDR fast, slowest variant, in process (s)", fast[slowest],
                     0.15, note=f"build_dr_fast in process, right regions included; slowest "
                                f"{slowest} (" + ", ".join(f"{v} {fast[v]:.3f}" for v in VARIANTS)
                                + "); " + profile_note(res, slowest)))
 
-    # issue 13: cfmpa dr whole process vs the shapely-vectorised peer
+    # full checking: cfmpa dr whole process vs the shapely-vectorised peer
     dr = res.get("dr_cli", {})
     nan = float("nan")
     sh = res["shapely"]
     peer = sh["vectorised_intersects"]["median_s"]
     dw = sh["vectorised_dwithin"]["extrapolated_full_grid_s"]
     speed = peer / dr["median_s"] if "median_s" in dr else None
-    rows.append(row("issue 13: shapely-vectorised peer / cfmpa dr (x)", speed, 10.0, False,
+    rows.append(row("full checking: shapely-vectorised peer / cfmpa dr (x)", speed, 10.0, False,
                     note=failed(dr) or
                     (f"`cfmpa dr --variant {dr.get('variant')}` {fresh} {dr['median_s']:.3f} s "
                      f"against the bench's shapely-vectorised peer (shapely.intersects on "
@@ -651,13 +651,13 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
                      f"project's rule, extrapolated: {dw:.3f} s ({dw / dr['median_s']:.1f}x); "
                      f"in process BuiltDR fast {fast.get(dr.get('variant'), nan):.3f} s")))
 
-    # issue 13: cfmpa plan end to end in the CLI's default contract mode
+    # full checking: cfmpa plan end to end in the CLI's default contract mode
     mode = res["plan"].get("cli_default_contracts")
     cli = res["contracts"].get("cli", {})
     plan_d = cli.get(mode) if isinstance(cli, dict) and mode in CONTRACT_MODES else None
     others = ", ".join(f"--contracts {m} {med(cli[m]):.3f} s" for m in ("sampled", "full")
                        if isinstance(cli, dict) and med(cli.get(m)) is not None)
-    rows.append(row(f"issue 13: cfmpa plan end to end, default --contracts {mode} (s)",
+    rows.append(row(f"full checking: cfmpa plan end to end, default --contracts {mode} (s)",
                     med(plan_d), 1.5,
                     note=failed(plan_d) or
                     (f"`cfmpa plan` {fresh}, default scenario, certificate included; "
@@ -665,14 +665,14 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
                      f"time); measured: {others}"
                      + stage_note(plan_d.get("timings_s"), med(plan_d)))))
 
-    # issue 17: cfmpa monitor
+    # monitoring: cfmpa monitor
     mon = res.get("monitor", {})
     big = mon.get("log", {}) if isinstance(mon.get("log"), dict) else {}
     tenth = mon.get("log_tenth", {}) if isinstance(mon.get("log_tenth"), dict) else {}
     n = big.get("samples", cfg.monitor_samples)
     why = failed(big.get("cli")) if big else str(mon.get("skipped") or mon.get("error") or "")
     wall = med(big.get("cli")) if big else None
-    rows.append(row(f"issue 17: cfmpa monitor, {n:,}-sample log (samples/s)",
+    rows.append(row(f"monitoring: cfmpa monitor, {n:,}-sample log (samples/s)",
                     big.get("cli_samples_per_s"), 100_000.0, False,
                     wall_s=wall, peak_rss_mb=big.get("peak_rss_mb"),
                     note=why or (f"whole `cfmpa monitor` process: wall {wall:.3f} s, peak "
@@ -680,16 +680,16 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
                                  f"{big['samples_per_s']:,.0f} samples/s (its timings_s.monitor); "
                                  f"status {big.get('status')}")))
     growth = mon.get("peak_growth_mb")
-    rows.append(row(f"issue 17: cfmpa monitor peak growth, {n // 10:,} -> {n:,} samples (MiB)",
+    rows.append(row(f"monitoring: cfmpa monitor peak growth, {n // 10:,} -> {n:,} samples (MiB)",
                     growth, 16.0,
                     note=why or (f"bounded memory: peak {tenth.get('peak_rss_mb')} MiB on the "
                                  f"{n // 10:,}-sample log, {big.get('peak_rss_mb')} MiB on the "
                                  f"{n:,}-sample log ({big.get('bytes', 0) / 2**20:.0f} MiB of "
-                                 "CSV); the issue says bounded and names no number: the limit "
+                                 "CSV); the requirement says bounded and names no number: the limit "
                                  "is the bench's (reading the log whole would add more than the "
                                  "log's size)")))
 
-    # issues 12/14: make prove
+    # proving: make prove
     pv = res.get("prove", {})
     what = "`cfmpa prove --audit DIR` (make prove) as one " + fresh + ", one run"
     if "median_s" in pv:
@@ -701,8 +701,8 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
         note = f"{what}; it FAILED ({str(pv.get('error'))[:160]})"
     else:
         seconds, note = None, failed(pv)
-    rows.append(row("issues 12/14: make prove, whole process (s)", seconds, 120.0, note=note))
-    rows.append(row("issue 12: make prove, obligations alone (s)", pv.get("obligations_s"), 60.0,
+    rows.append(row("proving: make prove, whole process (s)", seconds, 120.0, note=note))
+    rows.append(row("proving: make prove, obligations alone (s)", pv.get("obligations_s"), 60.0,
                     note=(failed(pv) or pv.get("obligations_error", "")
                           if pv.get("obligations_s") is None else
                           "the same run's results.json `seconds`: the obligations' discharge as "
@@ -717,18 +717,18 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
 
 
 #: The rows of `make prove`, whose command does not depend on the bench's grid.
-PROVE_ROWS = ("issues 12/14: make prove", "issue 12: make prove")
+PROVE_ROWS = ("proving: make prove",)
 
 
 def informational(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
-    """Former targets that no open issue names any more, kept as information (``limit``: the
+    """Former targets, no longer required, kept as information (``limit``: the
     former limit; ``met`` against it)."""
     sh = res["shapely"]["ratios"]
     one = res["one_degree"]
     rows = [
         row("BuiltDR fast, slowest variant (s)",
             max(res["builtdr"][v]["fast"]["median_s"] for v in VARIANTS), 0.5,
-            note="in process, right regions included; superseded by issue 13's 0.15 s"),
+            note="in process, right regions included; superseded by the 0.15 s target"),
         row("BuiltDR fast vs per-cell shapely loop (x)", sh["loop_over_ours"], 1000, False,
             note="in process, both given the same regions; extrapolated from the sample"),
         row("BuiltDR fast vs vectorised shapely intersects (x)", sh["intersects_over_ours"], 10,
@@ -832,11 +832,11 @@ def table(res: dict[str, Any]) -> str:
         lines += campaign_lines(camp)
     lines += profile_lines(res.get("builtdr_profile"))
     lines.append("")
-    lines.append("targets (the open issues'; measured, limit, verdict, what was measured):")
+    lines.append("targets (measured, limit, verdict, what was measured):")
     lines += target_lines(res["targets"])
     if res.get("informational"):
         lines.append("")
-        lines.append("informational (former targets, named by no open issue; former limit):")
+        lines.append("informational (former targets; former limit):")
         lines += target_lines(res["informational"])
     return "\n".join(lines)
 

@@ -90,9 +90,9 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     assert "BuiltDR fast profile" in proc.stdout and "results.json" in proc.stdout
 
 
-#: The open issues' targets, in the table's order: issue 13 (check s, check MiB, full/off,
-#: BuiltDR s, peer/dr, plan s), issue 17 (monitor samples/s, its peak growth), issues 12/14
-#: (make prove s, obligations alone s).
+#: The targets, in the table's order: full checking (check s, check MiB, full/off, BuiltDR s,
+#: peer/dr, plan s), monitoring (samples/s, its peak growth), proving (make prove s,
+#: obligations alone s).
 LIMITS = [5.0, 1024.0, 5.0, 0.15, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0]
 
 
@@ -140,7 +140,7 @@ def test_targets_are_the_issues_with_their_limits_and_verdicts():
                                              90.0, 70.0]
     assert [r["met"] for r in rows] == [True, False, True, False, False, False, True, True, True,
                                         False]
-    assert "issue 13" in rows[0]["target"] and "issue 17" in rows[6]["target"]
+    assert "full checking" in rows[0]["target"] and "monitoring" in rows[6]["target"]
     assert "make prove" in rows[8]["target"]
     # The BuiltDR miss is explained by the profile; the slowest variant is the one measured.
     assert "modified" in rows[3]["note"] and "right regions 0.190 s" in rows[3]["note"]
@@ -167,9 +167,9 @@ def test_unmeasured_targets_are_not_applicable():
     res["prove"] = run.skipped("--prove not given (`make bench` passes it)")
     res["dr_cli"] = {"error": "exit 2: boom", "argv": ["dr"]}
     rows = {r["target"]: r for r in run.targets(res, run.Config.of(False, None))}
-    for name in ("issues 12/14: make prove, whole process (s)",
-                 "issue 12: make prove, obligations alone (s)",
-                 "issue 13: shapely-vectorised peer / cfmpa dr (x)"):
+    for name in ("proving: make prove, whole process (s)",
+                 "proving: make prove, obligations alone (s)",
+                 "full checking: shapely-vectorised peer / cfmpa dr (x)"):
         assert rows[name]["measured"] is None and rows[name]["met"] is None
         assert rows[name]["note"].startswith("not measured")
 

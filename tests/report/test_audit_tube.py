@@ -1,4 +1,4 @@
-"""The report's tolerance tubes and its monitored simulated run (issue 17, part 6).
+"""The report's tolerance tubes and its monitored simulated run (docs/model.md §8, §12).
 
 One report per module, built as test_audit.py builds its own (the coarse copy of the default
 workcell, a small prove run, no campaign): per found plan its tolerance_rad, proved clearance,
