@@ -429,28 +429,21 @@ def _parser() -> argparse.ArgumentParser:
 
     ce = sub.add_parser("certify", help="certify any trajectory file: proved clearance and "
                                         "tolerance tube")
-    ce.add_argument("scenario", help="scenario (the geometry): a bundled name or a TOML file")
-    ce.add_argument("--traj", required=True, metavar="FILE",
-                    help="trajectory: CSV t,left1,left2,right1,right2 or the same columns as "
-                         "JSON (docs/model.md §12)")
+    _trajectory_arguments(ce, "trajectory: CSV t,left1,left2,right1,right2 or the same columns "
+                              "as JSON (docs/model.md §12)",
+                          "certify even when a joint speed exceeds the scenario's omega")
     ce.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
-    ce.add_argument("--allow-speed", action="store_true",
-                    help="certify even when a joint speed exceeds the scenario's omega")
     ce.set_defaults(func=cmd_certify)
 
     mo = sub.add_parser("monitor", help="check a measured joint log against the certified tube")
-    mo.add_argument("scenario", help="scenario: a bundled name or a TOML file")
-    mo.add_argument("--traj", required=True, metavar="FILE", help="the planned trajectory")
+    _trajectory_arguments(mo)
     mo.add_argument("--log", required=True, metavar="LOG",
                     help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
     mo.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
-    mo.add_argument("--allow-speed", action="store_true",
-                    help="accept a trajectory whose joint speeds exceed omega")
     mo.set_defaults(func=cmd_monitor)
 
     si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")
-    si.add_argument("scenario", help="scenario: a bundled name or a TOML file")
-    si.add_argument("--traj", required=True, metavar="FILE", help="the planned trajectory")
+    _trajectory_arguments(si)
     si.add_argument("--out", required=True, metavar="LOG", help="the log file to write (CSV)")
     si.add_argument("--lag", type=float, default=0.0, help="tracking lag in s (default 0)")
     si.add_argument("--noise", type=float, default=0.0,
@@ -464,10 +457,17 @@ def _parser() -> argparse.ArgumentParser:
                     help="this many evenly spaced samples instead of --period")
     si.add_argument("--tail", type=float, default=0.0,
                     help="keep sampling this many s after the trajectory ends (default 0)")
-    si.add_argument("--allow-speed", action="store_true",
-                    help="accept a trajectory whose joint speeds exceed omega")
     si.set_defaults(func=cmd_simulate)
     return p
+
+
+def _trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",
+                          speed: str = "accept a trajectory whose joint speeds exceed omega"
+                          ) -> None:
+    """What certify, monitor and simulate share: the scenario, --traj and --allow-speed."""
+    p.add_argument("scenario", help="scenario (the geometry): a bundled name or a TOML file")
+    p.add_argument("--traj", required=True, metavar="FILE", help=traj)
+    p.add_argument("--allow-speed", action="store_true", help=speed)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

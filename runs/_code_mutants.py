@@ -159,16 +159,15 @@ def _env(copy: Path) -> dict[str, str]:
     return env
 
 
-def _python(copy: Path) -> list[str]:
-    """The interpreter, with -P: the working folder is not put first on the path, so a process
-    started in a checkout imports the copy, not the checkout's cfmpa/ folder."""
-    return [sys.executable, "-P"]
+#: The interpreter, with -P: the working folder is not put first on the path, so a process
+#: started in a checkout imports the copy, not the checkout's cfmpa/ folder.
+_PYTHON = (sys.executable, "-P")
 
 
 def imports_copy(copy: Path, cwd: Path) -> bool:
     """Whether a process started as the checks start theirs (in ``cwd``) imports the copy's
     cfmpa and cfmpa.impl."""
-    code, text = _run([*_python(copy), "-c", "import cfmpa, cfmpa.impl; "
+    code, text = _run([*_PYTHON, "-c", "import cfmpa, cfmpa.impl; "
                        "print(cfmpa.__file__); print(cfmpa.impl.__file__)"], copy, cwd, 120)
     files = [Path(x) for x in text.split()]
     return code == 0 and len(files) == 2 and all(f.is_relative_to(copy) for f in files)
@@ -186,7 +185,7 @@ def _run(cmd: Sequence[str], copy: Path, cwd: Path, timeout_s: float) -> tuple[i
 def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool | None, str]:
     out = work / "proofs"
     select = [a for i in only for a in ("--only", i)]
-    code, text = _run([*_python(copy), "-m", "cfmpa", "prove", "--out", str(out), *select],
+    code, text = _run([*_PYTHON, "-m", "cfmpa", "prove", "--out", str(out), *select],
                       copy, work, 1800)
     if code not in (0, 1):
         return None, f"cfmpa prove exited {code}: {text.strip().splitlines()[-1:]}"
@@ -203,7 +202,7 @@ def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool
 
 
 def _check_contracts(copy: Path, work: Path) -> tuple[bool | None, str]:
-    code, text = _run([*_python(copy), "-c", _CONTRACTS_SCRIPT], copy, work, 1800)
+    code, text = _run([*_PYTHON, "-c", _CONTRACTS_SCRIPT], copy, work, 1800)
     try:
         found = json.loads(text.strip().splitlines()[-1])
     except (ValueError, IndexError):
@@ -218,7 +217,7 @@ def _check_tests(copy: Path, work: Path, tests_dir: Path | None) -> tuple[bool |
         return None, "not run: no tests/ folder (not a checkout)"
     folders = [str(tests_dir / f) for f in TEST_FOLDERS]
     # Started in the work folder, not the checkout (whose cfmpa/ folder would be found first).
-    code, text = _run([*_python(copy), "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+    code, text = _run([*_PYTHON, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
                        "--rootdir", str(tests_dir.parent), *folders], copy, work, 3600)
     lines = text.strip().splitlines()
     failing = [ln for ln in lines if ln.startswith(("FAILED", "ERROR"))]

@@ -72,3 +72,17 @@ def tiny_default(folder: Path) -> Path:
     p = folder / "tiny.toml"
     p.write_text(text)
     return p
+
+
+def planned(folder: Path, doc: dict[str, Any]) -> tuple[Scenario, Path, Path, Any]:
+    """``doc`` written to folder/tiny.toml and planned (modified variant) into folder/plan:
+    (the scenario, its file, the plan folder, the PlanResult)."""
+    from cfmpa.runs import plan, write_plan
+    from cfmpa.spec import load_scenario
+
+    scen = folder / "tiny.toml"
+    scen.write_text(toml(doc))
+    s = load_scenario(scen)
+    p = plan(s, "modified")
+    write_plan(p, folder / "plan")
+    return s, scen, folder / "plan", p

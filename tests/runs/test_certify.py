@@ -23,13 +23,7 @@ DOC = factory.doc(right__start_cell=START, right__goal_cell=GOAL)
 
 @pytest.fixture(scope="module")
 def workcell(tmp_path_factory):
-    d = tmp_path_factory.mktemp("certify")
-    scen = d / "tiny.toml"
-    scen.write_text(factory.toml(DOC))
-    s = load_scenario(scen)
-    p = plan(s, "modified")
-    write_plan(p, d / "plan")
-    return s, scen, d / "plan", p
+    return factory.planned(tmp_path_factory.mktemp("certify"), DOC)
 
 
 def test_certify_on_traj_csv_agrees_with_plan_json(workcell, tmp_path, capsys):

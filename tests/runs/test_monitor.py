@@ -12,9 +12,8 @@ import pytest
 import factory
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.runs import (Excursion, monitor_log, parse_excursion, plan, simulate_log,
-                        write_plan)
-from cfmpa.spec import load_scenario, load_trajectory, tolerance_rad
+from cfmpa.runs import Excursion, monitor_log, parse_excursion, simulate_log
+from cfmpa.spec import load_trajectory, tolerance_rad
 
 DOC = factory.doc(right__start_cell=[2, 8], right__goal_cell=[13, 5])
 HEADER = "t,left1,left2,right1,right2\n"
@@ -22,14 +21,9 @@ HEADER = "t,left1,left2,right1,right2\n"
 
 @pytest.fixture(scope="module")
 def cell(tmp_path_factory):
-    d = tmp_path_factory.mktemp("monitor")
-    scen = d / "tiny.toml"
-    scen.write_text(factory.toml(DOC))
-    s = load_scenario(scen)
-    p = plan(s, "modified")
-    write_plan(p, d)
-    traj = load_trajectory(d / "traj.csv", s)
-    return s, scen, d / "traj.csv", traj, tolerance_rad(s, p.certificate)
+    s, scen, folder, p = factory.planned(tmp_path_factory.mktemp("monitor"), DOC)
+    traj = load_trajectory(folder / "traj.csv", s)
+    return s, scen, folder / "traj.csv", traj, tolerance_rad(s, p.certificate)
 
 
 def test_a_noisy_lagging_log_inside_the_tube_passes(cell, tmp_path):

@@ -54,6 +54,14 @@ def labels(w: Witness):
     return w.j1.copy(), w.j2.copy()
 
 
+def found_labels(dr, start, goal):
+    """The fast search's answer on a case where it finds a path (others are discarded), with
+    copies of its labels to corrupt."""
+    r = search_opt_path_fast(dr, start, goal, with_witness=True)
+    assume(r.status is SearchStatus.FOUND)
+    return (r, *labels(r.witness))
+
+
 def conditions(fails):
     return [f.condition for f in fails]
 
@@ -106,9 +114,7 @@ def test_another_optimal_path_passes_with_the_same_labels():
 @given(case=cases(), data=st.data())
 def test_a_label_lowered_on_the_walk_is_rejected(case, data):
     dr, start, goal = case
-    r = search_opt_path_fast(dr, start, goal, with_witness=True)
-    assume(r.status is SearchStatus.FOUND)
-    j1, j2 = labels(r.witness)
+    r, j1, j2 = found_labels(dr, start, goal)
     states = [x for x in walk(r.path, dr.shape[0] - 1)[1:] if j1[x] > 0 or j2[x] > 0]
     assume(states)
     x = data.draw(st.sampled_from(states))
@@ -124,9 +130,7 @@ def test_a_label_lowered_on_the_walk_is_rejected(case, data):
 @given(case=cases(), data=st.data())
 def test_a_label_raised_anywhere_is_rejected(case, data):
     dr, start, goal = case
-    r = search_opt_path_fast(dr, start, goal, with_witness=True)
-    assume(r.status is SearchStatus.FOUND)
-    j1, j2 = labels(r.witness)
+    r, j1, j2 = found_labels(dr, start, goal)
     none = np.iinfo(j1.dtype).max
     states = [tuple(int(v) for v in x) for x in np.argwhere(j1 != none)]
     x = data.draw(st.sampled_from(states))
