@@ -171,7 +171,7 @@ def cmd_prove(args: argparse.Namespace) -> int:
         raise InputError("--audit", args.audit, "needs every obligation; run it without --only")
     if args.audit is None:
         return run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
-                         repin=args.repin)
+                         repin=args.repin, workers=args.workers)
     import multiprocessing
 
     from .impl import progress_silenced
@@ -212,7 +212,7 @@ def cmd_prove(args: argparse.Namespace) -> int:
         worker.start()
         try:
             code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
-                             repin=args.repin)
+                             repin=args.repin, workers=args.workers)
         except BaseException:
             stopped.set()
             gate.set()
@@ -389,7 +389,7 @@ def _parser() -> argparse.ArgumentParser:
     pr = sub.add_parser("prove", help="discharge every obligation (make prove)")
     pr.add_argument("--out", default="build/proofs", help="results folder (default build/proofs)")
     pr.add_argument("--scenarios", default=None,
-                    help="a folder of your workcells (*.toml) to prove: four checks per file, "
+                    help="a folder of your workcells (*.toml) to prove: seven checks per file, "
                          "ids from the file names (default: the bundled workcells)")
     pr.add_argument("--only", action="append", default=None,
                     help="an obligation id, prefix or glob (repeatable)")
@@ -398,6 +398,9 @@ def _parser() -> argparse.ArgumentParser:
     pr.add_argument("--repin", action="store_true",
                     help="rewrite proofs/obligations.lock with the statements run and print "
                          "what changed (review the diff), instead of failing on a change")
+    pr.add_argument("--workers", type=int, default=None, metavar="K",
+                    help="processes discharging obligations side by side (default 2 on a "
+                         "machine with two cores or more, else 1); the results do not depend on K")
     pr.set_defaults(func=cmd_prove)
 
     au = sub.add_parser("audit", help="write report.html and report.json")

@@ -18,14 +18,16 @@ from ._obl_scenario import scenario_check_id, scenario_files, scenario_obligatio
 from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proof, VCResult,
                           Verdict, Z3Query, discharge)
 from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
-                      collect_obligations, compare_ids, expected_ids, is_bundled, pinned_verdict,
+                      collect_obligations, compare_ids, default_workers, expected_ids, is_bundled,
+                      pinned_verdict,
                       render_report, run_obligations, run_record, scenarios_note, selected)
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
     "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
-    "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "discharge",
+    "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "default_workers",
+    "discharge",
     "expected_ids",
     "is_bundled", "pinned_verdict", "render_report", "run_obligations", "run_prove", "run_record",
     "scenarios_note", "selected",
@@ -34,13 +36,15 @@ __all__ = [
 
 def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path | None = None,
               only: Iterable[str] | None = None, stream: TextIO | None = None,
-              repin: bool = False) -> int:
+              repin: bool = False, workers: int | None = None) -> int:
     """Discharge the obligations (all, or those ``only`` selects), print the summary, write
     ``out_dir/results.json``; 0 iff every verdict is the pinned one and no id is missing, extra
     or repeated, 1 otherwise. Raises InputError (exit 2) for a ``--scenarios`` that is not a
     folder, a folder other than the bundled one with no scenario file, or an ``--only``
-    pattern that selects no expected obligation."""
+    pattern that selects no expected obligation, or ``workers`` below 1 (``--workers``)."""
     picks = None if only is None else list(only)
+    if workers is not None and workers < 1:
+        raise InputError("--workers", str(workers), "must be at least 1 (1: one process)")
     sdir = BUNDLED_DIR if scenarios_dir is None else Path(scenarios_dir)
     if not sdir.is_dir():
         raise InputError("--scenarios", str(scenarios_dir), "must be a folder of *.toml files")
@@ -55,7 +59,8 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
     obligations = collect_obligations(sdir, picks)
     expected = [i for i in every if selected(i, picks)]
     run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir),
-                          record=run_record(sdir), repin=repin)
+                          record=run_record(sdir), repin=repin,
+                          workers=default_workers() if workers is None else workers)
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
 

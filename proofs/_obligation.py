@@ -364,10 +364,18 @@ def discharge_pending(ob: Obligation, pool: Any,
             text += _outcome_text(outcome)
     except Exception as exc:  # noqa: BLE001 - an obligation must end in a verdict, not a crash
         tb = traceback.format_exception_only(type(exc), exc)[-1].strip()
-        fields = dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
-                      reason_unknown=None, reason=f"exception: {tb}", vcs=())
-        futures, certs = [], []
+        fields, futures, certs = _failed_fields(f"exception: {tb}"), [], []
     return _Pending(ob, text, time.perf_counter() - t0, fields, futures, certs)
+
+
+def failed_proof(ob: Obligation, reason: str) -> Proof:
+    """The FAILED Proof of an obligation that could not be run to an answer, saying why."""
+    return _Pending(ob, "", 0.0, _failed_fields(reason), [], []).settle()
+
+
+def _failed_fields(reason: str) -> dict[str, Any]:
+    return dict(verdict=Verdict.FAILED, statistics={}, counterexample=None, reason_unknown=None,
+                reason=reason, vcs=())
 
 
 def _source_hash(ob: Obligation, q: CheckQuery) -> str:

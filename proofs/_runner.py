@@ -37,7 +37,7 @@ from ._obl_witness import witness_obligations
 from ._obl_tolerance import tolerance_obligations
 from ._obl_safety import safety_obligations
 from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
-from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending
+from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
 from ._pins import LOCK, Mismatch, check_pins, cvc5_skips, load_lock
 from ._pins import repin as repin_lock
 
@@ -48,6 +48,7 @@ __all__ = [
     "FIXED_IDS",
     "ProveRun",
     "collect_obligations",
+    "default_workers",
     "expected_ids",
     "is_bundled",
     "pinned_verdict",
@@ -218,8 +219,9 @@ def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
 def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                     expected: Sequence[str], *, note: str = "",
                     record: dict[str, Any] | None = None, lock: str | Path | None = None,
-                    repin: bool = False) -> ProveRun:
-    """Discharge each obligation, save its query and the results, compare with the last run;
+                    repin: bool = False, workers: int = 1) -> ProveRun:
+    """Discharge each obligation (in ``workers`` forked processes side by side; the results do
+    not depend on how many), save its query and the results, compare with the last run;
     every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``,
     and every statement against the lock (``lock``, default proofs/obligations.lock), which
     ``repin`` rewrites first (for the obligations run; after a whole run, dropping the rest).
@@ -233,9 +235,13 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
     # cvc5 replays the statements it decided when they were pinned (--repin: every one).
     skip = {} if repin else cvc5_skips(load_lock(lock_path))
     t0 = time.perf_counter()
-    with Cvc5Pool() as pool:
-        pending = [discharge_pending(o, pool, skip) for o in obligations]
-        proofs = tuple(p.settle() for p in pending)
+    if workers > 1 and len(obligations) > 1:
+        cost = {i: float(o.get("seconds") or 0.0) for i, o in previous.items()}
+        proofs = _discharge_side_by_side(obligations, skip, workers, cost)
+    else:
+        with Cvc5Pool() as pool:
+            pending = [discharge_pending(o, pool, skip) for o in obligations]
+            proofs = tuple(p.settle() for p in pending)
     seconds = time.perf_counter() - t0
     repinned = None
     if repin:
@@ -268,6 +274,59 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                    repinned=repinned)
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run
+
+
+def default_workers() -> int:
+    """Processes that discharge obligations side by side: two where the machine has two cores
+    or more (each is one Z3 at a time, with its own cvc5 replay beside it)."""
+    return 2 if (os.cpu_count() or 1) >= 2 else 1
+
+
+# What a worker process of _discharge_side_by_side works on: set before the pool forks, so the
+# obligations (closures) are inherited, never pickled; only an index goes out, a Proof back.
+_SHARED: dict[str, Any] = {}
+
+
+def _worker_start() -> None:
+    from multiprocessing.util import Finalize
+
+    from ._cvc5 import Cvc5Pool
+
+    pool = Cvc5Pool()
+    _SHARED["pool"] = pool
+    Finalize(pool, pool.close, exitpriority=10)   # the worker's cvc5 ends with the worker
+
+
+def _worker_discharge(index: int) -> Proof:
+    ob = _SHARED["obligations"][index]
+    return discharge_pending(ob, _SHARED["pool"], _SHARED["skip"]).settle()
+
+
+def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, str], jobs: int,
+                            cost: dict[str, float]) -> tuple[Proof, ...]:
+    """Each obligation discharged in one of ``jobs`` forked processes, the longest (by the last
+    run's seconds) first so that the two finish together; returned in the given order. An
+    obligation whose process dies is FAILED with that reason, never lost or waited for."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    order = sorted(range(len(obligations)), key=lambda i: -cost.get(obligations[i].id, 0.0))
+    _SHARED.update(obligations=obligations, skip=skip)
+    out: list[Proof | None] = [None] * len(obligations)
+    try:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(obligations)),
+                                 mp_context=multiprocessing.get_context("fork"),
+                                 initializer=_worker_start) as ex:
+            futures = {i: ex.submit(_worker_discharge, i) for i in order}
+            for i in order:
+                try:
+                    out[i] = futures[i].result()
+                except Exception as exc:  # noqa: BLE001 - a dead worker is a verdict, not a crash
+                    why = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+                    out[i] = failed_proof(obligations[i], f"its worker process ended ({why})")
+    finally:
+        _SHARED.clear()
+    return tuple(p for p in out if p is not None)
 
 
 def _query_file(p: Proof) -> str:

@@ -228,3 +228,39 @@ def test_results_json_records_what_it_is_of(tmp_path: Path):
     files = sorted((REPO / "scenarios").glob("*.toml"))
     assert run["scenarios"] == {f.name: hashlib.sha256(f.read_bytes()).hexdigest() for f in files}
     assert run["date_utc"].endswith("+00:00")
+
+
+def test_workers_side_by_side_give_the_results_of_one(tmp_path: Path):
+    obs = collect_obligations("/nonexistent", CHEAP + ["Prop8.printed"])
+    exp = [o.id for o in obs]
+    one = run_obligations(obs, tmp_path / "one", exp, workers=1)
+    two = run_obligations(obs, tmp_path / "two", exp, workers=2)
+    assert one.ok and two.ok
+    assert [p.id for p in two.proofs] == exp                  # in the given order, not finishing order
+    docs = [json.loads((tmp_path / d / "results.json").read_text()) for d in ("one", "two")]
+    assert _strip_times(docs[0]) == _strip_times(docs[1])
+    for p in one.proofs:                                      # the saved queries too
+        saved = [sorted(f.read_text() for f in (tmp_path / d).glob(f"{p.id}.*"))
+                 for d in ("one", "two")]
+        assert saved[0] and saved[0] == saved[1]
+
+
+def test_an_obligation_whose_worker_dies_is_failed_not_lost(tmp_path: Path):
+    import os
+    obs = collect_obligations("/nonexistent", ["Def1.segment"])
+
+    def die():
+        os._exit(3)
+    dying = dataclasses.replace(obs[0], id="Def1.dies", build=die)
+    run = run_obligations([dying, *obs], tmp_path, ["Def1.dies", "Def1.segment"], workers=2)
+    got = {p.id: p for p in run.proofs}
+    assert list(got) == ["Def1.dies", "Def1.segment"] and not run.ok
+    assert got["Def1.dies"].verdict is Verdict.FAILED
+    assert "worker process ended" in got["Def1.dies"].reason
+
+
+def test_workers_below_one_is_an_input_error(tmp_path: Path, capsys):
+    from cfmpa.cli import main
+    rc = main(["prove", "--out", str(tmp_path), "--only", "Def1.segment", "--workers", "0"])
+    assert rc == 2 and "--workers" in capsys.readouterr().err
+    assert not (tmp_path / "results.json").exists()
