@@ -121,87 +121,29 @@ def item_plan_fast(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any
 
 
 def item_builtdr_profile(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any]]:
-    """build_dr_fast's stages timed apart: its own steps, in its order, through the functions
-    it calls (the public right_regions and left_regions, then the module's packing, layer kernel
-    and settle helpers; impl is read, never changed). Each run's D_R must equal build_dr_fast's
-    (checked once, outside the time), so the split is of the very computation timed as
-    "BuiltDR fast". Stage seconds of every call land in info["stages_s"] (warm-up included; the
-    bench keeps the timed runs')."""
+    """build_dr_fast's stages timed apart by build_dr_fast itself (its ``stages`` argument), so
+    the split is of the very computation timed as "BuiltDR fast". Stage seconds of every call
+    land in info["stages_s"] (warm-up included; the bench keeps the timed runs')."""
     from cfmpa.impl import _fast_builtdr as fb
-    from cfmpa.impl import build_dr_fast, left_regions, right_regions
-    from cfmpa.impl._collide import pad_polygons
-    from cfmpa.spec import EPS, make_grid
+    from cfmpa.impl import build_dr_fast
+    from cfmpa.spec import make_grid
 
     s = load(it["scenario"])
     g = make_grid(s)
     variant = it["variant"]
-    m, n = g.m, g.n
     info: dict[str, Any] = {"cells": int(np.prod(g.shape)), "grid": [g.N + 1, g.m, g.n],
                             "variant": variant, "kernel_threads": fb.KERNEL_THREADS,
                             "stages_s": []}
-    clock = time.perf_counter
 
     def run():
-        st = dict.fromkeys(STAGES, 0.0)
-        t0 = clock()
-        rr = right_regions(s, g)
-        t1 = clock()
-        left = left_regions(s, variant, g)
-        t2 = clock()
-        st["right_regions"], st["left_regions"] = t1 - t0, t2 - t1
-        spine1, spine2 = fb._right_spines(s, g)
-        r1 = np.ascontiguousarray(rr.link1)
-        r2 = np.ascontiguousarray(rr.link2.reshape(m * n, *rr.link2.shape[2:]))
-        g1, box1 = fb._pack(r1)
-        g2, box2 = fb._pack(r2)
-        rows = box2.reshape(m, n, 4)
-        row_box = np.concatenate([rows[..., :2].min(axis=1), rows[..., 2:].max(axis=1)], axis=1)
-        margin = fb.decision_margin(box1, box2, *(p for pair in left.links for p in pair))
-        P = np.zeros(g.shape, dtype=np.uint8)
-        unc1 = np.zeros((2, m), dtype=np.bool_)
-        unc2 = np.zeros((2, m * n), dtype=np.bool_)
-        t3 = clock()
-        st["pack_right"] = t3 - t2
-        layers = unsure = settled_layers = 0
-        for k, pair in enumerate(left.links):
-            a = clock()
-            if k > 0 and pair is left.links[k - 1]:
-                P[k] = P[k - 1]
-                st["other"] += clock() - a
-                continue
-            ga, boxa = fb._pack(pad_polygons(list(pair)))
-            spa = fb._left_spines(s, k, g.N)
-            out = P[k].reshape(m * n)
-            unc1[:] = False
-            unc2[:] = False
-            b = clock()
-            fb._run_layer(ga, boxa, spa, g1, box1, spine1, g2, box2, spine2, row_box, n, EPS,
-                          margin, out, unc1, unc2)
-            c = clock()
-            if unc1.any() or unc2.any():
-                unsure += int(unc1.sum() + unc2.sum())
-                settled_layers += 1
-                fb._settle_unsure(pair, r1, r2, unc1, unc2, out.reshape(m, n), EPS)
-            d = clock()
-            st["pack_left"] += b - a
-            st["layer_kernel"] += c - b
-            st["settle_unsure"] += d - c
-            layers += 1
-        st["total"] = clock() - t0
+        st: dict[str, float] = dict.fromkeys(fb.STAGES, 0.0)
+        t0 = time.perf_counter()
+        dr = build_dr_fast(s, variant, g, progress=False, stages=st)
+        st["total"] = time.perf_counter() - t0
+        info["unsure_pairs"] = int(st.pop("unsure_pairs", 0))
         info["stages_s"].append(st)
-        info.update(layers_computed=layers, layers_copied=len(left.links) - layers,
-                    unsure_pairs=unsure, layers_with_unsure=settled_layers)
-        return P
-
-    fb_out = build_dr_fast(s, variant, g, progress=False)   # also compiles or loads the kernels
-    info["same_as_build_dr_fast"] = bool(np.array_equal(run(), fb_out))
-    info["stages_s"].clear()
+        return dr
     return run, info
-
-
-#: The stages of build_dr_fast, in its order ("other": the rest layer's copy).
-STAGES = ("right_regions", "left_regions", "pack_right", "pack_left", "layer_kernel",
-          "settle_unsure", "other")
 
 
 def _shapely_setup(it: dict[str, Any]):

@@ -511,10 +511,10 @@ def contracts_section(have_cli: bool, base: dict[str, Any],
     return out
 
 
-#: build_dr_fast's stages as the profile names them (bench/_worker.py's STAGES, in order).
+#: build_dr_fast's stages as the profile names them (impl's STAGES, in order).
 PROFILE_STAGES = {
-    "right_regions": "right regions (right_regions: the subordinate's m + m n swept polygons)",
-    "left_regions": "left regions (left_regions: the principal's 2 polygons a layer)",
+    "right_regions": "right regions (right_regions_fast: the subordinate's m + m n swept polygons)",
+    "left_regions": "left regions (left_regions_fast: the principal's 2 polygons a layer)",
     "pack_right": "right packing (centre lines, _pack of the m + m n polygons, row boxes, margin)",
     "pack_left": "left packing (_pack and centre lines of each layer's 2 polygons)",
     "layer_kernel": "numba layer loop (_run_layer over the computed layers)",
@@ -525,9 +525,8 @@ PROFILE_STAGES = {
 
 def builtdr_profile(res: dict[str, Any], runs: dict[str, dict[str, Any]]) -> dict[str, Any]:
     """BuiltDR fast on the default scenario split into build_dr_fast's stages, per variant: the
-    median of each stage over the timed runs (its own process, after the warm-up), by calling
-    the functions build_dr_fast calls in its order (bench/_worker.py item_builtdr_profile). The
-    split's D_R is checked equal to build_dr_fast's."""
+    median of each stage over the timed runs (its own process, after the warm-up), as
+    build_dr_fast records them (its ``stages`` argument; bench/_worker.py item_builtdr_profile)."""
     out: dict[str, Any] = {
         "stages": PROFILE_STAGES,
         "note": "in process, per variant: median seconds of each stage over the timed runs "
@@ -543,9 +542,8 @@ def builtdr_profile(res: dict[str, Any], runs: dict[str, dict[str, Any]]) -> dic
             "share": {k: mid[k] / mid["total"] for k in PROFILE_STAGES} if mid["total"] else {},
             "build_dr_fast_median_s": res["builtdr"][v]["fast"].get("median_s"),
             "runs": r["runs"], "peak_rss_mb": r["peak_rss_mb"],
-            **{k: info[k] for k in ("cells", "grid", "kernel_threads", "layers_computed",
-                                    "layers_copied", "unsure_pairs", "layers_with_unsure",
-                                    "same_as_build_dr_fast") if k in info},
+            **{k: info[k] for k in ("cells", "grid", "kernel_threads", "unsure_pairs")
+               if k in info},
         }
     return out
 
@@ -565,9 +563,7 @@ def profile_note(res: dict[str, Any], variant: str) -> str:
     floor = s["right_regions"] + s["left_regions"]
     return (f"profile of {variant} (builtdr_profile, in process): {parts}; staged total "
             f"{s['total']:.3f} s. The two region builders alone take {floor:.3f} s, "
-            f"{floor / 0.15:.1f}x the 0.15 s budget"
-            + ("" if p.get("same_as_build_dr_fast") else
-               " (WARNING: the staged D_R differs from build_dr_fast's; the split is suspect)"))
+            f"{floor / 0.15:.1f}x the 0.15 s budget")
 
 
 def row(name: str, measured: float | None, limit: float, at_most: bool = True,
@@ -867,8 +863,7 @@ def profile_lines(prof: dict[str, Any] | None) -> list[str]:
         s = p["stages_median_s"]
         lines.append(f"  {v:9s}" + "".join(f"{s[k]:15.4f}" for k in head)
                      + f"{p['build_dr_fast_median_s'] or float('nan'):15.4f} "
-                       f"{p.get('unsure_pairs', 0):7d}"
-                     + ("" if p.get("same_as_build_dr_fast") else "  (D_R DIFFERS!)"))
+                       f"{p.get('unsure_pairs', 0):7d}")
     return lines
 
 

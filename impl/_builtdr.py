@@ -8,21 +8,26 @@ over i and j are vectorised; the loop over k and the links is written out.
 from __future__ import annotations
 
 import hashlib
-from fractions import Fraction
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 import numpy.typing as npt
 
 from ..spec import EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid
 from ._collide import PolygonSet, blocked_against, pad_polygons
-from ._regions import Polygon, swept_region
+from ._kinematics import link_rectangles
+from ._regions import Box, Polygon, convex_hull, swept_lattice, swept_points
 
 __all__ = [
     "LeftRegions",
     "RightRegions",
     "left_regions",
+    "left_regions_by",
     "right_regions",
+    "right_row",
+    "rotate_row",
     "build_dr",
     "ContainmentReport",
     "check_containment",
@@ -60,20 +65,29 @@ def left_spacing(s: Scenario) -> tuple[float, float]:
 def left_regions(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,
                  margin_scale: float = 1.0) -> LeftRegions:
     """S_LArm[k] for k = 0..N-1 and the rest layer (index N), per docs/model.md §4."""
+    return left_regions_by(convex_hull, s, variant, grid, margin_scale=margin_scale)
+
+
+def left_regions_by(hull: Callable[[npt.NDArray[np.float64]], Polygon], s: Scenario,
+                    variant: Variant | str, grid: Grid | None = None, *,
+                    margin_scale: float = 1.0) -> LeftRegions:
+    """left_regions with ``hull`` taking the points' convex hull (impl's compiled twin of
+    convex_hull gives the same arrays faster)."""
     v = Variant(variant)
     g = grid or make_grid(s)
     spacing = left_spacing(s)
+
+    def region(link: int, box: Box, anchor: Sequence[float]) -> Polygon:
+        return hull(swept_points(s.left, link, box, anchor, spacing, margin_scale=margin_scale))
     out = []
     for k in range(g.N):
         box = left_box(s, v, k)
         anchor = left_angles(s, k * s.dt)
-        out.append(tuple(swept_region(s.left, link, box, anchor, spacing, margin_scale=margin_scale)
-                          for link in (0, 1)))
+        out.append(tuple(region(link, box, anchor) for link in (0, 1)))
     if v is Variant.TIGHT:
         goal = tuple(s.left.goal)
-        rest = tuple(swept_region(s.left, link, ((goal[0], goal[0]), (goal[1], goal[1])), goal,
-                                  spacing, margin_scale=margin_scale) for link in (0, 1))
-        out.append(rest)
+        out.append(tuple(region(link, ((goal[0], goal[0]), (goal[1], goal[1])), goal)
+                         for link in (0, 1)))
     else:
         out.append(out[-1])
     return LeftRegions(variant=v, links=tuple(out))  # type: ignore[arg-type]
@@ -98,16 +112,44 @@ def right_regions(s: Scenario, grid: Grid | None = None, *, margin_scale: float 
     theta1 rotates every configuration's rectangle rigidly, so this is the same construction.
     """
     g = grid or make_grid(s)
+    return rotate_row(s, g, *right_row(s, g, lambda pts: [convex_hull(p) for p in pts],
+                                       margin_scale=margin_scale))
+
+
+def rotate_row(s: Scenario, g: Grid, link1: Polygon, link2: npt.NDArray[np.float64]
+               ) -> RightRegions:
+    """right_row's regions turned by every t_i about the subordinate's base."""
+    t_i = np.asarray(g.angle(0, np.arange(g.m)), dtype=float)
+    return RightRegions(link1=_rotate(link1, t_i, s.right.base),
+                        link2=_rotate(link2, t_i, s.right.base))
+
+
+def right_row(s: Scenario, g: Grid,
+              hulls: Callable[[list[npt.NDArray[np.float64]]], Sequence[Polygon]], *,
+              margin_scale: float = 1.0) -> tuple[Polygon, npt.NDArray[np.float64]]:
+    """The subordinate's regions at t_i = 0, base at the origin: link 1 (V, 2) and link 2 per j
+    (n, V, 2), padded; ``hulls`` takes the convex hull of each point set (as convex_hull)."""
     arm = s.right
     origin = type(arm)(**{**arm.__dict__, "base": (0.0, 0.0)})
     h1, h2 = g.h
-    t_i = np.asarray(g.angle(0, np.arange(g.m)), dtype=float)
     t_j = np.asarray(g.angle(1, np.arange(g.n)), dtype=float)
-    l1 = swept_region(origin, 0, ((-h1, h1), (0.0, 0.0)), (0.0, 0.0), (h1, h2),
-                      margin_scale=margin_scale)
-    l2 = pad_polygons([swept_region(origin, 1, ((-h1, h1), (tj - h2, tj + h2)), (0.0, tj), (h1, h2),
-                                    margin_scale=margin_scale) for tj in t_j])
-    return RightRegions(link1=_rotate(l1, t_i, arm.base), link2=_rotate(l2, t_i, arm.base))
+    points = [swept_points(origin, 0, ((-h1, h1), (0.0, 0.0)), (0.0, 0.0), (h1, h2),
+                           margin_scale=margin_scale)]
+    # Link 2's rectangles for all j in one call per lattice shape and margin (elementwise the
+    # same operations as one call per j, so the same doubles).
+    lattices = [swept_lattice(origin, 1, ((-h1, h1), (tj - h2, tj + h2)), (0.0, tj), (h1, h2),
+                              margin_scale=margin_scale) for tj in t_j]
+    groups: dict[tuple[tuple[int, ...], float], list[int]] = {}
+    for j, (t1, _, grow) in enumerate(lattices):
+        groups.setdefault((t1.shape, grow), []).append(j)
+    link2: list[npt.NDArray[np.float64]] = [np.empty(0)] * len(lattices)
+    for (_, grow), js in groups.items():
+        corners = link_rectangles(origin, np.stack([lattices[j][0] for j in js]),
+                                  np.stack([lattices[j][1] for j in js]), 1, grow=grow)
+        for j, c in zip(js, corners):
+            link2[j] = c.reshape(-1, 2)
+    polys = hulls(points + link2)
+    return polys[0], pad_polygons(list(polys[1:]))
 
 
 def build_dr(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,

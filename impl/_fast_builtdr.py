@@ -1,6 +1,7 @@
 """BuiltDR, fast: the reference's regions and decision, bit for bit, in a compiled kernel.
 
-Same regions: ``left_regions`` and ``right_regions`` of the reference, the very same arrays.
+Same regions: the arrays of the reference's ``left_regions`` and ``right_regions``, built by
+their compiled twins (``_fast_regions``, equal element for element, tested so).
 Same decision: the reference declares a pair blocked iff its bounding-box gap is <= eps and its
 computed separating-axis gap g (max over the edge normals of both polygons) is <= 0, or lies in
 (0, eps] and the exact distance is <= eps. The kernel decides a pair only where that outcome is
@@ -37,6 +38,8 @@ blocked by one left link is not tested again (the decision is an OR).
 from __future__ import annotations
 
 import math
+import threading
+import time
 
 import numpy as np
 import numpy.typing as npt
@@ -44,15 +47,24 @@ import numba
 from numba import njit, prange
 
 from ..spec import EPS, Grid, Scenario, Variant, joints, left_angles, make_grid
-from ._builtdr import DR, RightRegions, left_regions, right_regions
+from ._builtdr import DR, RightRegions
+from ._fast_regions import left_regions_fast, right_regions_fast
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._progress import progress_bar
 
-__all__ = ["MARGIN_REL", "MAX_COORD", "build_dr_fast", "decision_margin"]
+__all__ = ["MARGIN_REL", "MAX_COORD", "STAGES", "build_dr_fast", "decision_margin"]
 
 #: Safety margin around the thresholds 0 and eps, relative to the largest coordinate (at least
 #: 1 m). Rounding differences between two evaluations of one gap are ~1e-15 of the coordinates.
 MARGIN_REL = 1e-12
+
+# A fork-safe threading layer (workqueue here; numba's OpenMP on Linux is GNU's, which aborts a
+# forked child that runs a parallel kernel once the parent has): the prove run, the audit and the
+# campaigns fork processes that build D_R. Workqueue is not thread-safe, so _run_layer holds
+# _KERNEL_LOCK: threads that build D_R at once (a multi-threaded Dask worker) take turns.
+if numba.config.THREADING_LAYER == "default":
+    numba.config.THREADING_LAYER = "forksafe"
+_KERNEL_LOCK = threading.Lock()
 
 #: Threads for the layer kernel. One: on the shared 2-core machine this was measured on, a second
 #: thread gained nothing, and with numba's OpenMP layer it lost 2.5x to the other processes.
@@ -80,13 +92,23 @@ def decision_margin(*coords: npt.NDArray[np.float64]) -> float:
     return MARGIN_REL * scale
 
 
+#: build_dr_fast's stages, in its order, as ``stages`` records them.
+STAGES = ("right_regions", "left_regions", "pack_right", "pack_left", "layer_kernel",
+          "settle_unsure", "other")
+
+
 def build_dr_fast(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,
                   eps: float = EPS, right: RightRegions | None = None,
-                  progress: bool | None = None) -> DR:
-    """D_R for ``variant``, identical to ``build_dr`` (uint8 (N + 1, m, n), 1 = blocked)."""
+                  progress: bool | None = None, stages: dict[str, float] | None = None) -> DR:
+    """D_R for ``variant``, identical to ``build_dr`` (uint8 (N + 1, m, n), 1 = blocked).
+
+    ``stages``, if given, gains the seconds spent in each of STAGES (and "unsure_pairs")."""
+    clock = _Clock(stages)
     g = grid or make_grid(s)
-    rr = right or right_regions(s, g)
-    left = left_regions(s, variant, g)
+    rr = right or right_regions_fast(s, g)
+    clock.lap("right_regions")
+    left = left_regions_fast(s, variant, g)
+    clock.lap("left_regions")
     m, n = g.m, g.n
     spine1, spine2 = _right_spines(s, g)
     r1 = np.ascontiguousarray(rr.link1)
@@ -99,33 +121,59 @@ def build_dr_fast(s: Scenario, variant: Variant | str, grid: Grid | None = None,
     P = np.zeros(g.shape, dtype=np.uint8)
     unc1 = np.zeros((2, m), dtype=np.bool_)
     unc2 = np.zeros((2, m * n), dtype=np.bool_)
+    clock.lap("pack_right")
     with progress_bar(f"BuiltDR {Variant(variant)}", len(left.links), int(np.prod(g.shape)),
                       progress) as bar:
         for k, pair in enumerate(left.links):
             if k > 0 and pair is left.links[k - 1]:
                 P[k] = P[k - 1]                   # the rest layer is layer N-1 itself
                 bar.advance()
+                clock.lap("other")
                 continue
             ga, boxa = _pack(pad_polygons(list(pair)))
             out = P[k].reshape(m * n)
             unc1[:] = False
             unc2[:] = False
-            _run_layer(ga, boxa, _left_spines(s, k, g.N), g1, box1, spine1, g2, box2, spine2,
+            spa = _left_spines(s, k, g.N)
+            clock.lap("pack_left")
+            _run_layer(ga, boxa, spa, g1, box1, spine1, g2, box2, spine2,
                        row_box, n, eps, margin, out, unc1, unc2)
+            clock.lap("layer_kernel")
             if unc1.any() or unc2.any():
+                clock.count("unsure_pairs", int(unc1.sum() + unc2.sum()))
                 _settle_unsure(pair, r1, r2, unc1, unc2, out.reshape(m, n), eps)
             bar.advance()
+            clock.lap("settle_unsure")
     return P
+
+
+class _Clock:
+    """Adds the seconds since the last lap to a stage of ``stages`` (nothing if it is None)."""
+
+    def __init__(self, stages: dict[str, float] | None) -> None:
+        self.stages = stages
+        self.t = time.perf_counter()
+
+    def lap(self, stage: str) -> None:
+        if self.stages is not None:
+            now = time.perf_counter()
+            self.stages[stage] = self.stages.get(stage, 0.0) + now - self.t
+            self.t = now
+
+    def count(self, what: str, k: int) -> None:
+        if self.stages is not None:
+            self.stages[what] = self.stages.get(what, 0) + k
 
 
 def _run_layer(*args: object) -> None:
     """The compiled layer kernel on KERNEL_THREADS threads (numba's setting is per thread)."""
-    before = numba.get_num_threads()
-    numba.set_num_threads(min(KERNEL_THREADS, numba.config.NUMBA_NUM_THREADS))
-    try:
-        _layer(*args)
-    finally:
-        numba.set_num_threads(before)
+    with _KERNEL_LOCK:
+        before = numba.get_num_threads()
+        numba.set_num_threads(min(KERNEL_THREADS, numba.config.NUMBA_NUM_THREADS))
+        try:
+            _layer(*args)
+        finally:
+            numba.set_num_threads(before)
 
 
 def _left_spines(s: Scenario, k: int, N: int) -> npt.NDArray[np.float64]:

@@ -47,6 +47,8 @@ __all__ = [
     "convex_hull",
     "lattice_range",
     "sweep_margin",
+    "swept_lattice",
+    "swept_points",
     "swept_region",
     "naive_hull",
 ]
@@ -124,6 +126,22 @@ def swept_region(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequ
                  margin_scale: float = 1.0) -> Polygon:
     """A convex polygon containing link ``link`` at every configuration in ``box`` (sound for
     ``margin_scale`` >= 1; a smaller scale exists to seed faults that the checks must catch)."""
+    return convex_hull(swept_points(arm, link, box, anchor, g, margin_scale=margin_scale))
+
+
+def swept_points(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequence[float], *,
+                 margin_scale: float = 1.0) -> npt.NDArray[np.float64]:
+    """The points (P, 2) whose convex hull is ``swept_region``: the grown rectangles' corners
+    at the box's lattice points."""
+    t1, t2, grow = swept_lattice(arm, link, box, anchor, g, margin_scale=margin_scale)
+    return link_rectangles(arm, t1, t2, link, grow=grow).reshape(-1, 2)
+
+
+def swept_lattice(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequence[float], *,
+                  margin_scale: float = 1.0
+                  ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float]:
+    """The lattice configurations (theta1, theta2 grids) sampled for ``swept_region`` and the
+    margin its rectangles are grown by."""
     axes = []
     moving = []
     for q in range(2):
@@ -136,8 +154,7 @@ def swept_region(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequ
         axes.append(anchor[q] + np.arange(i_lo, i_hi + 1) * g[q])
         moving.append(i_hi > i_lo)
     t1, t2 = np.meshgrid(axes[0], axes[1], indexing="ij")
-    grow = margin_scale * sweep_margin(arm, link, g, moving)
-    return convex_hull(link_rectangles(arm, t1, t2, link, grow=grow))
+    return t1, t2, margin_scale * sweep_margin(arm, link, g, moving)
 
 
 def naive_hull(arm: Arm, link: int, box: Box) -> Polygon:

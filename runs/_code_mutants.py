@@ -42,12 +42,12 @@ class CodeMutant:
 CODE_MUTANTS: tuple[CodeMutant, ...] = (
     CodeMutant("rest_layer_free", "the fast BuiltDR leaves the rest layer free",
                "impl/_fast_builtdr.py",
-               (("            bar.advance()\n    return P\n",
-                 "            bar.advance()\n    P[-1] = 0  # mutant\n    return P\n"),)),
+               (("            clock.lap(\"settle_unsure\")\n    return P\n",
+                 "            clock.lap(\"settle_unsure\")\n    P[-1] = 0  # mutant\n    return P\n"),)),
     CodeMutant("margin_halved", "the regions grown by half the margin the lemma needs",
                "impl/_regions.py",
-               (("    grow = margin_scale * sweep_margin(arm, link, g, moving)",
-                 "    grow = 0.5 * margin_scale * sweep_margin(arm, link, g, moving)"),)),
+               (("    return t1, t2, margin_scale * sweep_margin(arm, link, g, moving)",
+                 "    return t1, t2, 0.5 * margin_scale * sweep_margin(arm, link, g, moving)"),)),
     CodeMutant("lattice_coarsened", "the regions sampled at twice the spacing their margin is "
                "computed for", "impl/_regions.py",
                (("        i_lo, i_hi = lattice_range(box[q][0], box[q][1], anchor[q], g[q])\n"
@@ -65,6 +65,10 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                (("    free = np.ascontiguousarray(np.asarray(dr) == 0)\n",
                  "    free = np.ascontiguousarray(np.asarray(dr) == 0)\n"
                  "    free[N] = True  # mutant\n"),)),
+    CodeMutant("right_regions_turned_backwards", "the fast right regions turned by -t_i "
+               "instead of t_i", "impl/_fast_regions.py",
+               (("        ci, si, nsi = c[i], s[i], -s[i]\n",
+                 "        ci, si, nsi = c[i], -s[i], s[i]\n"),)),
     CodeMutant("layer_count_off_by_one", "the principal's regions for N - 1 layers, not N",
                "impl/_builtdr.py",
                (("    for k in range(g.N):\n        box = left_box(s, v, k)\n",
