@@ -198,8 +198,8 @@ _READINGS = ("binary = the doubles the code computes with, as exact rationals; d
 
 
 def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[Obligation]:
-    """Four data checks per scenario file: those of a folder (sorted), or the files given (the
-    workcells a report is about, in the order given)."""
+    """The data checks (CHECKS) per scenario file: those of a folder (sorted), or the files
+    given (the workcells a report is about, in the order given)."""
     files = (scenario_files(scenarios) if isinstance(scenarios, (str, Path))
              else [Path(f) for f in scenarios])
     out = []

@@ -167,6 +167,17 @@ def test_round_number_workcells_never_violate_pre_grid(doc: dict[str, Any]) -> N
     assert_sound(doc)
 
 
+def test_every_boundary_joint_the_strategy_can_draw_is_sound() -> None:
+    """The random draws above may miss some: every (dt, omega, span, lo) of the strategy where
+    the old construction was unsafe, on both joints of a workcell, meets pre.grid.* and the
+    per-scenario checks."""
+    cases = [(dt, w, span, lo) for dt, w, span, lo in itertools.product(DTS, OMEGAS, SPANS, LOWS)
+             if unsafe(lo, lo + span, w, dt, *old_grid(lo, lo + span, w, dt))]
+    assert len(cases) == 289
+    for dt, w, span, lo in cases:
+        assert_sound(workcell(dt, (w, w), (span, span), (lo, lo)))
+
+
 @pytest.mark.slow
 @settings(max_examples=5000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(round_workcells())
