@@ -6,7 +6,8 @@ after the other (tests, small runs); ``workers=K`` starts a local cluster of K w
 with one thread each (the default; its dashboard address is printed); ``scheduler=ADDRESS``
 connects to a running cluster (``dask scheduler`` and ``dask worker ADDRESS``, each worker with
 cfmpa installed). A malformed address is refused before any connection, and a scheduler that
-does not answer within the connect timeout is an input error too: neither hangs.
+does not answer within the connect timeout is an input error too, as is an address where
+something else answers (a worker, the dashboard's HTTP port): none of them hangs.
 
 Results come back in completion order to one callback in the client (which records them);
 nothing depends on which worker ran what. A task that raises is retried (``RETRIES``), and a
@@ -112,6 +113,10 @@ class ProgressBar:
             progress = bool(isatty is not None and isatty())
         return cls(label, total, start, out if progress else None)
 
+    def restart(self) -> None:
+        """The clock of the rate and the elapsed time starts now (when the tasks start)."""
+        self._t0 = time.monotonic()
+
     def advance(self, units: int = 1) -> None:
         self.done = min(self.done + units, self.total)
         now = time.monotonic()
@@ -142,6 +147,64 @@ def _duration(seconds: float) -> str:
     s = int(round(seconds))
     h, rest = divmod(s, 3600)
     return f"{h}h{rest // 60:02d}m" if h else f"{rest // 60}m{rest % 60:02d}s"
+
+
+def _probe_scheduler(address: str, timeout: float) -> None:
+    """InputError unless a Dask scheduler answers at ``address`` within ``timeout`` seconds.
+
+    dask's own connect bounds the TCP connect but not the handshake after it: a server of another
+    protocol (the dashboard's HTTP port, say) would keep ``Client`` waiting forever, and a
+    worker's address is not a scheduler's. So one bounded exchange first: the handshake and an
+    ``identity`` request, in an event loop of its own (whatever runs in this thread)."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+    from distributed.security import Security
+
+    args = Security().get_connection_args("client")   # as Client's (TLS from dask's config)
+
+    async def identity() -> Any:
+        comm = await connect(address, timeout=timeout, **args)
+        try:
+            await comm.write({"op": "identity"})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    async def bounded() -> Any:
+        return await asyncio.wait_for(identity(), timeout)
+
+    try:
+        with ThreadPoolExecutor(1) as pool:
+            info = pool.submit(asyncio.run, bounded()).result()
+    except (OSError, TimeoutError) as exc:   # asyncio.TimeoutError is TimeoutError (3.11)
+        raise InputError("--scheduler", address, f"did not answer within {timeout:g} s "
+                         f"({error_message(exc)[:200]})") from None
+    except Exception as exc:
+        raise InputError("--scheduler", address, f"does not answer as a Dask scheduler "
+                         f"({error_message(exc)[:200]})") from None
+    kind = info.get("type") if isinstance(info, dict) else None
+    if kind != "Scheduler":
+        raise InputError("--scheduler", address, f"is not a Dask scheduler (it answered as "
+                         f"{kind or 'something else'}); give the address `dask scheduler` "
+                         f"prints")
+
+
+def _one_kernel_thread() -> None:
+    """BuiltDR's kernel on one thread in a worker process that shares the machine's cores."""
+    from ..impl import set_kernel_threads
+
+    set_kernel_threads(1)
+
+
+def _ignore_interrupt() -> None:
+    """SIGINT ignored in a local worker process (run in its event loop: its main thread)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 class Engine:
@@ -200,6 +263,7 @@ class Engine:
         from dask.distributed import Client, LocalCluster
 
         if self.scheduler is not None:
+            _probe_scheduler(self.scheduler, self.connect_timeout)
             try:
                 self._client = Client(self.scheduler, timeout=self.connect_timeout,
                                       set_as_default=False)
@@ -229,6 +293,11 @@ class Engine:
                                          dashboard_address="127.0.0.1:8787",
                                          silence_logs=logging.CRITICAL)
         self._client = Client(self._cluster, set_as_default=False)
+        # Ctrl-C reaches the workers too (one process group): the client alone handles it and
+        # closes the cluster, so the workers ignore it (else each prints a traceback).
+        self._client.run(_ignore_interrupt)
+        if self.workers > 1:
+            self._client.run(_one_kernel_thread)   # the workers share the cores already
         self.dashboard = self._client.dashboard_link
         self.info = (f"local Dask cluster, {self.workers} worker process(es) x 1 thread; "
                      f"dashboard {self.dashboard}")
@@ -267,6 +336,7 @@ class Engine:
         finishes (in completion order), with a ``TaskLost`` for a task that ended without one.
         ``fn`` must be importable by the workers (a module-level function of cfmpa)."""
         bar = progress or ProgressBar(name, len(argsets))
+        bar.restart()       # the rate and time left count from here, not from the engine start
         t0 = time.perf_counter()
         try:
             if self.serial:

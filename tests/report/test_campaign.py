@@ -320,6 +320,30 @@ def test_a_scheduler_that_does_not_answer_is_an_input_error_not_a_hang(tmp_path,
     assert "error: --scheduler did not answer within 1 s" in err and "Traceback" not in err
 
 
+def test_a_server_that_is_not_a_scheduler_is_an_input_error_not_a_hang(cluster, tmp_path,
+                                                                        capsys):
+    """A port that accepts and never answers (as the dashboard's HTTP port does: dask's own
+    handshake would wait forever) and a worker's address, each exit 2 within the timeout."""
+    import socket
+
+    from dask.distributed import Client
+
+    with Client(cluster, set_as_default=False) as client:
+        worker = next(iter(client.scheduler_info()["workers"]))
+    with socket.socket() as silent:
+        silent.bind(("127.0.0.1", 0))
+        silent.listen()
+        mute = f"tcp://127.0.0.1:{silent.getsockname()[1]}"
+        for address, said in [(mute, "did not answer within 1 s"),
+                              (worker, "is not a Dask scheduler (it answered as Worker)")]:
+            t0 = time.monotonic()
+            code = main(["compare", "--n", "2", "--scheduler", address, "--connect-timeout", "1",
+                         "--out", str(tmp_path)])
+            err = capsys.readouterr().err
+            assert code == 2 and time.monotonic() - t0 < 15
+            assert f"error: --scheduler {said}" in err and "Traceback" not in err
+
+
 def test_a_scheduler_without_workers_is_an_input_error_not_a_hang():
     from dask.distributed import LocalCluster
 
