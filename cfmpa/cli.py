@@ -192,6 +192,9 @@ def cmd_prove(args: argparse.Namespace) -> int:
         return results
 
     def audit() -> None:
+        from .impl import set_kernel_threads
+
+        set_kernel_threads(1)          # beside the prove run's processes
         try:
             code = run_audit(None, args.audit, argv=["cfmpa", *args.argv],
                              proofs_json=proofs_ready, scenarios_dir=args.scenarios)

@@ -290,8 +290,10 @@ _SHARED: dict[str, Any] = {}
 def _worker_start() -> None:
     from multiprocessing.util import Finalize
 
+    from ..impl import set_kernel_threads
     from ._cvc5 import Cvc5Pool
 
+    set_kernel_threads(1)              # the workers share the cores already
     pool = Cvc5Pool()
     _SHARED["pool"] = pool
     Finalize(pool, pool.close, exitpriority=10)   # the worker's cvc5 ends with the worker

@@ -172,3 +172,15 @@ def test_absurd_magnitudes_past_the_loader_block_every_cell_in_both_kernels(fiel
         ref = build_dr(s, variant, g)
         assert ref.all()
         assert np.array_equal(build_dr_fast(s, variant, g), ref)
+
+
+def test_one_thread_and_two_give_the_same_bits(monkeypatch):
+    # The rows are dealt out to the threads alternately; any split must give the same D_R.
+    s = factory.scenario(dt=0.08, right__start_cell=[10, 25], right__goal_cell=[38, 15])
+    out = {}
+    for k in (1, 2):
+        monkeypatch.setattr(_fast_builtdr, "KERNEL_THREADS", k)
+        out[k] = build_dr_fast(s, Variant.MODIFIED, progress=False)
+    assert np.array_equal(out[1], out[2]) and 0 < out[1].mean() < 1
+    with pytest.raises(ValueError, match="k=0"):
+        _fast_builtdr.set_kernel_threads(0)
