@@ -233,7 +233,8 @@ def cmd_audit(args: argparse.Namespace) -> int:
 
     files = [str(resolve(a)) for a in args.scenarios] or None
     return run_audit(files, args.out, argv=["cfmpa", *args.argv],
-                     proofs_json=args.proofs, compare_n=args.compare_n)
+                     proofs_json=args.proofs, compare_n=args.compare_n,
+                     campaign=args.campaign)
 
 
 def cmd_scenarios(args: argparse.Namespace) -> int:
@@ -416,6 +417,9 @@ def _parser() -> argparse.ArgumentParser:
                          "must cover the given workcells' checks, others' rows are left out")
     au.add_argument("--compare-n", type=_positive, default=100,
                     help="workcells in the campaign (0 skips it; default 100)")
+    au.add_argument("--campaign", metavar="DIR", default=None,
+                    help="show the campaign `cfmpa compare --out DIR` recorded there (read "
+                         "from its records, not run again) instead of running one")
     au.set_defaults(func=cmd_audit)
 
     sc = sub.add_parser("scenarios", help="list the bundled scenarios and their purposes")

@@ -35,7 +35,7 @@ from ..impl import left_regions
 from ..spec import (Scenario, SearchStatus, Variant, certify_trajectory, executed_trajectory,
                     load_scenario, tolerance_rad, tube_lipschitz)
 from . import _figures as F
-from ._compare import campaign_json, format_campaign, run_campaign
+from ._compare import Campaign, campaign_json, format_campaign, load_campaign, run_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
 from ._obligations import ProofData, load_proofs, load_selftest, summary_table
@@ -82,18 +82,21 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
               proofs_json: str | Callable[[], str] | None = None,
               scenarios_dir: str | None = None,
               contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
-              compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> int:
+              compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
+              campaign: str | Path | None = None) -> int:
     """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
 
     ``scenarios``: scenario files (None: every scenarios/*.toml). ``proofs_json``: a results.json
     of ``make prove`` to report (None: run the obligations afresh). Exit code 0 when everything
     the report checks holds (see the report's first table), 1 otherwise (the report is written
     either way), 2 for bad input. ``expected_ids``: the obligation ids the report must find
-    (None: every obligation of the prove machinery).
+    (None: every obligation of the prove machinery). ``campaign``: a folder written by
+    ``cfmpa compare --out``, whose recorded campaign the report shows instead of running one.
     """
     result = build_audit(scenarios, argv=argv, proofs_json=proofs_json,
                          scenarios_dir=scenarios_dir, contracts=contracts, compare_n=compare_n,
-                         compare_seed=compare_seed, expected_ids=expected_ids)
+                         compare_seed=compare_seed, expected_ids=expected_ids,
+                         campaign=campaign)
     html_path, json_path = write_report(result, out_dir)
     v = result.doc["verdict"]
     for item in v["items"]:
@@ -115,7 +118,8 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
                 proofs_json: str | Callable[[], str] | None = None,
               scenarios_dir: str | None = None,
                 contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
-                compare_seed: int = 0, expected_ids: Sequence[str] | None = None) -> AuditResult:
+                compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
+                campaign: str | Path | None = None) -> AuditResult:
     """Compute everything the report shows (no files written). A callable ``proofs_json`` is
     called for the results.json path once everything else is computed."""
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
@@ -129,6 +133,7 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
         stems[p.stem] = p
     if isinstance(compare_n, bool) or not isinstance(compare_n, int) or compare_n < 0:
         raise InputError("compare_n", compare_n, "must be an integer >= 0 (0: no campaign)")
+    recorded = None if campaign is None else load_campaign(campaign)   # input errors first
     plans = _Plans(contracts)
     figures: dict[str, F.Figure] = {}
     # The plans, pictures and campaign first: they do not need the proofs, so `cfmpa prove
@@ -138,7 +143,7 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
         "selftest": load_selftest(),
         "scenarios": [_scenario_entry(s, plans, figures) for s in loaded],
         "monitor": _monitor(sdir, loaded, plans, figures),
-        "compare": _compare(compare_n, compare_seed, figures),
+        "compare": _compare(compare_n, compare_seed, figures, recorded, campaign),
     }
     # The user's workcells are the ones to prove: given files bring their own per-scenario
     # obligations (the bundled set, by default, its pinned ones).
@@ -601,14 +606,20 @@ def monitor_problems(mon: Mapping[str, Any]) -> list[str]:
 
 # --- campaign -----------------------------------------------------------------------------------
 
-def _compare(n: int, seed: int, figures: dict[str, F.Figure]) -> dict[str, Any]:
-    if n == 0:
+def _compare(n: int, seed: int, figures: dict[str, F.Figure], recorded: Campaign | None = None,
+             folder: str | Path | None = None) -> dict[str, Any]:
+    if recorded is not None:
+        doc = campaign_json(recorded)
+        note = (f"the campaign recorded in {folder} (cfmpa compare --n {recorded.n} --seed "
+                f"{recorded.seed} --dt {recorded.dt:g}), read from its records, not run again")
+    elif n == 0:
         return {"available": False, "note": "not run for this report (compare_n = 0)"}
-    doc = campaign_json(run_campaign(n, seed))
+    else:
+        doc, note = campaign_json(run_campaign(n, seed)), ""
     fig = F.compare_figure("fig-compare", doc)
     rate = F.campaign_rate_figure("fig-compare-rate", doc)
     figures[fig.id], figures[rate.id] = fig, rate
-    return {"available": True, "note": "", "text": format_campaign(doc),
+    return {"available": True, "note": note, "text": format_campaign(doc),
             "figure": {"id": fig.id, "caption": fig.caption},
             "rate_figure": {"id": rate.id, "caption": rate.caption}, **doc}
 

@@ -42,11 +42,12 @@ from ..runs import CONNECT_TIMEOUT_S, Engine, ProgressBar, TaskLost, error_messa
 from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
                     parse_scenario, polygon_distance)
 from ._stats import mcnemar_exact_p, wilson_interval
-from ._store import Store, open_store
+from ._store import Store, open_store, read_store
 
 __all__ = ["COMPARE_DT", "CONTACT_NOTE", "MAX_DRAWS", "MAX_DT", "PAIRS", "STORE_NAME",
            "Campaign", "CaseError", "CaseResult", "VariantOutcome", "campaign_json",
-           "format_campaign", "plan_workcell", "random_workcell", "run_campaign", "run_compare",
+           "format_campaign", "load_campaign", "plan_workcell", "random_workcell", "run_campaign",
+           "run_compare",
            "workcell_task"]
 
 #: Time step of campaign workcells (s): grids of about 10-30 layers of 60-80 x 50-65 cells.
@@ -296,6 +297,31 @@ def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers
     missing = [i for i in range(n) if i not in records]
     if missing:   # the engine reports every task; this would be a bug of cfmpa, not of input
         raise CfmpaError(f"campaign ended without a record of workcells {missing[:10]}")
+    timings = {"run": time.perf_counter() - t_start, **engine.timings_s}
+    return _campaign(n, seed, dt, records, reused, timings)
+
+
+def load_campaign(folder: str | os.PathLike[str]) -> Campaign:
+    """The campaign recorded in ``folder`` by ``cfmpa compare --out`` (its compare.jsonl), read
+    only and whole: the same Campaign, so the same compare.json, as the run that wrote it.
+    InputError if a workcell is missing or raised (finish it with the same command first)."""
+    path = Path(folder) / STORE_NAME
+    settings, lines = read_store(path, STORE_FORMAT, STORE_VERSION)
+    n, seed, dt = _check_settings(settings.get("n"), settings.get("seed"), settings.get("dt"))
+    records: dict[int, dict[str, Any]] = {}
+    for k, rec in enumerate(lines):
+        _check_record(rec, n, path, k + 2)
+        records[rec["index"]] = rec
+    ok = sum(1 for r in records.values() if r["status"] == "ok")
+    if ok < n:
+        raise InputError("--campaign", str(folder), f"holds {ok} of {n} finished workcells; "
+                         f"finish it first: cfmpa compare --n {n} --seed {seed} --dt {dt:g} "
+                         f"--out {folder}", source=str(path))
+    return _campaign(n, seed, dt, records, ok, {})
+
+
+def _campaign(n: int, seed: int, dt: float, records: Mapping[int, dict[str, Any]],
+              reused: int, timings: Mapping[str, float]) -> Campaign:
     cases, errors = [], []
     for i in range(n):
         rec = records[i]
@@ -303,9 +329,8 @@ def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers
             cases.append(_case_of(rec))
         else:
             errors.append(CaseError(i, rec["error"]))
-    timings = {"run": time.perf_counter() - t_start, **engine.timings_s}
     return Campaign(n=n, seed=seed, dt=dt, kernel=KERNEL, cases=tuple(cases),
-                    errors=tuple(errors), reused=reused, timings_s=timings)
+                    errors=tuple(errors), reused=reused, timings_s=dict(timings))
 
 
 def _env_faults() -> dict[int, str]:

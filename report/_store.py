@@ -27,7 +27,7 @@ try:  # POSIX; elsewhere the store is simply not locked
 except ImportError:  # pragma: no cover
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["Store", "open_store"]
+__all__ = ["Store", "open_store", "read_store"]
 
 
 @dataclass
@@ -94,7 +94,24 @@ def open_store(path: str | os.PathLike[str], fmt: str, version: int,
         raise
 
 
-def _parse(p: Path, data: bytes, fmt: str, version: int, settings: dict[str, Any]
+def read_store(path: str | os.PathLike[str], fmt: str, version: int
+               ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """(settings, records) of the store at ``path``, read only (nothing truncated or locked; a
+    torn last line is left out); InputError if it is missing, empty or not such a store."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise InputError("store", str(p), f"cannot be read ({exc.strerror or exc})") from None
+    records, _, _ = _parse(p, data, fmt, version, None)
+    head = json.loads(data.split(b"\n", 1)[0].decode("utf-8")) if records or data else {}
+    settings = head.get("settings") if isinstance(head, dict) else None
+    if not isinstance(settings, dict):
+        raise InputError("store", str(p), "holds no header with the run's settings")
+    return settings, records
+
+
+def _parse(p: Path, data: bytes, fmt: str, version: int, settings: dict[str, Any] | None
            ) -> tuple[list[dict[str, Any]], int, bool]:
     """(records, bytes of whole good lines, whether a torn last line was dropped)."""
     lines = data.split(b"\n")
@@ -119,7 +136,7 @@ def _parse(p: Path, data: bytes, fmt: str, version: int, settings: dict[str, Any
 
 
 def _checked(p: Path, lines: list[dict[str, Any]], fmt: str, version: int,
-             settings: dict[str, Any]) -> list[dict[str, Any]]:
+             settings: dict[str, Any] | None) -> list[dict[str, Any]]:
     if not lines:
         return []
     head = lines[0]
@@ -128,7 +145,7 @@ def _checked(p: Path, lines: list[dict[str, Any]], fmt: str, version: int,
                          "this file is not such a store (remove it or use another folder)",
                          source=str(p), line=1)
     recorded = head.get("settings")
-    if recorded != settings:
+    if settings is not None and recorded != settings:
         recorded = recorded if isinstance(recorded, dict) else {}
         key = next((k for k in settings if recorded.get(k) != settings[k]), next(iter(settings)))
         said = ", ".join(f"{k} {recorded.get(k)!r}" for k in settings)

@@ -86,3 +86,45 @@ def test_run_compare_prints_the_table_and_writes_json(tmp_path, capsys):
 def test_campaign_size_must_be_a_positive_integer(n):
     with pytest.raises(InputError, match="--n"):
         run_campaign(n, 0)
+
+
+def test_a_recorded_campaign_reads_back_to_the_same_compare_json(tmp_path, capsys):
+    from cfmpa.report._audit import _compare
+    from cfmpa.report._compare import load_campaign
+
+    assert run_compare(n=3, seed=SEED, out=str(tmp_path)) == 0
+    capsys.readouterr()
+    written = json.loads((tmp_path / "compare.json").read_text())
+    store = (tmp_path / "compare.jsonl").read_bytes()
+    back = campaign_json(load_campaign(tmp_path))
+    drop = {"timings_s", "reused"}
+    assert {k: v for k, v in back.items() if k not in drop} == \
+        {k: v for k, v in written.items() if k not in drop}
+    assert (tmp_path / "compare.jsonl").read_bytes() == store          # read, not written
+    figures: dict = {}
+    part = _compare(0, 0, figures, load_campaign(tmp_path), tmp_path)
+    assert part["available"] and part["n"] == 3 and "recorded in" in part["note"]
+    assert part["table"] == written["table"] and set(figures) == {"fig-compare", "fig-compare-rate"}
+
+
+def test_a_recorded_campaign_must_be_whole(tmp_path, capsys):
+    from cfmpa.report._compare import load_campaign
+
+    with pytest.raises(InputError, match="cannot be read"):
+        load_campaign(tmp_path / "nowhere")
+    assert run_compare(n=3, seed=SEED, out=str(tmp_path)) == 0
+    capsys.readouterr()
+    lines = (tmp_path / "compare.jsonl").read_text().splitlines(keepends=True)
+    (tmp_path / "compare.jsonl").write_text("".join(lines[:-1]))      # one workcell missing
+    with pytest.raises(InputError, match="holds 2 of 3 finished workcells") as exc:
+        load_campaign(tmp_path)
+    assert f"cfmpa compare --n 3 --seed {SEED}" in str(exc.value)
+
+
+def test_audit_with_a_campaign_folder_that_holds_none_is_exit_2(tmp_path, capsys):
+    from cfmpa.cli import main
+
+    rc = main(["audit", "--campaign", str(tmp_path / "nowhere"), "--out", str(tmp_path / "r")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "compare.jsonl" in err and "Traceback" not in err
+    assert not (tmp_path / "r").exists()
