@@ -125,14 +125,14 @@ def item_builtdr_profile(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[st
     the split is of the very computation timed as "BuiltDR fast". Stage seconds of every call
     land in info["stages_s"] (warm-up included; the bench keeps the timed runs')."""
     from cfmpa.impl import _fast_builtdr as fb
-    from cfmpa.impl import build_dr_fast
+    from cfmpa.impl import build_dr_fast, kernel_threads
     from cfmpa.spec import make_grid
 
     s = load(it["scenario"])
     g = make_grid(s)
     variant = it["variant"]
     info: dict[str, Any] = {"cells": int(np.prod(g.shape)), "grid": [g.N + 1, g.m, g.n],
-                            "variant": variant, "kernel_threads": fb.KERNEL_THREADS,
+                            "variant": variant, "kernel_threads": kernel_threads(),
                             "stages_s": []}
 
     def run():

@@ -38,13 +38,10 @@ blocked by one left link is not tested again (the decision is an OR).
 from __future__ import annotations
 
 import math
-import os
-import threading
 import time
 
 import numpy as np
 import numpy.typing as npt
-import numba
 from numba import njit, prange
 
 from ..spec import EPS, Grid, Scenario, Variant, joints, left_angles, make_grid
@@ -52,35 +49,13 @@ from ._builtdr import DR, RightRegions
 from ._fast_regions import left_regions_fast, right_regions_fast
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._progress import progress_bar
+from ._threads import parallel
 
-__all__ = ["MARGIN_REL", "MAX_COORD", "STAGES", "build_dr_fast", "decision_margin",
-           "set_kernel_threads"]
+__all__ = ["MARGIN_REL", "MAX_COORD", "STAGES", "build_dr_fast", "decision_margin"]
 
 #: Safety margin around the thresholds 0 and eps, relative to the largest coordinate (at least
 #: 1 m). Rounding differences between two evaluations of one gap are ~1e-15 of the coordinates.
 MARGIN_REL = 1e-12
-
-# A fork-safe threading layer (workqueue here; numba's OpenMP on Linux is GNU's, which aborts a
-# forked child that runs a parallel kernel once the parent has): the prove run, the audit and the
-# campaigns fork processes that build D_R. Workqueue is not thread-safe, so _run_layer holds
-# _KERNEL_LOCK: threads that build D_R at once (a multi-threaded Dask worker) take turns.
-if numba.config.THREADING_LAYER == "default":
-    numba.config.THREADING_LAYER = "forksafe"
-_KERNEL_LOCK = threading.Lock()
-
-#: Threads for the layer kernel: two where the machine has two cores or more (the rows are dealt
-#: out alternately, so both threads get alike work: 1.8x on the default workcell, where contiguous
-#: halves gained 1.3x); one in processes that run side by side (the prove run's workers, the
-#: audit's second process, the campaign's workers), which call set_kernel_threads(1).
-KERNEL_THREADS = min(2, os.cpu_count() or 1)
-
-
-def set_kernel_threads(k: int) -> None:
-    """Run the layer kernel on ``k`` threads (at most numba's NUMBA_NUM_THREADS) from now on."""
-    global KERNEL_THREADS
-    if k < 1:
-        raise ValueError(f"k={k!r} must be at least 1")
-    KERNEL_THREADS = k
 
 #: Polygons with a coordinate beyond this (metres) are left to the reference: the loader's
 #: physical range keeps every coordinate far below it, so this never costs time in practice.
@@ -125,8 +100,8 @@ def build_dr_fast(s: Scenario, variant: Variant | str, grid: Grid | None = None,
     spine1, spine2 = _right_spines(s, g)
     r1 = np.ascontiguousarray(rr.link1)
     r2 = np.ascontiguousarray(rr.link2.reshape(m * n, *rr.link2.shape[2:]))
-    g1, box1 = _pack(r1)
-    g2, box2 = _pack(r2)
+    g1, box1 = parallel(_pack_all, r1)
+    g2, box2 = parallel(_pack_all, r2)
     rows = box2.reshape(m, n, 4)
     row_box = np.concatenate([rows[..., :2].min(axis=1), rows[..., 2:].max(axis=1)], axis=1)
     margin = decision_margin(box1, box2, *(p for pair in left.links for p in pair))
@@ -149,7 +124,7 @@ def build_dr_fast(s: Scenario, variant: Variant | str, grid: Grid | None = None,
             unc2[:] = False
             spa = _left_spines(s, k, g.N)
             clock.lap("pack_left")
-            _run_layer(rows_dealt, ga, boxa, spa, g1, box1, spine1, g2, box2, spine2,
+            parallel(_layer, rows_dealt, ga, boxa, spa, g1, box1, spine1, g2, box2, spine2,
                        row_box, n, eps, margin, out, unc1, unc2)
             clock.lap("layer_kernel")
             if unc1.any() or unc2.any():
@@ -176,17 +151,6 @@ class _Clock:
     def count(self, what: str, k: int) -> None:
         if self.stages is not None:
             self.stages[what] = self.stages.get(what, 0) + k
-
-
-def _run_layer(*args: object) -> None:
-    """The compiled layer kernel on KERNEL_THREADS threads (numba's setting is per thread)."""
-    with _KERNEL_LOCK:
-        before = numba.get_num_threads()
-        numba.set_num_threads(min(KERNEL_THREADS, numba.config.NUMBA_NUM_THREADS))
-        try:
-            _layer(*args)
-        finally:
-            numba.set_num_threads(before)
 
 
 def _left_spines(s: Scenario, k: int, N: int) -> npt.NDArray[np.float64]:
@@ -244,30 +208,47 @@ def _pack(verts):  # pragma: no cover - compiled; PolygonSet.of's formulas, per 
     geo = np.zeros((C, V, 6))
     box = np.empty((C, 4))
     for c in range(C):
-        sane = True
-        for v in range(V):
-            if not (abs(verts[c, v, 0]) <= MAX_COORD and abs(verts[c, v, 1]) <= MAX_COORD):
-                sane = False
-        if not sane:
-            for e in range(4):
-                box[c, e] = np.nan
-            continue
-        box[c, 0], box[c, 1] = verts[c, 0, 0], verts[c, 0, 1]
-        box[c, 2], box[c, 3] = verts[c, 0, 0], verts[c, 0, 1]
-        for v in range(V):
-            x, y = verts[c, v, 0], verts[c, v, 1]
-            w = v + 1 if v + 1 < V else 0
-            ex, ey = verts[c, w, 0] - x, verts[c, w, 1] - y
-            length = math.sqrt(ex * ex + ey * ey)  # hypot's care for overflow costs 3x here
-            geo[c, v, 0], geo[c, v, 1] = x, y
-            if length > 0:
-                nx, ny = ey / length, -ex / length
-                geo[c, v, 2], geo[c, v, 3] = nx, ny
-                geo[c, v, 4] = nx * x + ny * y
-                geo[c, v, 5] = 1.0
-            box[c, 0], box[c, 1] = min(box[c, 0], x), min(box[c, 1], y)
-            box[c, 2], box[c, 3] = max(box[c, 2], x), max(box[c, 3], y)
+        _pack_one(verts, c, geo, box)
     return geo, box
+
+
+@njit(cache=True, parallel=True)
+def _pack_all(verts):  # pragma: no cover - compiled; _pack over threads (each polygon alone)
+    """_pack for many polygons, the polygons shared out among the threads."""
+    C, V = verts.shape[0], verts.shape[1]
+    geo = np.zeros((C, V, 6))
+    box = np.empty((C, 4))
+    for c in prange(C):
+        _pack_one(verts, c, geo, box)
+    return geo, box
+
+
+@njit(cache=True, inline="always")
+def _pack_one(verts, c, geo, box):  # pragma: no cover - compiled
+    V = verts.shape[1]
+    sane = True
+    for v in range(V):
+        if not (abs(verts[c, v, 0]) <= MAX_COORD and abs(verts[c, v, 1]) <= MAX_COORD):
+            sane = False
+    if not sane:
+        for e in range(4):
+            box[c, e] = np.nan
+        return
+    box[c, 0], box[c, 1] = verts[c, 0, 0], verts[c, 0, 1]
+    box[c, 2], box[c, 3] = verts[c, 0, 0], verts[c, 0, 1]
+    for v in range(V):
+        x, y = verts[c, v, 0], verts[c, v, 1]
+        w = v + 1 if v + 1 < V else 0
+        ex, ey = verts[c, w, 0] - x, verts[c, w, 1] - y
+        length = math.sqrt(ex * ex + ey * ey)  # hypot's care for overflow costs 3x here
+        geo[c, v, 0], geo[c, v, 1] = x, y
+        if length > 0:
+            nx, ny = ey / length, -ex / length
+            geo[c, v, 2], geo[c, v, 3] = nx, ny
+            geo[c, v, 4] = nx * x + ny * y
+            geo[c, v, 5] = 1.0
+        box[c, 0], box[c, 1] = min(box[c, 0], x), min(box[c, 1], y)
+        box[c, 2], box[c, 3] = max(box[c, 2], x), max(box[c, 3], y)
 
 
 @njit(cache=True, parallel=True)

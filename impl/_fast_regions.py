@@ -15,11 +15,12 @@ import math
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
+from numba import njit, prange
 
 from ..spec import Grid, Scenario, Variant, make_grid
 from ._builtdr import LeftRegions, RightRegions, left_regions_by, right_row
 from ._regions import HULL_SCALE_ABOVE, Polygon, convex_hull
+from ._threads import parallel
 
 __all__ = ["convex_hulls", "left_regions_fast", "right_regions_fast"]
 
@@ -56,8 +57,8 @@ def right_regions_fast(s: Scenario, grid: Grid | None = None) -> RightRegions:
     # _rotate's cosines and sines, of the same array; then its products and sums, compiled.
     c, sn = np.cos(t_i), np.sin(t_i)
     bx, by = (float(v) for v in s.right.base)
-    return RightRegions(link1=_turn(np.ascontiguousarray(link1[None]), c, sn, bx, by)[:, 0],
-                        link2=_turn(np.ascontiguousarray(link2), c, sn, bx, by))
+    one = parallel(_turn, np.ascontiguousarray(link1[None]), c, sn, bx, by)[:, 0]
+    return RightRegions(link1=one, link2=parallel(_turn, np.ascontiguousarray(link2), c, sn, bx, by))
 
 
 # ---------------------------------------------------------------- compiled kernel (numba) ----
@@ -137,13 +138,13 @@ def _same_bits(x, y):  # pragma: no cover - compiled; equal numbers, also in the
     return x == y and math.copysign(1.0, x) == math.copysign(1.0, y)
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _turn(row, c, s, bx, by):  # pragma: no cover - compiled; tested against _rotate
     """(m, n, V, 2): polygons row (n, V, 2) turned by each angle (cosines c, sines s) about the
     origin, then moved to (bx, by), in _rotate's operations: (c x + (-s) y) + bx, (s x + c y) + by."""
     m, n, V = c.shape[0], row.shape[0], row.shape[1]
     out = np.empty((m, n, V, 2))
-    for i in range(m):
+    for i in prange(m):
         ci, si, nsi = c[i], s[i], -s[i]
         for j in range(n):
             for v in range(V):

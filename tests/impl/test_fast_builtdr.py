@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 
 import factory
 from dr_strategies import random_workcells
-from cfmpa.impl import _fast_builtdr, _progress, build_dr, right_regions
+from cfmpa.impl import (_fast_builtdr, _progress, build_dr, kernel_threads, right_regions,
+                        set_kernel_threads)
 from cfmpa.impl._fast_builtdr import build_dr_fast
 from cfmpa.spec import Variant, load_scenario, make_grid, parse_scenario
 
@@ -174,13 +175,19 @@ def test_absurd_magnitudes_past_the_loader_block_every_cell_in_both_kernels(fiel
         assert np.array_equal(build_dr_fast(s, variant, g), ref)
 
 
-def test_one_thread_and_two_give_the_same_bits(monkeypatch):
-    # The rows are dealt out to the threads alternately; any split must give the same D_R.
+def test_one_thread_and_two_give_the_same_bits():
+    # The rows (and the polygons packed, the rows turned) are shared out among the threads;
+    # any split must give the same D_R.
     s = factory.scenario(dt=0.08, right__start_cell=[10, 25], right__goal_cell=[38, 15])
+    before = kernel_threads()
     out = {}
-    for k in (1, 2):
-        monkeypatch.setattr(_fast_builtdr, "KERNEL_THREADS", k)
-        out[k] = build_dr_fast(s, Variant.MODIFIED, progress=False)
+    try:
+        for k in (1, 2):
+            set_kernel_threads(k)
+            out[k] = build_dr_fast(s, Variant.MODIFIED, progress=False)
+    finally:
+        set_kernel_threads(before)
     assert np.array_equal(out[1], out[2]) and 0 < out[1].mean() < 1
-    with pytest.raises(ValueError, match="k=0"):
-        _fast_builtdr.set_kernel_threads(0)
+    for bad in (0, True, 1.5):
+        with pytest.raises(ValueError, match="k="):
+            set_kernel_threads(bad)
