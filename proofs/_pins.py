@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import tempfile
 from collections.abc import Iterable
 from pathlib import Path
@@ -60,8 +61,20 @@ def pin_entry(p: Proof) -> dict[str, Any]:
     else:
         entry["vcs"] = dict(sorted(p.pins.items()))
         entry["cvc5"] = {v.name: v.cvc5 if v.cvc5 in ("sat", "unsat")
-                         else f"undecided: {v.cvc5_reason or 'not replayed'}" for v in p.vcs}
+                         else f"undecided: {_reason_class(v.cvc5_reason)}" for v in p.vcs}
     return entry
+
+
+_KILLED = re.compile(r"killed after [0-9.]+ s \(cvc5 overran its (\d+) ms limit\)")
+
+
+def _reason_class(reason: str | None) -> str:
+    """Why cvc5 did not decide a VC, without the seconds a kill took (they follow the load, not
+    the statement): "overran its 5000 ms limit (killed)" for every such kill."""
+    if not reason:
+        return "not replayed"
+    m = _KILLED.fullmatch(reason)
+    return f"overran its {m.group(1)} ms limit (killed)" if m else reason
 
 
 def _statement(entry: dict[str, Any]) -> dict[str, Any]:

@@ -107,3 +107,12 @@ def test_the_words_of_a_statement_are_not_pinned(tmp_path: Path):
     run = run_obligations(edited, tmp_path, [o.id for o in obs])
     assert not run.pin_mismatch and run.changes["Prop2.endpoints"] == "new"
     io.StringIO().write(render_report(run))
+
+
+def test_the_lock_records_why_cvc5_did_not_decide_without_the_seconds_it_took():
+    from cfmpa.proofs._pins import _reason_class
+    a = _reason_class("killed after 6.0 s (cvc5 overran its 5000 ms limit)")
+    b = _reason_class("killed after 8.3 s (cvc5 overran its 5000 ms limit)")
+    assert a == b == "overran its 5000 ms limit (killed)"
+    assert _reason_class("timeout at 5000 ms") == "timeout at 5000 ms"
+    assert _reason_class("incomplete") == "incomplete" and _reason_class(None) == "not replayed"
