@@ -38,7 +38,7 @@ from . import _figures as F
 from ._compare import Campaign, campaign_json, format_campaign, load_campaign, run_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
-from ._obligations import ProofData, load_proofs, load_selftest, summary_table
+from ._obligations import ProofData, load_proofs, load_selftest, read_results, summary_table
 from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
@@ -134,6 +134,8 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     if isinstance(compare_n, bool) or not isinstance(compare_n, int) or compare_n < 0:
         raise InputError("compare_n", compare_n, "must be an integer >= 0 (0: no campaign)")
     recorded = None if campaign is None else load_campaign(campaign)   # input errors first
+    if isinstance(proofs_json, (str, Path)):
+        read_results(proofs_json)        # unreadable results: said now, not after the plans
     plans = _Plans(contracts)
     figures: dict[str, F.Figure] = {}
     # The plans, pictures and campaign first: they do not need the proofs, so `cfmpa prove

@@ -33,6 +33,7 @@ __all__ = [
     "audited_ids",
     "check_ids",
     "load_proofs",
+    "read_results",
     "summary_table",
     "load_selftest",
 ]
@@ -188,18 +189,26 @@ def _column(r: ObligationRow) -> str:
 
 # --- from results.json ------------------------------------------------------------------------
 
-def _from_file(path: Path, expected: Sequence[str], keep: set[str] | None = None) -> ProofData:
+def read_results(path: str | Path) -> dict[str, Any]:
+    """The results.json of a prove run, parsed; InputError (naming it) if it cannot be read, is
+    not JSON or has no obligations list. The audit calls it first, before any work."""
+    p = Path(path)
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(p.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise InputError("proofs_json", str(path),
+        raise InputError("proofs_json", str(p),
                          f"cannot be read ({exc.strerror or exc})") from None
     except json.JSONDecodeError as exc:
-        raise InputError("proofs_json", str(path), f"is not valid JSON ({exc.msg}, line "
+        raise InputError("proofs_json", str(p), f"is not valid JSON ({exc.msg}, line "
                          f"{exc.lineno})") from None
-    items = doc.get("obligations") if isinstance(doc, dict) else None
-    if not isinstance(items, list):
-        raise InputError("proofs_json", str(path), "has no 'obligations' list")
+    if not isinstance(doc, dict) or not isinstance(doc.get("obligations"), list):
+        raise InputError("proofs_json", str(p), "has no 'obligations' list")
+    return doc
+
+
+def _from_file(path: Path, expected: Sequence[str], keep: set[str] | None = None) -> ProofData:
+    doc = read_results(path)
+    items = doc["obligations"]
     rows = tuple(_row_from_json(item, k, path) for k, item in enumerate(items))
     left_out: list[str] = []
     if keep is not None:   # other workcells' checks are not this report's
