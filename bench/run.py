@@ -515,9 +515,10 @@ def contracts_section(have_cli: bool, base: dict[str, Any],
 PROFILE_STAGES = {
     "right_regions": "right regions (right_regions_fast: the subordinate's m + m n swept polygons)",
     "left_regions": "left regions (left_regions_fast: the principal's 2 polygons a layer)",
-    "pack_right": "right packing (centre lines, _pack of the m + m n polygons, row boxes, margin)",
+    "pack_right": "right packing (centre lines, _pack_all of the m + m n polygons on the kernel "
+                  "threads, row boxes, margin)",
     "pack_left": "left packing (_pack and centre lines of each layer's 2 polygons)",
-    "layer_kernel": "numba layer loop (_run_layer over the computed layers)",
+    "layer_kernel": "numba layer loop (_layer over the computed layers, on the kernel threads)",
     "settle_unsure": "settle of unsure cells (_settle_unsure: the reference's blocked_against)",
     "other": "rest layer copied",
 }

@@ -31,16 +31,13 @@ def convex_hulls(point_sets: list[Points]) -> list[Polygon]:
     """``[convex_hull(p) for p in point_sets]``, the same arrays, most of them compiled."""
     if not point_sets:
         return []
-    flat = np.ascontiguousarray(np.concatenate([np.asarray(p, dtype=float).reshape(-1, 2)
-                                                for p in point_sets]))
-    starts = np.zeros(len(point_sets) + 1, dtype=np.int64)
-    starts[1:] = np.cumsum([len(np.asarray(p).reshape(-1, 2)) for p in point_sets])
+    sets = [np.asarray(p, dtype=float).reshape(-1, 2) for p in point_sets]
+    flat = np.ascontiguousarray(np.concatenate(sets))
+    starts = np.zeros(len(sets) + 1, dtype=np.int64)
+    starts[1:] = np.cumsum([len(p) for p in sets])
     order, counts = _hulls(flat, starts, HULL_SCALE_ABOVE)
-    out = []
-    for c, p in enumerate(point_sets):
-        k = counts[c]
-        out.append(convex_hull(p) if k < 0 else flat[order[starts[c]:starts[c] + k]])
-    return out
+    return [convex_hull(p) if k < 0 else flat[order[a:a + k]]
+            for p, k, a in zip(sets, counts, starts)]
 
 
 def left_regions_fast(s: Scenario, variant: Variant | str, grid: Grid | None = None

@@ -19,18 +19,16 @@ from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proo
                           Verdict, Z3Query, discharge)
 from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
                       collect_obligations, compare_ids, default_workers, expected_ids, is_bundled,
-                      pinned_verdict,
-                      render_report, run_obligations, run_record, scenarios_note, selected)
+                      pinned_verdict, render_report, run_obligations, run_record, scenarios_note,
+                      selected)
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
     "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
     "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "default_workers",
-    "discharge",
-    "expected_ids",
-    "is_bundled", "pinned_verdict", "render_report", "run_obligations", "run_prove", "run_record",
-    "scenarios_note", "selected",
+    "discharge", "expected_ids", "is_bundled", "pinned_verdict", "render_report",
+    "run_obligations", "run_prove", "run_record", "scenarios_note", "selected",
 ]
 
 

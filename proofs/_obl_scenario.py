@@ -176,11 +176,11 @@ def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
     s = load_scenario(path)
     if what.startswith("translation_"):
         from ..impl import kernels
-        from ..spec import check_witness, dr_cell_failures, search_failures
+        from ..spec import check_witness, dr_cell_failures, dr_shape_failures, search_failures
         # The checkers' sources (hashed: editing them is a change); the kernels' output is
         # judged by them, and its digest is in the detail.
-        src = check_source(_translation, make_grid, kernels, dr_cell_failures, search_failures,
-                           check_witness)
+        src = check_source(_translation, make_grid, kernels, dr_shape_failures, dr_cell_failures,
+                           search_failures, check_witness)
     else:
         src = check_source(check, Grid.time_readings, Grid.spacing_readings, decimal, make_grid)
     if check is _containment:

@@ -80,7 +80,7 @@ def open_store(path: str | os.PathLike[str], fmt: str, version: int,
         fh.seek(0)
         data = fh.read()
         header = {"format": fmt, "version": version, "settings": settings}
-        records, good_end, torn = _parse(p, data, fmt, version, settings)
+        _, records, good_end, torn = _parse(p, data, fmt, version, settings)
         if good_end < len(data):
             os.ftruncate(fh.fileno(), good_end)
             fh.seek(0, os.SEEK_END)
@@ -103,17 +103,17 @@ def read_store(path: str | os.PathLike[str], fmt: str, version: int
         data = p.read_bytes()
     except OSError as exc:
         raise InputError("store", str(p), f"cannot be read ({exc.strerror or exc})") from None
-    records, _, _ = _parse(p, data, fmt, version, None)
-    head = json.loads(data.split(b"\n", 1)[0].decode("utf-8")) if records or data else {}
-    settings = head.get("settings") if isinstance(head, dict) else None
+    head, records, _, _ = _parse(p, data, fmt, version, None)
+    settings = head.get("settings")
     if not isinstance(settings, dict):
         raise InputError("store", str(p), "holds no header with the run's settings")
     return settings, records
 
 
 def _parse(p: Path, data: bytes, fmt: str, version: int, settings: dict[str, Any] | None
-           ) -> tuple[list[dict[str, Any]], int, bool]:
-    """(records, bytes of whole good lines, whether a torn last line was dropped)."""
+           ) -> tuple[dict[str, Any], list[dict[str, Any]], int, bool]:
+    """(header, {} if none; records; bytes of whole good lines; whether a torn last line was
+    dropped)."""
     lines = data.split(b"\n")
     # split leaves b"" after a final newline; anything else there is a line without its newline.
     complete, rest = lines[:-1], lines[-1]
@@ -126,19 +126,22 @@ def _parse(p: Path, data: bytes, fmt: str, version: int, settings: dict[str, Any
                 raise ValueError("not an object")
         except (UnicodeDecodeError, ValueError):
             if k == len(complete) - 1 and not rest:
-                return _checked(p, parsed, fmt, version, settings), pos, True
+                return (*_checked(p, parsed, fmt, version, settings), pos, True)
             raise InputError("line", raw[:60].decode("utf-8", "replace"), "is not a JSON "
                              "object; the store is damaged (remove it to start afresh)",
                              source=str(p), line=k + 1) from None
         parsed.append(obj)
         pos += len(raw) + 1
-    return _checked(p, parsed, fmt, version, settings), pos, bool(rest)
+    return (*_checked(p, parsed, fmt, version, settings), pos, bool(rest))
 
 
 def _checked(p: Path, lines: list[dict[str, Any]], fmt: str, version: int,
-             settings: dict[str, Any] | None) -> list[dict[str, Any]]:
+             settings: dict[str, Any] | None
+             ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """(header, records) of the parsed lines, the header checked (and its settings against
+    ``settings`` unless None)."""
     if not lines:
-        return []
+        return {}, []
     head = lines[0]
     if head.get("format") != fmt or head.get("version") != version:
         raise InputError("format", head.get("format"), f"must be {fmt!r} version {version}: "
@@ -152,4 +155,4 @@ def _checked(p: Path, lines: list[dict[str, Any]], fmt: str, version: int,
         raise InputError(f"--{key}", settings[key], f"differs from the run recorded in this "
                          f"folder ({said}); rerun with those settings to resume it, or write "
                          f"to another --out", source=str(p))
-    return lines[1:]
+    return head, lines[1:]

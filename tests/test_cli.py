@@ -195,7 +195,8 @@ def test_plan_with_a_contact_exits_1_in_every_mode_and_keeps_the_evidence(tmp_pa
 
 
 def test_prove_with_a_bad_scenarios_folder_writes_no_report(tmp_path, capsys):
-    # The report is computed beside the proofs; a prove run that stops leaves nothing written.
+    # A bad folder is exit 2 and no report is written (the report process fails on the same
+    # input; the stop mechanism itself is the next test's).
     code = main(["prove", "--scenarios", str(tmp_path / "none"), "--out", str(tmp_path / "p"),
                  "--audit", str(tmp_path / "a")])
     err = capsys.readouterr().err
@@ -210,3 +211,41 @@ def test_prove_refuses_an_audit_of_a_partial_run(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "--audit needs every obligation" in err and "Traceback" not in err
     assert not (tmp_path / "p").exists() and not (tmp_path / "a").exists()
+
+
+def test_prove_that_stops_opens_the_gate_with_stop_and_the_report_writes_nothing(
+        tmp_path, capsys, monkeypatch):
+    # The report process (forked) waits at the gate for the proofs; a prove run that stops must
+    # release it with `stopped`, so that it ends writing nothing. A stand-in report writes a
+    # marker as soon as the gate hands it the results path; a stand-in prove run stops.
+    import time
+
+    import cfmpa.proofs
+    import cfmpa.report
+    from cfmpa.errors import InputError
+
+    marker = tmp_path / "a" / "written"
+
+    def report(files, out_dir, *, proofs_json, **kw):
+        path = proofs_json()
+        marker.parent.mkdir(parents=True, exist_ok=True)
+        marker.write_text(str(path))
+        return 0
+    monkeypatch.setattr(cfmpa.report, "run_audit", report)
+
+    def proving(stops):
+        def run(**kw):
+            time.sleep(0.3)                       # the report process is waiting by now
+            if stops:
+                raise InputError("--scenarios", "x", "stands for any stop")
+            return 0
+        return run
+
+    monkeypatch.setattr(cfmpa.proofs, "run_prove", proving(True))
+    code = main(["prove", "--out", str(tmp_path / "p"), "--audit", str(tmp_path / "a")])
+    assert code == 2 and "stands for any stop" in capsys.readouterr().err
+    assert not marker.exists()
+    # The stand-in writes when the prove run goes through, so its silence above means something.
+    monkeypatch.setattr(cfmpa.proofs, "run_prove", proving(False))
+    assert main(["prove", "--out", str(tmp_path / "p"), "--audit", str(tmp_path / "a")]) == 0
+    assert marker.read_text().endswith("results.json")

@@ -16,7 +16,8 @@ from dr_strategies import random_workcells
 from cfmpa.impl import build_dr, convex_hull, left_regions, right_regions, swept_region
 from cfmpa.impl._collide import pad_polygons
 from cfmpa.impl._fast_builtdr import build_dr_fast
-from cfmpa.impl._fast_regions import convex_hulls, left_regions_fast, right_regions_fast
+from cfmpa.impl._fast_regions import _hulls, convex_hulls, left_regions_fast, right_regions_fast
+from cfmpa.impl._regions import HULL_SCALE_ABOVE
 from cfmpa.spec import Variant, load_scenario, make_grid
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
@@ -47,10 +48,16 @@ def test_hull_twin_on_the_cases_it_hands_back():
     cases = [np.array([[0.0, 0.0], [-0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),   # 0.0 and -0.0
              np.array([[0.0, 0.0], [1e120, 0.0], [0.0, 1e120]]),              # scaled path
              np.array([[0.0, 0.0], [np.nan, 1.0], [1.0, 1.0], [1.0, 0.0]]),  # NaN
-             np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]]),                  # two distinct
-             np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [3.0, 3.0]])]      # all collinear
+             np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 1.0]])]                  # two distinct
     for p, got in zip(cases, convex_hulls(cases)):
         assert same_bytes(got, convex_hull(p))
+        # ...by handing each back: the twin itself answers -1 (equality alone would also hold
+        # if the twin happened to choose as np.unique did).
+        _, counts = _hulls(np.ascontiguousarray(p), np.array([0, len(p)]), HULL_SCALE_ABOVE)
+        assert counts[0] == -1, p.tolist()
+    line = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [3.0, 3.0]])      # the twin's own case
+    assert same_bytes(convex_hulls([line])[0], convex_hull(line))
+    assert convex_hulls([line])[0].tolist() == [[0.0, 0.0], [3.0, 3.0]]
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5], [0.5, 0.0]])
     assert convex_hulls([square])[0].tolist() == [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
 

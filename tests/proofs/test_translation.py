@@ -106,3 +106,21 @@ def test_a_forged_optimum_fails_the_witness(monkeypatch: pytest.MonkeyPatch):
     _planted(monkeypatch, search=forged)
     pr = discharge(_translation(SMALL, "modified"))
     assert pr.verdict is Verdict.FAILED and "post.costs" in pr.counterexample
+
+
+def test_a_forged_witness_fails_though_path_and_costs_are_right(monkeypatch: pytest.MonkeyPatch):
+    # The search's true answer, but labels that claim every state costs nothing: only the
+    # witness check can see it (the path is valid and its costs are its own).
+    from cfmpa.spec import Witness
+
+    def zero_labels(search):
+        def s(dr, start, goal, **k):
+            r = search(dr, start, goal, **k)
+            assert r.status is SearchStatus.FOUND and r.witness.kind == "labels"
+            w = Witness.of_labels(np.zeros_like(r.witness.j1), np.zeros_like(r.witness.j2))
+            return dataclasses.replace(r, witness=w)
+        return s
+    _planted(monkeypatch, search=zero_labels)
+    pr = discharge(_translation(SMALL, "modified"))
+    assert pr.verdict is Verdict.FAILED, pr.reason
+    assert pr.counterexample.startswith("witness."), pr.counterexample

@@ -112,6 +112,11 @@ def test_a_recorded_campaign_must_be_whole(tmp_path, capsys):
 
     with pytest.raises(InputError, match="cannot be read"):
         load_campaign(tmp_path / "nowhere")
+    for text in ("", '{"format":'):         # empty, or only a torn header: no settings to read
+        (tmp_path / "torn").mkdir(exist_ok=True)
+        (tmp_path / "torn" / "compare.jsonl").write_text(text)
+        with pytest.raises(InputError, match="holds no header"):
+            load_campaign(tmp_path / "torn")
     assert run_compare(n=3, seed=SEED, out=str(tmp_path)) == 0
     capsys.readouterr()
     lines = (tmp_path / "compare.jsonl").read_text().splitlines(keepends=True)
