@@ -15,7 +15,8 @@ from fractions import Fraction
 import numpy as np
 import numpy.typing as npt
 
-from ..spec import EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid
+from ..spec import (EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid,
+                    rest_box)
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._kinematics import link_rectangles
 from ._regions import Box, Polygon, convex_hull, swept_lattice, swept_points
@@ -84,10 +85,9 @@ def left_regions_by(hull: Callable[[npt.NDArray[np.float64]], Polygon], s: Scena
         box = left_box(s, v, k)
         anchor = left_angles(s, k * s.dt)
         out.append(tuple(region(link, box, anchor) for link in (0, 1)))
-    if v is Variant.TIGHT:
+    if v.rest_at_goal:
         goal = tuple(s.left.goal)
-        out.append(tuple(region(link, ((goal[0], goal[0]), (goal[1], goal[1])), goal)
-                         for link in (0, 1)))
+        out.append(tuple(region(link, rest_box(s, v, g.N), goal) for link in (0, 1)))
     else:
         out.append(out[-1])
     return LeftRegions(variant=v, links=tuple(out))  # type: ignore[arg-type]

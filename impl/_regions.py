@@ -35,11 +35,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from ..spec import Arm
+from ..spec import Arm, cases, ceil_of, floor_of, max_of, min_of
 from ._kinematics import link_rectangles, link_reach
 
 __all__ = [
@@ -100,13 +101,16 @@ def _hull_indices(pts: np.ndarray) -> list[int]:
     return lower[:-1] + upper[:-1]
 
 
-def lattice_range(lo: float, hi: float, anchor: float, g: float) -> tuple[int, int]:
-    """Lattice indices (i_lo, i_hi) with anchor + i*g covering [lo, hi], up to SNAP * g."""
-    if g <= 0:
-        return (0, 0)
-    i_lo = math.floor((lo - anchor) / g + SNAP)
-    i_hi = math.ceil((hi - anchor) / g - SNAP)
-    return (min(i_lo, i_hi), max(i_lo, i_hi))
+def lattice_range(lo: Any, hi: Any, anchor: Any, g: Any) -> tuple[Any, Any]:
+    """Lattice indices (i_lo, i_hi) with anchor + i*g covering [lo, hi], up to SNAP * g.
+
+    Written once for floats and Z3 terms (``spec.floor_of`` and the like): Safety.region_soundness
+    runs this very function on symbols, so its lattice is the one proved to cover the box."""
+    def span() -> tuple[Any, Any]:
+        i_lo = floor_of((lo - anchor) / g + SNAP)
+        i_hi = ceil_of((hi - anchor) / g - SNAP)
+        return (min_of(i_lo, i_hi), max_of(i_lo, i_hi))
+    return cases(g <= 0, lambda: (0, 0), span)
 
 
 def sweep_margin(arm: Arm, link: int, g: Sequence[float], moving: Sequence[bool] = (True, True)

@@ -23,7 +23,7 @@ import numpy as np
 import shapely
 from flint import arb, ctx
 
-from ._grid import EPS, Grid, Variant, left_angles, left_box
+from ._grid import EPS, Grid, Variant, left_angles, left_box, rest_box
 from ._regions import SNAP, lattice
 from ._scenario import Arm, Scenario
 
@@ -182,9 +182,9 @@ def _left_points(s: Scenario, v: Variant, grid: Grid, layer: int, g: tuple[float
                  ) -> list[tuple[Points, np.ndarray]]:
     """The principal's two regions of ``layer`` (the rest layer is N), as the spec builds them."""
     if layer == grid.N:
-        if v is Variant.TIGHT:
+        if v.rest_at_goal:
             goal = (float(s.left.goal[0]), float(s.left.goal[1]))
-            box, anchor = ((goal[0], goal[0]), (goal[1], goal[1])), goal
+            box, anchor = rest_box(s, v, grid.N), goal
         else:
             return _left_points(s, v, grid, grid.N - 1, g)
     else:

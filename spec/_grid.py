@@ -10,15 +10,18 @@ planner uses is confirmed against the exact bound (a point is added when it fail
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import Enum
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ._counts import (READINGS, joint_grid, joint_points, spacing_readings, time_readings,
                       time_steps, travel_time)
+from ._arith import cases, if_then, is_term, max_of, min_of
 from ._scenario import Scenario
 
 __all__ = [
@@ -31,7 +34,12 @@ __all__ = [
     "left_angles",
     "left_box",
     "right_box",
-    "rest_is_goal",
+    "rest_box",
+    "cell_box",
+    "ptp_angles",
+    "ptp_fraction",
+    "rule_of",
+    "VariantRule",
     "EPS",
 ]
 
@@ -42,7 +50,11 @@ FloatArray = npt.NDArray[np.float64]
 
 
 class Variant(str, Enum):
-    """How the principal's box per layer is taken (docs/model.md §4)."""
+    """How the principal's box per layer is taken (docs/model.md §4). Each member's rules are
+    its row of ``_RULES``: the box of one joint at layer k (``joint_box``) and whether the rest
+    layer is the principal at rest at its goal (``rest_at_goal``) or layer N-1's region. They
+    run on floats and on Z3 terms (``spec._arith``): spec, impl, the exact re-decision and the
+    proofs all read them here, and a member without a row raises."""
 
     ORIGINAL = "original"  # Algorithm 1: [a - w dt, a + w dt]
     MODIFIED = "modified"  # Section IV.A: [a, a + s w dt]
@@ -50,6 +62,108 @@ class Variant(str, Enum):
 
     def __str__(self) -> str:
         return self.value
+
+    @property
+    def rule(self) -> VariantRule:
+        """This member's row of the rule table; a member without one raises."""
+        return rule_of(self)
+
+    @property
+    def rest_at_goal(self) -> bool:
+        """True when the rest layer is the principal at rest at its goal, else layer N-1."""
+        return self.rule.rest_at_goal
+
+    def joint_box(self, a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
+        """One joint's interval (lo, hi) at layer k: a = theta_q(k dt), b = theta_q((k+1) dt),
+        step = omega_q dt, up = (goal_q > start_q). Floats or Z3 terms."""
+        return self.rule.joint_box(a, b, step, up)
+
+    def layer_box(self, start: Sequence[Any], goal: Sequence[Any], omega: Sequence[Any],
+                  dt: Any, tf: Any, k: Any) -> tuple[tuple[Any, Any], tuple[Any, Any]]:
+        """The principal's joint box at layer k, ((lo1, hi1), (lo2, hi2)), for the PTP motion
+        from start to goal in time tf (``ptp_angles``). Floats or Z3 terms."""
+        a = ptp_angles(start, goal, tf, k * dt)
+        b = ptp_angles(start, goal, tf, (k + 1) * dt)
+        out = [self.joint_box(a[q], b[q], omega[q] * dt, goal[q] > start[q]) for q in range(2)]
+        return (out[0], out[1])
+
+    def rest_box(self, start: Sequence[Any], goal: Sequence[Any], omega: Sequence[Any],
+                 dt: Any, tf: Any, N: Any) -> tuple[tuple[Any, Any], tuple[Any, Any]]:
+        """The rest layer's box (the principal from N dt on): the goal, a one-point box, when
+        ``rest_at_goal``, else layer N-1's box."""
+        if self.rest_at_goal:
+            return ((goal[0], goal[0]), (goal[1], goal[1]))
+        return self.layer_box(start, goal, omega, dt, tf, N - 1)
+
+
+@dataclass(frozen=True)
+class VariantRule:
+    """A variant's rules: ``joint_box(a, b, step, up) -> (lo, hi)`` (see Variant.joint_box),
+    whether its rest layer is the goal, and the rule in words (docs/model.md §4.1)."""
+
+    joint_box: Callable[[Any, Any, Any, Any], tuple[Any, Any]]
+    rest_at_goal: bool
+    words: str
+    rest_words: str
+
+
+def _original_box(a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
+    return (a - step, a + step)
+
+
+def _modified_box(a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
+    end = a + if_then(up, 1.0, -1.0) * step
+    return (min_of(a, end), max_of(a, end))
+
+
+def _tight_box(a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
+    return (min_of(a, b), max_of(a, b))
+
+
+_RULES: dict[str, VariantRule] = {
+    "original": VariantRule(_original_box, False,
+                            "[a - omega_q dt, a + omega_q dt], a = theta_L(k dt) (Algorithm 1)",
+                            "layer N-1's box"),
+    "modified": VariantRule(_modified_box, False,
+                            "from a = theta_L(k dt) to a + s_q omega_q dt, s_q = +1 if goal_q > "
+                            "start_q else -1 (Section IV.A)", "layer N-1's box"),
+    "tight": VariantRule(_tight_box, True, "from theta_L(k dt) to theta_L((k+1) dt)",
+                         "the goal, a one-point box"),
+}
+
+
+def rule_of(variant: Variant | str) -> VariantRule:
+    """The rule table's row of ``variant``; a value without a row raises ValueError."""
+    key = variant.value if isinstance(variant, Variant) else str(variant)
+    try:
+        return _RULES[key]
+    except KeyError:
+        raise ValueError(f"variant {key!r} has no box rule; the rules are for "
+                         f"{', '.join(_RULES)}") from None
+
+
+def ptp_fraction(t: Any, tf: Any) -> Any:
+    """How far along the PTP motion is at t: min(max(t / Tf, 0), 1), and 1 when Tf = 0 (the arm
+    rests at its start, = goal). Floats, numpy arrays or Z3 terms."""
+    return cases(tf <= 0, lambda: np.ones_like(np.asarray(t, dtype=float)) if not is_term(t)
+                 else 1.0, lambda: min_of(max_of(t / tf, 0.0), 1.0))
+
+
+def ptp_angles(start: Sequence[Any], goal: Sequence[Any], tf: Any, t: Any) -> tuple[Any, Any]:
+    """theta(t) per joint: start_q + (goal_q - start_q) * ptp_fraction(t, Tf)."""
+    f = ptp_fraction(t, tf)
+    return (start[0] + (goal[0] - start[0]) * f, start[1] + (goal[1] - start[1]) * f)
+
+
+def cell_box(lo: Sequence[Any], h: Sequence[Any], cell: Sequence[Any]
+             ) -> tuple[tuple[Any, Any], tuple[Any, Any]]:
+    """The subordinate's box at cell (i, j) of the grid lo_q + index h_q: [t_i - h1, t_i + h1] x
+    [t_j - h2, t_j + h2]. Floats or Z3 terms."""
+    out = []
+    for q in range(2):
+        t = lo[q] + cell[q] * h[q]
+        out.append((t - h[q], t + h[q]))
+    return (out[0], out[1])
 
 
 def exact_tf(s: Scenario) -> Fraction:
@@ -123,45 +237,29 @@ def left_angles(s: Scenario, t: float | FloatArray) -> FloatArray:
     Returns shape (..., 2). With Tf = 0 the arm rests at its start (= goal).
     """
     t = np.asarray(t, dtype=float)
-    start = np.asarray(s.left.start)
-    goal = np.asarray(s.left.goal)
-    tf = float(exact_tf(s))
-    frac = np.ones_like(t) if tf == 0 else np.clip(t / tf, 0.0, 1.0)
-    return start + (goal - start) * frac[..., None]
+    th = ptp_angles(s.left.start, s.left.goal, float(exact_tf(s)), t)
+    return np.stack([np.asarray(th[0], dtype=float), np.asarray(th[1], dtype=float)], axis=-1)
 
 
 def left_box(s: Scenario, variant: Variant | str, k: int) -> tuple[Pair2, Pair2]:
-    """The principal's joint box at layer k (docs/model.md §4), ((lo1, hi1), (lo2, hi2))."""
-    v = Variant(variant)
-    dt = s.dt
-    a = left_angles(s, k * dt)
-    out = []
-    for q in range(2):
-        w = s.left.omega[q] * dt
-        if v is Variant.ORIGINAL:
-            out.append((float(a[q] - w), float(a[q] + w)))
-        elif v is Variant.MODIFIED:
-            sign = 1.0 if s.left.goal[q] > s.left.start[q] else -1.0
-            ends = (a[q], a[q] + sign * w)
-            out.append((float(min(ends)), float(max(ends))))
-        else:
-            b = left_angles(s, (k + 1) * dt)[q]
-            out.append((float(min(a[q], b)), float(max(a[q], b))))
-    return (out[0], out[1])
+    """The principal's joint box at layer k (docs/model.md §4), ((lo1, hi1), (lo2, hi2)):
+    ``Variant.layer_box`` on the scenario's floats."""
+    L = s.left
+    box = Variant(variant).layer_box(L.start, L.goal, L.omega, s.dt, float(exact_tf(s)), k)
+    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))
 
 
-def rest_is_goal(variant: Variant | str) -> bool:
-    """True when the rest layer is the principal at rest at its goal (tight), else layer N-1."""
-    return Variant(variant) is Variant.TIGHT
+def rest_box(s: Scenario, variant: Variant | str, N: int) -> tuple[Pair2, Pair2]:
+    """The principal's box in the rest layer (from N dt on): ``Variant.rest_box``."""
+    L = s.left
+    box = Variant(variant).rest_box(L.start, L.goal, L.omega, s.dt, float(exact_tf(s)), N)
+    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))
 
 
 def right_box(g: Grid, cell: tuple[int, int]) -> tuple[Pair2, Pair2]:
-    """The subordinate's box at cell (i, j): [t_i - h1, t_i + h1] x [t_j - h2, t_j + h2]."""
-    out = []
-    for q in range(2):
-        t = float(g.angle(q, cell[q]))
-        out.append((t - g.h[q], t + g.h[q]))
-    return (out[0], out[1])
+    """The subordinate's box at cell (i, j): ``cell_box`` on the grid's floats."""
+    box = cell_box(g.lo, g.h, cell)
+    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))
 
 
 Pair2 = tuple[float, float]

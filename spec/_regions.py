@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 import shapely
 
-from ._grid import Grid, Variant, left_angles, left_box
+from ._grid import Grid, Variant, left_angles, left_box, rest_box
 from ._kinematics import corners, reach
 from ._scenario import Arm, Scenario
 
@@ -64,9 +64,9 @@ def left_region_polygons(s: Scenario, variant: Variant | str, grid: Grid
         anchor = (float(a[0]), float(a[1]))
         box = left_box(s, v, k)
         out.append((_region(s.left, 0, box, anchor, g), _region(s.left, 1, box, anchor, g)))
-    if v is Variant.TIGHT:
+    if v.rest_at_goal:
         goal = (float(s.left.goal[0]), float(s.left.goal[1]))
-        box = ((goal[0], goal[0]), (goal[1], goal[1]))
+        box = rest_box(s, v, grid.N)
         out.append((_region(s.left, 0, box, goal, g), _region(s.left, 1, box, goal, g)))
     else:
         out.append(out[-1])
