@@ -38,7 +38,7 @@ from fractions import Fraction
 import z3
 
 from ..impl import SNAP, lattice_range, link_reach, sweep_margin
-from ..spec import EPS, Arm
+from ..spec import EPS, Arm, Variant, cell_box, ptp_angles
 from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
                             is_path_fixed, member, position, z3_path)
 from ._obl_margin import margin_obligations
@@ -1202,15 +1202,9 @@ class Principal:
         return cls(_v("L.start"), _v("L.goal"), _v("L.omega"), z3.Real("dt"), z3.Real("Tf"),
                    Z3Dims.named().N)
 
-    def frac(self, t: z3.ArithRef) -> z3.ArithRef:
-        """min(max(t / Tf, 0), 1); 1 when Tf = 0 (spec.left_angles)."""
-        return z3.If(self.Tf <= 0, z3.RealVal(1),
-                     _mn(_mx(t / self.Tf, z3.RealVal(0)), z3.RealVal(1)))
-
     def theta(self, t: z3.ArithRef) -> Vec:
-        f = self.frac(t)
-        return (self.start[0] + (self.goal[0] - self.start[0]) * f,
-                self.start[1] + (self.goal[1] - self.start[1]) * f)
+        """spec.ptp_angles (spec.left_angles' motion) run on the symbols."""
+        return ptp_angles(self.start, self.goal, self.Tf, t)
 
     def tf_def(self) -> Hyp:
         d = [_abs(self.goal[q] - self.start[q]) / self.omega[q] for q in range(2)]
@@ -1226,31 +1220,29 @@ class Principal:
                 ("omega_q > 0", z3.And(self.omega[0] > 0, self.omega[1] > 0)), self.tf_def())
 
     def box(self, variant: str, k: z3.ArithRef, *, sign_flip: bool = False) -> tuple[Vec, Vec]:
-        """spec.left_box's rule for layer k (a real), per joint (lo, hi), docs/model.md §4.1."""
-        a = self.theta(k * self.dt)
-        out = []
-        for q in range(2):
-            step = self.omega[q] * self.dt
-            if variant == "original":
-                out.append((a[q] - step, a[q] + step))
-            elif variant == "modified":
-                up, down = z3.RealVal(1), z3.RealVal(-1)
-                sign = z3.If(self.goal[q] > self.start[q], down if sign_flip else up,
-                             up if sign_flip else down)
-                end = a[q] + sign * step
-                out.append((_mn(a[q], end), _mx(a[q], end)))
-            elif variant == "tight":
-                b = self.theta((k + 1) * self.dt)[q]
-                out.append((_mn(a[q], b), _mx(a[q], b)))
-            else:
-                raise ValueError(variant)
-        return (out[0], out[1])
+        """Layer k's box (k a real): spec.Variant.layer_box, the code's rule, run on the symbols
+        (``sign_flip``, a test's mutant, points the modified box away from the goal)."""
+        v = Variant(variant)
+        if sign_flip:
+            return v.layer_box(self.start, self.goal, self.omega, self.dt, self.Tf, k) if (
+                v is not Variant.MODIFIED) else _flipped(self, k)
+        return v.layer_box(self.start, self.goal, self.omega, self.dt, self.Tf, k)
 
     def rest_box(self, variant: str, **kw: bool) -> tuple[Vec, Vec]:
-        """The rest layer's box: layer N-1's (original, modified), the goal (tight)."""
-        if variant == "tight":
-            return ((self.goal[0], self.goal[0]), (self.goal[1], self.goal[1]))
-        return self.box(variant, z3.ToReal(self.N) - 1, **kw)
+        """The rest layer's box: spec.Variant.rest_box (layer N-1's, or the goal for tight)."""
+        v = Variant(variant)
+        if kw.get("sign_flip") and v is Variant.MODIFIED:
+            return _flipped(self, z3.ToReal(self.N) - 1)
+        return v.rest_box(self.start, self.goal, self.omega, self.dt, self.Tf,
+                          z3.ToReal(self.N))
+
+
+def _flipped(P: Principal, k: z3.ArithRef) -> tuple[Vec, Vec]:
+    """The modified rule with s_q negated (the tests' mutant), through the same joint_box."""
+    a = P.theta(k * P.dt)
+    out = [Variant.MODIFIED.joint_box(a[q], a[q], P.omega[q] * P.dt,
+                                      z3.Not(P.goal[q] > P.start[q])) for q in range(2)]
+    return (out[0], out[1])
 
 
 def in_box(theta: Vec, box: tuple[Vec, Vec]) -> z3.BoolRef:
@@ -1294,9 +1286,8 @@ class Subordinate:
         return (self.lo[0] + z3.ToReal(c[0]) * self.h[0], self.lo[1] + z3.ToReal(c[1]) * self.h[1])
 
     def box(self, c: tuple[z3.ArithRef, z3.ArithRef]) -> tuple[Vec, Vec]:
-        """spec.right_box: [t_i - h1, t_i + h1] x [t_j - h2, t_j + h2]."""
-        a = self.angle(c)
-        return ((a[0] - self.h[0], a[0] + self.h[0]), (a[1] - self.h[1], a[1] + self.h[1]))
+        """spec.cell_box (spec.right_box's rule) run on the symbols."""
+        return cell_box(self.lo, self.h, (z3.ToReal(c[0]), z3.ToReal(c[1])))
 
     def theta(self, c: tuple[z3.ArithRef, z3.ArithRef], c2: tuple[z3.ArithRef, z3.ArithRef],
               k: z3.ArithRef, t: z3.ArithRef, dt: z3.ArithRef) -> Vec:
