@@ -23,7 +23,8 @@ label" in ``labels.conclusion`` and the reachable-set conditions are still writt
 ``labels.optimal`` closes the chain: the returned path's recomputed cost Q passes the checker's
 goal comparison against C, and the conclusion's C <= (J1, J2)(L) gives Q <= (J1, J2)(L).
 
-Each has four VCs (labels five, with ``optimal``): the induction's base, its step (split in two: ``walk``, that is_path makes
+Each has four VCs (labels five, with ``optimal``): the induction's base, its step (split in
+two: ``walk``, that is_path makes
 L's edge k a free edge to its state at k + 1; and ``step``, that the edge or closure condition
 at that edge keeps the invariant), and its conclusion; the induction principle over 0 .. T
 (what the while rule is for a loop) joins them. The checker tests its edge condition at every
