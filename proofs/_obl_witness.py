@@ -15,7 +15,16 @@ T = max(LENGTH L - 1, N); its state at step k is ``(min(k, N), c(k), p(k))``.
 - ``Witness.reachable_sound``: the invariant "the state at step k is in the set" holds at 0,
   is kept by closure, and at T contradicts the exclusion: no list is a valid path.
 
-Each has four VCs: the induction's base, its step (split in two: ``walk``, that is_path makes
+The checker's edge and goal conditions are not restated here: ``spec``'s own functions
+(``step_cost``, ``label_key``, ``edge_bound``, ``edge_holds``, ``label_in_range``,
+``goal_holds``), which ``check_witness`` calls on numpy arrays, are called on Z3 terms, so a
+loosened condition fails ``labels.step`` or ``labels.optimal``. (The goal condition's "least
+label" in ``labels.conclusion`` and the reachable-set conditions are still written here.)
+``labels.optimal`` closes the chain: the returned path's recomputed cost Q passes the checker's
+goal comparison against C, and the conclusion's C <= (J1, J2)(L) gives Q <= (J1, J2)(L).
+
+Each has four VCs (labels five, with ``optimal``): the induction's base, its step (split in
+two: ``walk``, that is_path makes
 L's edge k a free edge to its state at k + 1; and ``step``, that the edge or closure condition
 at that edge keeps the invariant), and its conclusion; the induction principle over 0 .. T
 (what the while rule is for a loop) joins them. The checker tests its edge condition at every
@@ -34,6 +43,7 @@ from dataclasses import dataclass
 
 import z3
 
+from ..spec import edge_bound, edge_holds, goal_holds, label_in_range, label_key, step_cost
 from ..spec.z3defs import (Z3Dims, Z3PathVar, abs_int, in_grid, is_path_fixed, lex_le, position,
                             z3_path)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
@@ -145,14 +155,22 @@ def _labels_vcs() -> tuple[VC, ...]:
     ints = z3.IntSort()
     A1, A2 = z3.Array("A1", ints, ints), z3.Array("A2", ints, ints)
     C = (z3.Int("C.J1"), z3.Int("C.J2"))
+    Q = (z3.Int("Q.J1"), z3.Int("Q.J2"))
 
     def label(x: State) -> tuple[z3.ArithRef, z3.ArithRef]:
         return lab1[x], lab2[x]
 
+    def key(x: State) -> z3.ArithRef:
+        return label_key(lab1[x], lab2[x])
+
     def edge_ok(src: State, dst: State, d: Cell) -> z3.BoolRef:
-        p = src[3:]
-        cost = (abs_int(d[0]) + abs_int(d[1]), abs_int(d[0] - p[0]) + abs_int(d[1] - p[1]))
-        return z3.And(has[dst], lex_le(label(dst), (lab1[src] + cost[0], lab2[src] + cost[1])))
+        # spec.check_witness's own condition, run on Z3 terms: keys, not pairs.
+        cost = step_cost((d[0], d[1]), (src[3], src[4]))
+        return z3.And(has[dst], edge_holds(key(dst), edge_bound(key(src), cost)))
+
+    def in_range(x: State) -> z3.BoolRef:
+        return z3.Implies(has[x], z3.And(0 <= lab1[x], 0 <= lab2[x],
+                                         label_in_range(lab1[x], lab2[x])))
 
     k = z3.Int("k")
     kk = z3.Int("pre!k")
@@ -168,6 +186,8 @@ def _labels_vcs() -> tuple[VC, ...]:
              z3.And(has[origin], lex_le(label(origin), (0, 0))))
     edge = ("witness.edge at L's edge k: label[s'] <= label[s] + cost if it is a free edge from "
             "a labelled state", _edge_condition(w, has, edge_ok, w.state(k), w.prev(k + 1)))
+    form = ("witness.form at L's states k, k + 1: labels unsigned, in range",
+            z3.And(in_range(w.state(k)), in_range(w.state(k + 1))))
     qi, qj = z3.Ints("g!pi g!pj")
     at_goal = (w.d.N, w.goal[0], w.goal[1], qi, qj)
     goal = ("witness.goal: C <= label + (0, |p|_1) at every labelled admissible goal state",
@@ -186,11 +206,17 @@ def _labels_vcs() -> tuple[VC, ...]:
         _walk_vc(w, "labels.walk"),
         VC("labels.step", (dims, prefix, ("L's edge k is a free edge to its state at k + 1 "
                                            "(VC labels.walk)", _walk(w, k)),
-                           edge, ("0 <= k < T", z3.And(0 <= k, k < w.T)),
+                           edge, form, ("0 <= k < T", z3.And(0 <= k, k < w.T)),
                            ("invariant at k", inv(k))),
            inv(k + 1), key_premise=edge[0]),
         VC("labels.conclusion", w.base() + (prefix, goal, ("invariant at T", inv(w.T))),
            lex_le(C, cost_L), key_premise=goal[0]),
+        # The returned path's recomputed (J1, J2) = Q passes witness.goal (the checker's own
+        # comparison, run on Z3 terms) and C <= (J1, J2)(L) for any valid L (the conclusion's
+        # goal, verbatim): Q <= (J1, J2)(L), the returned path is optimal.
+        VC("labels.optimal", (("witness.goal's comparison: Q equals C", goal_holds(Q, C)),
+                              ("C <= (J1, J2)(L) (VC labels.conclusion)", lex_le(C, cost_L))),
+           lex_le(Q, cost_L), key_premise="witness.goal's comparison: Q equals C"),
     )
 
 
@@ -248,8 +274,10 @@ def witness_obligations() -> list[Obligation]:
             "the goal to T = max(LENGTH L - 1, N) moves: the state held at step k is labelled "
             "at most the first k moves' cost (VCs base; walk and step, with the edge condition "
             "at L's own edge, a named instance: ledger A8); the last is an admissible goal "
-            "state (VC conclusion). So a valid returned path of cost C, the least goal label, "
-            "is optimal (Definition 5): spec.check_witness's acceptance is sound (ledger A6).",
+            "state (VC conclusion). The edge condition is spec's own (edge_holds on label keys, "
+            "run on Z3 terms, with witness.form's range); VC optimal: a returned path whose "
+            "cost passes spec's goal_holds against C is no worse than any valid L (Definition "
+            "5): spec.check_witness's acceptance is sound (ledger A6).",
             Z, P, lambda: Z3Query(_labels_vcs())),
         Obligation(
             "Witness.reachable_sound", GROUP, "ours: McConnell et al.'s certifying algorithms",

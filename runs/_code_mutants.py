@@ -73,6 +73,14 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "impl/_builtdr.py",
                (("    for k in range(g.N):\n        box = left_box(s, v, k)\n",
                  "    for k in range(g.N - 1):\n        box = left_box(s, v, k)\n"),)),
+    # --- issue 21 item 9, the witness checker's conditions (helper h21c) ---
+    CodeMutant("witness_edge_loosened", "the witness checker's edge bound loosened by one "
+               "(label[s'] <= label[s] + cost + 1)", "spec/_witness.py",
+               (("    return target_key <= bound\n", "    return target_key <= bound + 1\n"),)),
+    CodeMutant("witness_goal_inequality", "the witness checker's goal comparison turned into an "
+               "inequality (the path's cost >= the least goal label)", "spec/_witness.py",
+               (("    return (cost[0] == least[0]) & (cost[1] == least[1])\n",
+                 "    return (cost[0] >= least[0]) & (cost[1] >= least[1])\n"),)),
 )
 
 #: The checks a mutant is run through, in this order.

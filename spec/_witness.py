@@ -45,6 +45,15 @@ exists (obligation ``Witness.reachable_sound``).
 The checker shares no code with impl/; it reads each layer once, on the bounding box of the
 labelled (or reached) states, and names the first failing condition with its state, edge and
 labels.
+
+**The conditions, written once.** Each test the checker makes at a state or an edge is one of the
+functions below (``label_key`` .. ``exclusion_breaks``). They use only ``+ - * == <= < & | ~``
+and ``abs``, so they run on numpy integer or Boolean arrays (as the checker calls them) and on
+Z3 terms (as ``proofs/_obl_witness.py`` calls them): the soundness proof is about these very
+conditions, and an edit of one changes the proved statement (a loosened one fails the proof).
+Labels are compared as keys ``J1 * 2**32 + J2`` (``label_key``), lexicographic as long as J2 and
+the sums below stay under 2**32, which ``witness.form``'s ``label_in_range`` ensures (proved in
+the VC ``labels.edge``).
 """
 
 from __future__ import annotations
@@ -63,23 +72,85 @@ from ..errors import MISSING, InputError
 from ._paths import J1, J2, MOVES, SearchResult, SearchStatus, path_violations
 from ._triples import Failure
 
-__all__ = ["LABEL_LIMITS", "WITNESS_FORMAT", "Witness", "check_witness", "load_witness"]
+__all__ = ["KEY_BASE", "LABEL_LIMITS", "WITNESS_FORMAT", "Witness", "check_witness",
+           "closure_breaks", "edge_bound", "edge_holds", "exclusion_breaks", "goal_holds",
+           "label_in_range", "label_key", "load_witness", "start_breaks", "step_cost",
+           "stop_key"]
 
 #: The tag a witness file carries (npz member ``format``).
 WITNESS_FORMAT = "cfmpa-witness-1"
 #: Labels must lie below these (J1, J2): then keys J1 * 2**32 + J2 and their sums are exact.
 LABEL_LIMITS = (1 << 30, 1 << 31)
 
+#: The weight of J1 in a label's key J1 * KEY_BASE + J2.
+KEY_BASE = 1 << 32
+
+Array = npt.NDArray[Any]
+
+
+# --- the checker's conditions: on numpy arrays and on Z3 terms ----------------------------------
+# Nothing here may use Python's `and`, `or`, `not`, `if` or a call numpy and Z3 do not share.
+
+
+def label_key(j1: Any, j2: Any) -> Any:
+    """The key J1 * KEY_BASE + J2 by which labels are compared."""
+    return j1 * KEY_BASE + j2
+
+
+def label_in_range(j1: Any, j2: Any) -> Any:
+    """witness.form's range: J1 < 2**30 and J2 < 2**31 (unsigned: both >= 0)."""
+    return (j1 < LABEL_LIMITS[0]) & (j2 < LABEL_LIMITS[1])
+
+
+def step_cost(d: tuple[Any, Any], p: tuple[Any, Any]) -> tuple[Any, Any]:
+    """(|d|_1, |d - p|_1): what J1 and J2 add for the move d after the move p."""
+    return abs(d[0]) + abs(d[1]), abs(d[0] - p[0]) + abs(d[1] - p[1])
+
+
+def edge_bound(source_key: Any, cost: tuple[Any, Any]) -> Any:
+    """The key of label[s] + cost(s, s'): cost's J1 part weighs KEY_BASE, its J2 part 1."""
+    return source_key + cost[0] * KEY_BASE + cost[1]
+
+
+def edge_holds(target_key: Any, bound: Any) -> Any:
+    """witness.edge at one free edge from a labelled state: label[s'] <= label[s] + cost."""
+    return target_key <= bound
+
+
+def stop_key(key: Any, p: tuple[Any, Any]) -> Any:
+    """A goal state's key plus the stop term (0, |p|_1), p the move that arrived."""
+    return key + abs(p[0]) + abs(p[1])
+
+
+def goal_holds(cost: tuple[Any, Any], least: tuple[Any, Any]) -> Any:
+    """witness.goal: the path's (J1, J2) equals the least goal label plus its stop term."""
+    return (cost[0] == least[0]) & (cost[1] == least[1])
+
+
+def start_breaks(start_free: Any, in_set: Any) -> Any:
+    """witness.start (no path) fails: the start is free in layer 0, its state not in the set."""
+    return start_free & ~in_set
+
+
+def closure_breaks(source_in: Any, target_free: Any, target_in: Any) -> Any:
+    """witness.closure fails at an edge from a free state: its source in the set, its target
+    free and not in the set."""
+    return source_in & target_free & ~target_in
+
+
+def exclusion_breaks(goal_free: Any, in_set: Any) -> Any:
+    """witness.exclusion fails: the goal is free in R and a goal state (N, goal, p) in the set."""
+    return goal_free & in_set
+
+
 _WAIT = MOVES.index((0, 0))
 _DI = np.array([d[0] for d in MOVES], dtype=np.int64)
 _DJ = np.array([d[1] for d in MOVES], dtype=np.int64)
-_NORM = np.abs(_DI) + np.abs(_DJ)                                          # |d|_1
-_TURN = np.abs(_DI[:, None] - _DI[None, :]) + np.abs(_DJ[:, None] - _DJ[None, :])  # [p, d]
+_NORM = step_cost((_DI, _DJ), (0, 0))[0]                                          # |d|_1
+_TURN = step_cost((_DI[None, :], _DJ[None, :]), (_DI[:, None], _DJ[:, None]))[1]  # [p, d]
 _SHIFT = 32
 #: Above every finite key plus an edge cost, and far from overflowing int64.
 _NONE = np.int64((1 << 62) + (1 << 40))
-
-Array = npt.NDArray[Any]
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,7 +257,7 @@ def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
             return [_fail("form", "a state has a label in one array only",
                           ("state", _state(s, (i, j), p)), ("j1", int(j1[s, p, i, j])),
                           ("j2", int(j2[s, p, i, j])), ("no label", int(none)))]
-        big = ~a & ((j1[s] >= LABEL_LIMITS[0]) | (j2[s] >= LABEL_LIMITS[1]))
+        big = ~a & ~label_in_range(j1[s], j2[s])
         if big.any():
             p, i, j = _first(big)
             return [_fail("form", "a label is out of range (J1 < 2**30, J2 < 2**31)",
@@ -205,10 +276,10 @@ def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
         return [_fail("path", f"the returned path is not valid: {bad[0].message}",
                       ("clause", bad[0].clause), ("failed clauses", len(bad)))]
     cost = (J1(path), J2(path))
-    keys = _keys(j1[N, :, goal[0], goal[1]], j2[N, :, goal[0], goal[1]]) + _NORM
+    keys = stop_key(_keys(j1[N, :, goal[0], goal[1]], j2[N, :, goal[0], goal[1]]), (_DI, _DJ))
     p = int(np.argmin(keys))
     least = None if keys[p] >= _NONE else (int(keys[p] >> _SHIFT), int(keys[p] & 0xFFFFFFFF))
-    if least != cost:
+    if least is None or not goal_holds(cost, least):
         return [_fail("goal", "the path's (J1, J2) is not the least label over the goal's "
                       "admissible states (plus the stop term |p|_1)",
                       ("path's J1, J2 (recomputed)", list(cost)),
@@ -220,7 +291,8 @@ def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
 def _keys(j1: Array, j2: Array) -> Array:
     """Lexicographic keys J1 * 2**32 + J2 (int64), _NONE where there is no label."""
     none = np.iinfo(j1.dtype).max
-    k = (j1.astype(np.int64) << _SHIFT) | j2.astype(np.int64)
+    with np.errstate(over="ignore"):        # the unlabelled overflow; replaced by _NONE below
+        k = label_key(j1.astype(np.int64), j2.astype(np.int64))
     return np.where(j1 == none, _NONE, k)
 
 
@@ -245,11 +317,11 @@ def _check_edges(free: Array, j1: Array, j2: Array) -> list[Failure]:
             if a0 >= a1 or b0 >= b1:
                 continue
             sub = key[:, a0 - r0:a1 - r0, b0 - c0:b1 - c0]
-            bound = np.min(sub + _TURN[:, d, None, None], axis=0)     # least label + |d - p|
+            # The least label[s] + cost over p: the edge holds for every p iff for the least.
+            bound = np.min(edge_bound(sub, (_NORM[d], _TURN[:, d, None, None])), axis=0)
             ti, tj = slice(a0 + _DI[d], a1 + _DI[d]), slice(b0 + _DJ[d], b1 + _DJ[d])
             target = _keys(j1[t, d, ti, tj], j2[t, d, ti, tj])
-            bad = ((bound < _NONE) & free[t, ti, tj]
-                   & (target > bound + (int(_NORM[d]) << _SHIFT)))
+            bad = (bound < _NONE) & free[t, ti, tj] & ~edge_holds(target, bound)
             if bad.any():
                 count += int(bad.sum())
                 if first is None:
@@ -275,7 +347,7 @@ def _check_edges(free: Array, j1: Array, j2: Array) -> list[Failure]:
 def _check_reachable(free: Array, start: tuple[int, int], goal: tuple[int, int],
                      reach: Array) -> list[Failure]:
     N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
-    if free[0][start] and not reach[0, _WAIT, start[0], start[1]]:
+    if start_breaks(free[0][start], reach[0, _WAIT, start[0], start[1]]):
         return [_fail("start", "the start state is free but not in the set",
                       ("state", _state(0, start, _WAIT)))]
     first, count = None, 0
@@ -292,7 +364,7 @@ def _check_reachable(free: Array, start: tuple[int, int], goal: tuple[int, int],
             if a0 >= a1 or b0 >= b1:
                 continue
             ti, tj = slice(a0 + _DI[d], a1 + _DI[d]), slice(b0 + _DJ[d], b1 + _DJ[d])
-            bad = src[a0:a1, b0:b1] & free[t, ti, tj] & ~reach[t, d, ti, tj]
+            bad = closure_breaks(src[a0:a1, b0:b1], free[t, ti, tj], reach[t, d, ti, tj])
             if bad.any():
                 count += int(bad.sum())
                 if first is None:
@@ -305,7 +377,7 @@ def _check_reachable(free: Array, start: tuple[int, int], goal: tuple[int, int],
         return [_fail("closure", "a free edge leaves the set",
                       ("state", _state(s, (i, j), p)), ("move", list(MOVES[d])),
                       ("to state", _state(t, to, d)), count=count)]
-    if free[N][goal] and reach[N, :, goal[0], goal[1]].any():
+    if exclusion_breaks(free[N][goal], reach[N, :, goal[0], goal[1]]).any():
         p = int(np.flatnonzero(reach[N, :, goal[0], goal[1]])[0])
         return [_fail("exclusion", "an admissible goal state is in the set (the goal can be "
                       "held from it)", ("state", _state(N, goal, p)))]

@@ -21,6 +21,7 @@ from cfmpa.spec import J1, J2
 VCS = [(kind, vc) for kind in ("labels", "reachable") for vc in witness_vcs(kind)]
 KEYS = {"labels.base": "witness.start", "labels.walk": "is_path L",
         "labels.step": "witness.edge", "labels.conclusion": "witness.goal",
+        "labels.optimal": "witness.goal's comparison",
         "reachable.base": "witness.start", "reachable.walk": "is_path L",
         "reachable.step": "witness.closure", "reachable.conclusion": "witness.exclusion"}
 
@@ -53,8 +54,8 @@ def test_each_vc_is_keyed_by_the_condition_it_rests_on():
         assert vc.key_premise.startswith(KEYS[vc.name]), vc.name
 
 
-@pytest.mark.parametrize("name", ["labels.base", "labels.step", "reachable.base",
-                                  "reachable.step"])
+@pytest.mark.parametrize("name", ["labels.base", "labels.step", "labels.optimal",
+                                  "reachable.base", "reachable.step"])
 def test_dropping_the_start_or_edge_condition_makes_z3_answer_sat(name):
     vc = next(v for _, v in VCS if v.name == name)
     assert _answer(vc.without(vc.key_premise)) == z3.sat
@@ -88,7 +89,7 @@ def test_both_obligations_are_proved():
     for ob in witness_obligations():
         proof = discharge(ob)
         assert proof.verdict is Verdict.PROVED, (ob.id, proof.reason, proof.vcs)
-        assert len(proof.vcs) == 4
+        assert len(proof.vcs) == (5 if ob.id == "Witness.labels_sound" else 4)
 
 
 @st.composite
@@ -116,3 +117,26 @@ def test_the_obligations_costs_are_the_specs_j1_and_j2(case):
     a2 = sum(abs(prev[k + 1][0] - prev[k][0]) + abs(prev[k + 1][1] - prev[k][1])
              for k in range(T))
     assert (a1, a2 + abs(prev[T][0]) + abs(prev[T][1])) == (J1(cells), J2(cells))
+
+
+def _refuted(name, **patch):
+    """Z3's answer on VC ``name`` of Witness.labels_sound with spec's conditions replaced."""
+    import cfmpa.proofs._obl_witness as W
+    saved = {k: getattr(W, k) for k in patch}
+    try:
+        for k, f in patch.items():
+            setattr(W, k, f)
+        vc = next(v for v in W.witness_vcs("labels") if v.name == name)
+    finally:
+        for k, f in saved.items():
+            setattr(W, k, f)
+    return _answer(vc)
+
+
+def test_the_proof_reads_the_checkers_edge_and_goal_conditions():
+    # The proof runs spec's own conditions on Z3 terms: loosened, they fail it (the mutants
+    # witness_edge_loosened and witness_goal_inequality of runs/_code_mutants.py).
+    assert _refuted("labels.step", edge_holds=lambda t, b: t <= b + 1) == z3.sat
+    assert _refuted("labels.optimal",
+                    goal_holds=lambda c, m: (c[0] >= m[0]) & (c[1] >= m[1])) == z3.sat
+    assert _refuted("labels.step") == z3.unsat
