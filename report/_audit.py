@@ -32,10 +32,11 @@ from ..files import dumps_json, jsonable, write_bytes_atomic
 from ..errors import CfmpaError, InputError
 from ..scenarios import BUNDLED_DIR
 from ..impl import left_regions
+from ..runs import Campaign, load_campaign, run_campaign
 from ..spec import (Scenario, SearchStatus, Variant, certify_trajectory, executed_trajectory,
                     load_scenario, tolerance_rad, tube_lipschitz)
 from . import _figures as F
-from ._compare import Campaign, campaign_json, format_campaign, load_campaign, run_campaign
+from ._compare import campaign_json, format_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
 from ._obligations import ProofData, load_proofs, load_selftest, read_results, summary_table

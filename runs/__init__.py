@@ -1,5 +1,5 @@
 """Checked runs: a plan under the paper's contracts, `cfmpa check` of another planner's files,
-and the seeded-fault self-check (`cfmpa selftest`).
+the campaign of `cfmpa compare`, and the seeded-fault self-check (`cfmpa selftest`).
 
 This layer uses both ``spec`` (the contracts and the certificate) and ``impl`` (the planner it
 checks). The pipeline, stage by stage (docs/model.md §7, §9):
@@ -17,10 +17,15 @@ path           ``impl.search_opt_path`` (fast variant)      ``impl/_search.py``
 certificate    ``spec.certify``                             ``spec/_certificate.py``
 plan.json      ``plan``, ``plan_json``, ``write_plan``      ``runs/_plan.py``
 check          ``run_check`` (another planner's files)      ``runs/_check.py``
+campaign       ``run_campaign`` (`cfmpa compare`'s work)    ``runs/_campaign.py``
 report         ``report.run_audit``                         ``report/_audit.py``
 =============  ==========================================  ======================
 """
 
+from ._campaign import (COMPARE_DT, CONTACT_NOTE, KERNEL, MAX_DRAWS, MAX_DT, STORE_NAME, Campaign,
+                        CaseError, CaseResult, VariantOutcome, load_campaign, plan_workcell,
+                        random_workcell, run_campaign, workcell_task)
+from ._store import Store, open_store, read_store
 from ._batch import BATCH_JSON, batch_table, check_plan_folder, find_plan_folders, run_batch
 from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
 from ._engine import (CONNECT_TIMEOUT_S, RETRIES, Engine, ProgressBar, TaskLost,
@@ -47,6 +52,10 @@ __all__ = [
     "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
     "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost",
     "check_scheduler_address", "error_message",
+    # the campaign of `cfmpa compare` and its resumable store (docs/model.md §13)
+    "COMPARE_DT", "CONTACT_NOTE", "Campaign", "CaseError", "CaseResult", "KERNEL", "MAX_DRAWS",
+    "MAX_DT", "STORE_NAME", "Store", "VariantOutcome", "load_campaign", "open_store",
+    "plan_workcell", "random_workcell", "read_store", "run_campaign", "workcell_task",
     # any planner's trajectory (docs/model.md §12)
     "BLOCK_ROWS", "Excursion", "MonitorResult", "certify_json", "log_csv", "monitor_json",
     "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",

@@ -31,6 +31,9 @@ ALLOWED = {
     "cfmpa": {"cfmpa.spec", "cfmpa.impl", "cfmpa.proofs", "cfmpa.runs", "cfmpa.report"},
 }
 LEAVES = {"cfmpa", "cfmpa.errors", "cfmpa.files", "cfmpa.gitstate", "cfmpa.scenarios"}
+#: Libraries a module may not import, by module name prefix: the report presents what runs/
+#: computed (the campaign's engine is runs/_engine.py's), so it has no dask of its own.
+FORBIDDEN = {"cfmpa.report": {"dask", "distributed"}}
 
 
 def _modules() -> list[tuple[str, str, Path]]:
@@ -91,6 +94,18 @@ def _problems(pkg: str, module: str, f: Path) -> list[str]:
         leaf = target in LEAVES or f"{target}.{name}" in LEAVES
         if owner not in ALLOWED[pkg] and not leaf:
             found.append(f"{where}: {pkg} may not import {owner} (layer order)")
+    return found + _forbidden(pkg, module, f)
+
+
+def _forbidden(pkg: str, module: str, f: Path) -> list[str]:
+    """Imports of a library that FORBIDDEN keeps out of ``module``, one line each."""
+    banned = set().union(*(libs for prefix, libs in FORBIDDEN.items()
+                           if module == prefix or module.startswith(prefix + ".")))
+    found = []
+    for line, target, _ in _imports(pkg, module, ast.parse(f.read_text(), str(f))):
+        if target.split(".")[0] in banned:
+            found.append(f"{f.relative_to(ROOT)}:{line}: {module} may not import "
+                         f"{target.split('.')[0]}")
     return found
 
 
@@ -113,6 +128,19 @@ def test_the_rule_catches_a_planted_import(source: str, expected: str):
     finally:
         planted.unlink()
     assert any(expected in p and "proofs/_planted_for_test.py:1" in p for p in problems), problems
+
+
+@pytest.mark.parametrize("source", ["import dask\n", "from dask.distributed import Client\n",
+                                    "def f():\n    from distributed import as_completed\n"])
+def test_the_report_may_not_import_dask(source: str):
+    planted = ROOT / "report" / "_planted_for_test.py"
+    planted.write_text(source)
+    try:
+        problems = _problems("cfmpa.report", "cfmpa.report._planted_for_test", planted)
+    finally:
+        planted.unlink()
+    assert any("cfmpa.report._planted_for_test may not import" in p for p in problems), problems
+    assert not _problems("cfmpa.runs", "cfmpa.runs._planted", ROOT / "runs" / "_engine.py")
 
 
 def test_the_rule_lets_a_public_import_through():
