@@ -6,7 +6,7 @@ The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
 from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
 from ._grid import (EPS, Grid, Variant, VariantRule, cell_box, exact_n, exact_tf, joint_points,
-                    left_angles, left_box, make_grid, ptp_angles, rest_box, right_box)
+                    left_angles, left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
 from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
 from ._trajectory import (Trajectory, certify_trajectory, csv_column_order, executed_trajectory,
@@ -34,7 +34,7 @@ __all__ = [
     "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
     "MAX_EXTRA_POINTS", "decimal", "joint_grid",
     "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_box", "right_box",
-    "VariantRule", "cell_box", "ptp_angles",
+    "VariantRule", "cell_box", "ptp_angles", "rule_of",
     # one definition on floats and on Z3 terms (the rules the proofs read)
     "cases", "ceil_of", "floor_of", "if_then", "max_of", "min_of",
     # geometry

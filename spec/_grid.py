@@ -246,20 +246,25 @@ def left_box(s: Scenario, variant: Variant | str, k: int) -> tuple[Pair2, Pair2]
     ``Variant.layer_box`` on the scenario's floats."""
     L = s.left
     box = Variant(variant).layer_box(L.start, L.goal, L.omega, s.dt, float(exact_tf(s)), k)
-    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))
+    return _float_box(box)
 
 
 def rest_box(s: Scenario, variant: Variant | str, N: int) -> tuple[Pair2, Pair2]:
     """The principal's box in the rest layer (from N dt on): ``Variant.rest_box``."""
     L = s.left
     box = Variant(variant).rest_box(L.start, L.goal, L.omega, s.dt, float(exact_tf(s)), N)
-    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))
+    return _float_box(box)
 
 
 def right_box(g: Grid, cell: tuple[int, int]) -> tuple[Pair2, Pair2]:
     """The subordinate's box at cell (i, j): ``cell_box`` on the grid's floats."""
     box = cell_box(g.lo, g.h, cell)
-    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))
+    return _float_box(box)
 
 
 Pair2 = tuple[float, float]
+
+
+def _float_box(box: Any) -> tuple[Pair2, Pair2]:
+    """A rule's box ((lo1, hi1), (lo2, hi2)) as Python floats."""
+    return ((float(box[0][0]), float(box[0][1])), (float(box[1][0]), float(box[1][1])))

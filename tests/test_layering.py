@@ -114,6 +114,16 @@ def test_no_package_imports_another_packages_private_module_or_against_the_layer
     assert not problems, "\n".join(problems)
 
 
+def _planted_problems(folder: str, source: str) -> list[str]:
+    """The layering problems of a module holding ``source``, planted in ``folder`` for the call."""
+    planted = ROOT / folder / "_planted_for_test.py"
+    planted.write_text(source)
+    try:
+        return _problems(f"cfmpa.{folder}", f"cfmpa.{folder}._planted_for_test", planted)
+    finally:
+        planted.unlink()
+
+
 @pytest.mark.parametrize("source, expected", [
     ("from ..impl._regions import SNAP\n", "a private part of cfmpa.impl"),
     ("from ..impl import _regions\n", "a private part of cfmpa.impl"),
@@ -121,24 +131,14 @@ def test_no_package_imports_another_packages_private_module_or_against_the_layer
     ("from ..runs import plan\n", "may not import cfmpa.runs"),
 ])
 def test_the_rule_catches_a_planted_import(source: str, expected: str):
-    planted = ROOT / "proofs" / "_planted_for_test.py"
-    planted.write_text(source)
-    try:
-        problems = _problems("cfmpa.proofs", "cfmpa.proofs._planted_for_test", planted)
-    finally:
-        planted.unlink()
+    problems = _planted_problems("proofs", source)
     assert any(expected in p and "proofs/_planted_for_test.py:1" in p for p in problems), problems
 
 
 @pytest.mark.parametrize("source", ["import dask\n", "from dask.distributed import Client\n",
                                     "def f():\n    from distributed import as_completed\n"])
 def test_the_report_may_not_import_dask(source: str):
-    planted = ROOT / "report" / "_planted_for_test.py"
-    planted.write_text(source)
-    try:
-        problems = _problems("cfmpa.report", "cfmpa.report._planted_for_test", planted)
-    finally:
-        planted.unlink()
+    problems = _planted_problems("report", source)
     assert any("cfmpa.report._planted_for_test may not import" in p for p in problems), problems
     assert not _problems("cfmpa.runs", "cfmpa.runs._planted", ROOT / "runs" / "_engine.py")
 

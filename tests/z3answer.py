@@ -5,6 +5,7 @@ unknown retried under other seeds, since only sat or unsat is an answer."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from fractions import Fraction
 
 import z3
 
@@ -23,3 +24,16 @@ def answer(formulas: Sequence[z3.BoolRef], *, seeds: int = 3,
         if result != z3.unknown:
             return result
     return result
+
+
+def exact_real(x: float | Fraction) -> z3.ArithRef:
+    """The exact rational value of a double (or Fraction) as a Z3 real."""
+    f = Fraction(x)
+    return z3.RealVal(f"{f.numerator}/{f.denominator}")
+
+
+def as_float(e: z3.ExprRef) -> float:
+    """A closed Z3 term's value as the nearest double (asserting it simplifies to a rational)."""
+    v = z3.simplify(e)
+    assert z3.is_rational_value(v), v
+    return float(v.as_fraction())

@@ -6,13 +6,11 @@ spec.right_box's on the bundled scenarios, and the margin read from impl is impl
 
 from __future__ import annotations
 
-from fractions import Fraction
 from pathlib import Path
 
 import pytest
 import z3
-from z3answer import answer
-from z3answer import answer
+from z3answer import answer, as_float, exact_real
 from cfmpa.impl import SNAP, link_reach, sweep_margin
 from cfmpa.proofs import FIXED_IDS, collect_obligations
 from cfmpa.proofs import _obl_safety as S
@@ -151,25 +149,16 @@ def _scenarios():
     return sorted((REPO / "scenarios").glob("*.toml"))
 
 
-def _q(x) -> z3.ArithRef:
-    f = Fraction(x)
-    return z3.RealVal(f"{f.numerator}/{f.denominator}")
-
-
-def _num(e: z3.ExprRef) -> float:
-    v = z3.simplify(e)
-    assert z3.is_rational_value(v), v
-    return float(v.as_fraction())
 
 
 @pytest.mark.parametrize("path", _scenarios(), ids=lambda p: p.stem)
 def test_the_box_rules_are_spec_left_box_and_right_box(path):
     s = load_scenario(path)
     P = S.Principal.named()
-    pins = [(P.start[q], _q(s.left.start[q])) for q in range(2)]
-    pins += [(P.goal[q], _q(s.left.goal[q])) for q in range(2)]
-    pins += [(P.omega[q], _q(s.left.omega[q])) for q in range(2)]
-    pins += [(P.dt, _q(s.dt)), (P.Tf, _q(exact_tf(s))), (P.N, z3.IntVal(exact_n(s)))]
+    pins = [(P.start[q], exact_real(s.left.start[q])) for q in range(2)]
+    pins += [(P.goal[q], exact_real(s.left.goal[q])) for q in range(2)]
+    pins += [(P.omega[q], exact_real(s.left.omega[q])) for q in range(2)]
+    pins += [(P.dt, exact_real(s.dt)), (P.Tf, exact_real(exact_tf(s))), (P.N, z3.IntVal(exact_n(s)))]
 
     def sub(e: z3.ExprRef) -> z3.ExprRef:
         return z3.substitute(e, *pins)
@@ -180,29 +169,29 @@ def test_the_box_rules_are_spec_left_box_and_right_box(path):
             want = left_box(s, variant, k)
             for q in range(2):
                 for side in range(2):
-                    assert _num(sub(box[q][side])) == pytest.approx(want[q][side], abs=1e-12)
+                    assert as_float(sub(box[q][side])) == pytest.approx(want[q][side], abs=1e-12)
         rest = P.rest_box(variant)
         want = (tuple((g, g) for g in s.left.goal) if variant == "tight"
                 else left_box(s, variant, N - 1))
         for q in range(2):
             for side in range(2):
-                assert _num(sub(rest[q][side])) == pytest.approx(want[q][side], abs=1e-12)
+                assert as_float(sub(rest[q][side])) == pytest.approx(want[q][side], abs=1e-12)
     # The PTP formula is spec.left_angles'.
     for t in (0.0, s.dt / 3, 0.5 * float(exact_tf(s)), 2.0 * float(exact_tf(s)) + 1):
-        th = P.theta(_q(t))
+        th = P.theta(exact_real(t))
         a = left_angles(s, t)
         for q in range(2):
-            assert _num(sub(th[q])) == pytest.approx(float(a[q]), abs=1e-12)
+            assert as_float(sub(th[q])) == pytest.approx(float(a[q]), abs=1e-12)
     # The subordinate's box is spec.right_box's.
     g = make_grid(s)
     R = S.Subordinate.named()
-    rpins = [(R.lo[q], _q(g.lo[q])) for q in range(2)] + [(R.h[q], _q(g.h[q])) for q in range(2)]
+    rpins = [(R.lo[q], exact_real(g.lo[q])) for q in range(2)] + [(R.h[q], exact_real(g.h[q])) for q in range(2)]
     for cell in ((0, 0), (g.m - 1, g.n - 1), (g.m // 2, 1)):
         box = R.box((z3.IntVal(cell[0]), z3.IntVal(cell[1])))
         want = right_box(g, cell)
         for q in range(2):
             for side in range(2):
-                assert (_num(z3.substitute(box[q][side], *rpins))
+                assert (as_float(z3.substitute(box[q][side], *rpins))
                         == pytest.approx(want[q][side], abs=1e-12))
 
 

@@ -3,28 +3,19 @@ functions give on Z3 terms the numbers they give on floats."""
 
 from __future__ import annotations
 
-from fractions import Fraction
 from pathlib import Path
 
 import pytest
 import z3
+from z3answer import as_float, exact_real
 
 from cfmpa.impl import lattice_range
-from cfmpa.spec import Variant, cell_box, exact_tf, left_box, load_scenario, make_grid, rest_box
-from cfmpa.spec._grid import rule_of
+from cfmpa.spec import (Variant, cell_box, exact_tf, left_box, load_scenario, make_grid, rest_box,
+                        rule_of)
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _q(x: float) -> z3.ArithRef:
-    f = Fraction(x)
-    return z3.RealVal(f"{f.numerator}/{f.denominator}")
-
-
-def _num(e: z3.ExprRef) -> float:
-    v = z3.simplify(e)
-    assert z3.is_rational_value(v), v
-    return float(v.as_fraction())
 
 
 def test_every_member_has_a_rule_and_an_unknown_value_raises():
@@ -40,7 +31,7 @@ def test_the_rules_on_terms_give_the_floats(name):
     s = load_scenario(REPO / "scenarios" / f"{name}.toml")
     L = s.left
     tf = float(exact_tf(s))
-    sym = [_q(x) for x in (*L.start, *L.goal, *L.omega, s.dt, tf)]
+    sym = [exact_real(x) for x in (*L.start, *L.goal, *L.omega, s.dt, tf)]
     start, goal, omega, dt, T = sym[0:2], sym[2:4], sym[4:6], sym[6], sym[7]
     g = make_grid(s)
     for v in Variant:
@@ -49,22 +40,22 @@ def test_the_rules_on_terms_give_the_floats(name):
             want = left_box(s, v, k)
             for q in range(2):
                 for side in range(2):
-                    assert _num(box[q][side]) == pytest.approx(want[q][side], abs=1e-12)
+                    assert as_float(box[q][side]) == pytest.approx(want[q][side], abs=1e-12)
         rb = v.rest_box(start, goal, omega, dt, T, z3.IntVal(g.N))
         want = rest_box(s, v, g.N)
         for q in range(2):
             for side in range(2):
-                assert _num(rb[q][side]) == pytest.approx(want[q][side], abs=1e-12)
-    cb = cell_box([_q(x) for x in g.lo], [_q(x) for x in g.h], (z3.IntVal(2), z3.IntVal(1)))
+                assert as_float(rb[q][side]) == pytest.approx(want[q][side], abs=1e-12)
+    cb = cell_box([exact_real(x) for x in g.lo], [exact_real(x) for x in g.h], (z3.IntVal(2), z3.IntVal(1)))
     fb = cell_box(g.lo, g.h, (2, 1))
     for q in range(2):
         for side in range(2):
-            assert _num(cb[q][side]) == pytest.approx(fb[q][side], abs=1e-12)
+            assert as_float(cb[q][side]) == pytest.approx(fb[q][side], abs=1e-12)
 
 
 def test_lattice_range_on_terms_is_lattice_range():
     for lo, hi, a, gg in ((-0.04, 0.04, 0.0, 0.04), (0.3, 0.32, 0.3, 0.02), (1.0, 1.0, 1.0, 0.5),
                           (-1.3, 0.7, 0.25, 0.1)):
-        got = lattice_range(_q(lo), _q(hi), _q(a), _q(gg))
+        got = lattice_range(exact_real(lo), exact_real(hi), exact_real(a), exact_real(gg))
         assert tuple(z3.simplify(x).as_long() for x in got) == lattice_range(lo, hi, a, gg)
     assert lattice_range(0.0, 1.0, 0.0, 0.0) == (0, 0)
