@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TextIO
 
 from ..errors import InputError
+from ._controls import Control, ControlResult, collect_controls
 from ._ledger import ASSUMPTIONS, Assumption
 from ._obl_scenario import CHECKS as SCENARIO_CHECKS
 from ._obl_scenario import scenario_check_id, scenario_files, scenario_obligations
@@ -24,6 +25,7 @@ from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_I
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
+    "Control", "ControlResult", "collect_controls",
     "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
     "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "default_workers",
@@ -50,15 +52,18 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
         raise InputError("--scenarios", str(scenarios_dir),
                          f"holds no *.toml scenario file (the bundled folder is {BUNDLED_DIR})")
     every = expected_ids(sdir)
+    controls = collect_controls(picks)
     for pat in picks or ():
-        if not any(selected(i, [pat]) for i in every):
+        if not any(selected(i, [pat]) for i in every) and not any(
+                selected(c.id, [pat]) for c in controls):
             raise InputError("--only", pat, "selects no obligation (give an id such as "
                              "Prop8.printed, a prefix such as Prop8, or a glob such as 'Thm*')")
     obligations = collect_obligations(sdir, picks)
     expected = [i for i in every if selected(i, picks)]
     run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir),
                           record=run_record(sdir), repin=repin,
-                          workers=default_workers() if workers is None else workers)
+                          workers=default_workers() if workers is None else workers,
+                          controls=controls)
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
 

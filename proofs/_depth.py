@@ -32,7 +32,7 @@ import z3
 
 from ._smtlib import Mode, NotStandard, smtlib_query
 
-__all__ = ["DEPTH_TIMEOUT_MS", "LEVELS", "deepest", "vc_depth"]
+__all__ = ["DEPTH_TIMEOUT_MS", "LEVELS", "deepest", "is_nonlinear", "vc_depth"]
 
 #: Per abstraction check; the abstractions are small, or they fail fast.
 DEPTH_TIMEOUT_MS = 3_000
@@ -70,3 +70,48 @@ def vc_depth(hypotheses: list[z3.BoolRef], goal: z3.BoolRef,
 def deepest(levels: list[str]) -> str | None:
     """An obligation is as deep as its deepest VC (None: no proved VC)."""
     return max(levels, key=LEVELS.index) if levels else None
+
+
+_NONLINEAR_OPS = (z3.Z3_OP_MUL, z3.Z3_OP_DIV, z3.Z3_OP_IDIV, z3.Z3_OP_MOD, z3.Z3_OP_REM,
+                  z3.Z3_OP_POWER)
+
+
+def _constant_value(e: z3.ExprRef) -> bool:
+    """A numeral, or arithmetic of numerals only (e.g. -(1/2), 3 * 7)."""
+    if z3.is_rational_value(e) or z3.is_int_value(e) or z3.is_algebraic_value(e):
+        return True
+    if z3.is_app(e) and e.num_args() > 0 and e.decl().kind() in (
+            z3.Z3_OP_UMINUS, z3.Z3_OP_MUL, z3.Z3_OP_ADD, z3.Z3_OP_SUB, z3.Z3_OP_DIV,
+            z3.Z3_OP_TO_REAL):
+        return all(_constant_value(c) for c in e.children())
+    return False
+
+
+def is_nonlinear(formulas: list[z3.ExprRef]) -> bool:
+    """Whether the formulas hold nonlinear arithmetic: a product of two non-constant terms, or a
+    division, modulus or power whose divisor or exponent is not a numeral (quantifier bodies
+    included). This is not what ``depth`` measures (quantifier instantiation): a VC can be
+    ground and nonlinear, or full and linear."""
+    seen: set[int] = set()
+    todo = list(formulas)
+    while todo:
+        e = todo.pop()
+        key = e.get_id()
+        if key in seen:
+            continue
+        seen.add(key)
+        if z3.is_quantifier(e):
+            todo.append(e.body())
+            continue
+        if not z3.is_app(e):
+            continue
+        kind = e.decl().kind()
+        if kind in _NONLINEAR_OPS and e.num_args() >= 2:
+            args = e.children()
+            if kind == z3.Z3_OP_MUL:
+                if sum(not _constant_value(a) for a in args) >= 2:
+                    return True
+            elif not _constant_value(args[1]):
+                return True
+        todo.extend(e.children())
+    return False

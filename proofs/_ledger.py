@@ -135,13 +135,14 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "Scenario.*.margin_side, Lemma.sweep_margin, Scenario.*.containment"),
     Assumption(
         "A11.safety_scope",
-        "The end-to-end theorem (Safety.*) assumes only A2, A3 and A4: that the polygons and "
+        "The end-to-end theorem (Safety.*) assumes only A2, A3, A4 and A12: that the polygons and "
         "distances impl computes in doubles are the construction Safety.region_soundness "
         "proves sound, up to rounding (lattice indices by impl.lattice_range's formula, "
         "rectangles grown by impl.sweep_margin, their hull by impl.convex_hull (or, in "
         "build_dr_fast, its compiled twin, byte-equal in the tests), the "
         "subordinate's regions built at t_i = 0 and turned by t_i, reach by hypot, a cell free "
-        "iff the distance exceeds eps); A3's trigonometric facts; the solvers. It is a theorem "
+        "iff the distance exceeds eps); A12's bound on the float distance's error; A3's "
+        "trigonometric facts; the solvers. It is a theorem "
         "about A1's model (the links are docs/model.md §2's rectangles). Its premises "
         "are not assumed but stated: D_R meets Theorem 1/3's postcondition (proved of "
         "BuiltDR's program, Thm1/Thm3.builtdr, under A5; checked on the cells at run time) and "
@@ -156,4 +157,19 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "§2 at a configuration, of the polygon built for a box); norm chains are proved for "
         "every function standing for |v|^2, so for |v|^2.",
         "Safety.*"),
+    Assumption(
+        "A12.float_distance_error",
+        "The distance BuiltDR compares with eps, computed in doubles (a box gap, a "
+        "separating-axis gap along float edge normals, or the vertex-edge distance of "
+        "impl._collide and spec.polygon_distance), differs from the exact value of the same "
+        "lower bound of the distance, on the same doubles, by at most spec.DISTANCE_ERROR_M = "
+        "64 u M (u = 2^-53, M = spec.MAX_COORD_M = 4000 m, the coordinate bound of every "
+        "accepted scenario): about 2.8e-11 m.",
+        "Each formula rounds at most about 15 times, each rounding off by u times a quantity of "
+        "at most a few M; 64 u M leaves a factor of four. tests/spec/test_distance_error.py "
+        "checks the bound against exact rational arithmetic on random convex polygons at "
+        "coordinates up to M, near touching (where cancellation is worst). Safety.separation "
+        "proves what it buys: with eps = spec.EPS above it, a freed pair is at a positive exact "
+        "distance; an eps below it is refuted.",
+        "Safety.separation, Safety.*.composition"),
 )

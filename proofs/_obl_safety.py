@@ -15,9 +15,12 @@ dt, then at rest). The parts, each an obligation:
     region built for that box (the lattice of impl.lattice_range's formula, the link
     rectangles grown by impl.sweep_margin, their convex hull), the margin derived from
     Margin.arc_chord and the snap slack, and compared with the margin sweep_margin computes.
-(d) ``Safety.separation``: regions more than eps apart contain links that share no point.
-(e) ``Safety.<variant>.composition``: (a)-(d), Def4.is_path_fixed_safe and the time-layer
-    decomposition give the theorem.
+(d) ``Safety.separation``: a pair BuiltDR frees (float distance > eps) is at an exact distance
+    > 0 when the float value is within spec.DISTANCE_ERROR_M of the exact one (ledger A12) and
+    that bound is below eps; regions at a positive distance hold links that share no point.
+(e) ``Safety.<variant>.composition``: (a)-(d), the fixed is_path and the time-layer
+    decomposition give the theorem; each premise that is not a lemma's instance is shown
+    needed by cfmpa prove's negative controls (proofs/_controls.py).
 
 Trigonometry. sin and cos are the uninterpreted functions ``Sin``, ``Cos`` over Z3's reals;
 all that is known of them are the ledger's facts (A3), each stated at points the proof names.
@@ -38,7 +41,7 @@ from fractions import Fraction
 import z3
 
 from ..impl import SNAP, lattice_range, link_reach, sweep_margin
-from ..spec import EPS, Arm, Variant, cell_box, ptp_angles
+from ..spec import DISTANCE_ERROR_M, EPS, Arm, Variant, cell_box, ptp_angles
 from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
                             is_path_fixed, member, position, z3_path)
 from ._obl_margin import margin_obligations
@@ -437,16 +440,16 @@ def lattice(prefix: str, lo: z3.ArithRef, hi: z3.ArithRef, th: z3.ArithRef, A: z
     i_lo, i_hi, j = z3.Ints(f"{prefix}.i_lo {prefix}.i_hi {prefix}.j")
     moving = z3.Bool(f"{prefix}.moving")
     thc, G, c = z3.Reals(f"{prefix}.theta_c {prefix}.G {prefix}.c")
-    # lattice_range: floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP), then (min, max).
-    a = z3.ToInt((lo - A) / g + SNAP_Q)
-    b = -z3.ToInt(-((hi - A) / g - SNAP_Q))
+    # impl.lattice_range itself, run on the symbols: a changed snap or rounding is the proved
+    # statement's (a wrong one fails it), not a second copy's.
+    lo_t, hi_t = lattice_range(lo, hi, A, g)
     x = (th - A) / g
     lo_r, hi_r = z3.ToReal(i_lo), z3.ToReal(i_hi)
     xc = z3.If(x < lo_r, lo_r, z3.If(x > hi_r, hi_r, x))
     fl = z3.ToInt(xc)
     defs = (
         (f"{prefix}: i_lo, i_hi = impl.lattice_range(lo, hi, A, g)",
-         z3.And(i_lo == z3.If(a <= b, a, b), i_hi == z3.If(a <= b, b, a))),
+         z3.And(i_lo == lo_t, i_hi == hi_t)),
         (f"{prefix}: moving = i_hi > i_lo (more than one lattice point)", moving == (i_hi > i_lo)),
         (f"{prefix}: theta_c = theta clamped onto [A + i_lo g, A + i_hi g]", thc == A + xc * g),
         (f"{prefix}: the cell [c, c + G] of theta_c, j its first index",
@@ -1344,28 +1347,61 @@ def link_r(b: z3.ArithRef, theta: Vec, p: Vec) -> z3.BoolRef:
 
 
 def apart(A: z3.ExprRef, B: z3.ExprRef, eps: z3.ArithRef) -> z3.BoolRef:
-    """dist(A, B) > eps: every point of A is more than eps from every point of B (the regions
-    are compact polygons, so their distance is attained)."""
+    """Every point of A is more than eps from every point of B."""
     x1, y1, x2, y2 = z3.Reals("ap!x1 ap!y1 ap!x2 ap!y2")
     return z3.ForAll([x1, y1, x2, y2], z3.Implies(
         z3.And(member(A, (x1, y1)), member(B, (x2, y2))),
         (x1 - x2) * (x1 - x2) + (y1 - y2) * (y1 - y2) > eps * eps))
 
 
-def separation_lemma() -> Lemma:
+#: fdist(A, B): the distance of two regions as BuiltDR computes it in doubles (or the lower
+#: bound it compares: a box gap, a separating-axis gap); dist(A, B): the exact distance.
+_FDIST = z3.Function("fdist", REGION, REGION, _R)
+_DIST = z3.Function("dist", REGION, REGION, _R)
+#: spec.DISTANCE_ERROR_M as the rational its decimal literal denotes.
+ERR_Q = z3.RealVal(repr(DISTANCE_ERROR_M))
+EPS_HYP = "eps = spec.EPS"
+ERR_HYP = "err = spec.DISTANCE_ERROR_M"
+
+
+def float_free(A: z3.ExprRef, B: z3.ExprRef, eps: z3.ArithRef) -> z3.BoolRef:
+    """BuiltDR's free test on a pair of regions: the float distance exceeds eps."""
+    return _FDIST(A, B) > eps
+
+
+def rounding(A: z3.ExprRef, B: z3.ExprRef, err: z3.ArithRef) -> z3.BoolRef:
+    """Ledger A12 at (A, B): the float distance is within err of the exact one."""
+    return z3.And(_FDIST(A, B) - _DIST(A, B) <= err, _DIST(A, B) - _FDIST(A, B) <= err)
+
+
+def distance_meaning(A: z3.ExprRef, B: z3.ExprRef) -> z3.BoolRef:
+    """What a positive distance of compact regions means: no point of A is a point of B."""
+    return z3.Implies(_DIST(A, B) > 0, apart(A, B, z3.RealVal(0)))
+
+
+def separation_lemmas() -> tuple[Lemma, Lemma]:
+    """(d): (eps_margin) with the float distance within err of the exact one (A12) and err =
+    spec.DISTANCE_ERROR_M <= eps = spec.EPS, a cell freed on "float distance > eps" has
+    regions at an exact distance > 0 (refuted for any eps below err); (no_common_point) regions
+    at a positive distance hold links that share no point."""
     A, B = z3.Consts("sep.A sep.B", REGION)
+    eps, err = z3.Reals("eps err")
+    key = "A12: |fdist(A, B) - dist(A, B)| <= err"
+    hyps = ((EPS_HYP, eps == EPS_Q), (ERR_HYP, err == ERR_Q), (key, rounding(A, B, err)),
+            ("BuiltDR frees the pair: fdist(A, B) > eps", float_free(A, B, eps)))
+    margin = lemma("eps_margin", hyps, _DIST(A, B) > 0, key, names=dict(A=A, B=B))
     a, b = z3.Ints("sep.a sep.b")
     tl, tr, p = _v("sep.thetaL"), _v("sep.thetaR"), _v("sep.p")
-    eps = z3.Real("eps")
-    key = "dist(A, B) > eps"
-    hyps = (("eps = spec.EPS = 1e-9 m", eps == EPS_Q), (key, apart(A, B, eps)),
-            ("(c) link a of the principal at theta_L lies in A (at p)",
-             z3.Implies(link_l(a, tl, p), member(A, p))),
-            ("(c) link b of the subordinate at theta_R lies in B (at p)",
-             z3.Implies(link_r(b, tr, p), member(B, p))))
+    key2 = "dist(A, B) > 0"
+    hyps2 = ((key2, _DIST(A, B) > 0), ("the distance of compact regions", distance_meaning(A, B)),
+             ("(c) link a of the principal at theta_L lies in A (at p)",
+              z3.Implies(link_l(a, tl, p), member(A, p))),
+             ("(c) link b of the subordinate at theta_R lies in B (at p)",
+              z3.Implies(link_r(b, tr, p), member(B, p))))
     goal = z3.Not(z3.And(link_l(a, tl, p), link_r(b, tr, p)))
-    return lemma("no_common_point", hyps, goal, key,
-                 names=dict(A=A, B=B, a=a, b=b, thetaL=tl, thetaR=tr, p=p))
+    common = lemma("no_common_point", hyps2, goal, key2,
+                   names=dict(A=A, B=B, a=a, b=b, thetaL=tl, thetaR=tr, p=p))
+    return margin, common
 
 
 # --- (e) the composition -------------------------------------------------------------------------
@@ -1403,13 +1439,16 @@ LINKS = (0, 1)
 
 
 def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
-                   b: tuple[Lemma, Lemma] | None = None, sep: Lemma | None = None) -> VC:
-    """(e) for ``variant``; the lemmas may be replaced (the tests' mutants)."""
+                   b: tuple[Lemma, Lemma] | None = None) -> VC:
+    """(e) for ``variant``; the lemmas may be replaced (the tests' mutants).
+
+    Every hypothesis is a premise the conclusion needs: ``cfmpa prove`` drops each in turn and
+    requires the composition without it not to be proved (proofs/_controls.py). A fact used at
+    several points (a region's soundness for both links, the rounding bound at the eight pairs
+    of regions) is one hypothesis, the conjunction of its instances."""
     motion, rest = a or principal_lemmas(variant)
-    move, on_path = b or subordinate_lemmas()
-    sep = sep or separation_lemma()
+    move, _ = b or subordinate_lemmas()
     step = _step_lemma()
-    def4 = _obligation_vc("Def4.is_path_fixed_safe", "every_step", path_obligations())
     P = Principal.named()
     S = Subordinate.named()
     d = Z3Dims.named()
@@ -1417,69 +1456,71 @@ def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
     DR = z3.Array("P", ints, ints, ints, ints)
     start, goal = (z3.Int("start.i"), z3.Int("start.j")), (z3.Int("goal.i"), z3.Int("goal.j"))
     L = z3_path("L")
-    t, eps = z3.Real("t"), z3.Real("eps")
+    t, eps, err = z3.Real("t"), z3.Real("eps"), z3.Real("err")
     k = z3.Int("kk")
     p = _v("p")
     region_l, region_rest, region_r = _regions(variant)
 
-    def all_apart(left: Callable[[int], z3.ExprRef], i: z3.ArithRef, j: z3.ArithRef) -> z3.BoolRef:
-        return z3.And([apart(left(x), region_r(i, j, y), eps) for x in LINKS for y in LINKS])
+    def all_free(left: Callable[[int], z3.ExprRef], i: z3.ArithRef, j: z3.ArithRef) -> z3.BoolRef:
+        return z3.And([float_free(left(x), region_r(i, j, y), eps) for x in LINKS for y in LINKS])
 
     post = blocked_exact(
-        DR, d, motion=lambda kk, i, j: z3.Not(all_apart(lambda x: region_l(kk, x), i, j)),
-        rest=lambda _, i, j: z3.Not(all_apart(region_rest, i, j)))
+        DR, d, motion=lambda kk, i, j: z3.Not(all_free(lambda x: region_l(kk, x), i, j)),
+        rest=lambda _, i, j: z3.Not(all_free(region_rest, i, j)))
     here, nxt = position(L, k), position(L, k + 1)
     theta_l = P.theta(t)
     theta_r = S.theta(here, nxt, k, t, P.dt)
-    key = "Theorem 1/3's postcondition: P[k,i,j] = 0 iff every pair of link regions is > eps apart"
+    pairs = [(A, region_r(here[0], here[1], y)) for x in LINKS
+             for A in (region_l(k, x), region_rest(x)) for y in LINKS]
+    key = ("Theorem 1/3's postcondition: P[k,i,j] = 0 iff every pair of link regions has a "
+           "float distance > eps")
     hyps: list[Hyp] = [
         *P.basics(), P.n_def(), ("h_q > 0", z3.And(S.h[0] > 0, S.h[1] > 0)),
-        ("N >= 1, m, n >= 1", d.sane()),
-        ("start, goal in the grid", z3.And(in_grid(d, start), in_grid(d, goal))),
         ("is_path L (fixed, docs/model.md §5)", is_path_fixed(DR, d, start, goal, L)),
-        ("eps = spec.EPS = 1e-9 m", eps == EPS_Q),
         (key, post),
         ("t >= 0", t >= 0),
         ("k = floor(t / dt), the step at t (named)", k == z3.ToInt(t / P.dt)),
+        (EPS_HYP, eps == EPS_Q), (ERR_HYP, err == ERR_Q),
+        ("A12 at the eight pairs of regions (layer k and rest, links x links): "
+         "|fdist - dist| <= err", z3.And([rounding(A, B, err) for A, B in pairs])),
+        ("the distance of compact regions at the eight pairs: dist > 0 -> no common point",
+         z3.And([distance_meaning(A, B) for A, B in pairs])),
     ]
     hyps += step.at("t", k=k, N=d.N, t=t)
     hyps += motion.at("the step k (a)", k=k, t=t)
     hyps += rest.at("t (a)", t=t)
-    hyps += on_path.at("the step k (b)", k=k)
     hyps += move.at("the step k (b)", c=here, c2=nxt, k=k, t=t)
-    inst = z3.substitute(z3.Implies(z3.And([h for _, h in def4.hypotheses]), def4.goal),
-                         (z3.Int("k"), k))
-    hyps.append(("by Def4.is_path_fixed_safe at the step k", inst))
     box_k = P.box(variant, z3.ToReal(k))
-    for x in LINKS:
-        hyps.append((f"(c) Safety.region_soundness: link {x + 1} of the principal at theta_L(t) "
-                     f"in layer k's region (its box, k < N; at p)",
-                     z3.Implies(z3.And(0 <= k, k < d.N, in_box(theta_l, box_k)),
-                                z3.Implies(link_l(x, theta_l, p), member(region_l(k, x), p)))))
-        hyps.append((f"(c) Safety.region_soundness: link {x + 1} of the principal at theta_L(t) "
-                     f"in the rest region (its box; at p)",
-                     z3.Implies(in_box(theta_l, P.rest_box(variant)),
-                                z3.Implies(link_l(x, theta_l, p), member(region_rest(x), p)))))
-        hyps.append((f"(c) Safety.region_soundness: link {x + 1} of the subordinate at "
-                     f"theta_R(t) in the region of its cell (its box; at p)",
-                     z3.Implies(z3.And(in_grid(d, here), in_box(theta_r, S.box(here))),
-                                z3.Implies(link_r(x, theta_r, p),
-                                           member(region_r(here[0], here[1], x), p)))))
-    for x in LINKS:
-        for y in LINKS:
-            for where, A in (("layer k", region_l(k, x)), ("the rest layer", region_rest(x))):
-                hyps += sep.at(f"links ({x + 1}, {y + 1}), {where} (d)", A=A,
-                               B=region_r(here[0], here[1], y), a=z3.IntVal(x), b=z3.IntVal(y),
-                               thetaL=theta_l, thetaR=theta_r, p=p)
+    hyps.append(("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) "
+                 "in layer k's regions (its box, k < N; at p)",
+                 z3.And([z3.Implies(z3.And(0 <= k, k < d.N, in_box(theta_l, box_k)),
+                                    z3.Implies(link_l(x, theta_l, p), member(region_l(k, x), p)))
+                         for x in LINKS])))
+    hyps.append(("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) "
+                 "in the rest regions (its box; at p)",
+                 z3.And([z3.Implies(in_box(theta_l, P.rest_box(variant)),
+                                    z3.Implies(link_l(x, theta_l, p), member(region_rest(x), p)))
+                         for x in LINKS])))
+    hyps.append(("(c) Safety.region_soundness: links 1 and 2 of the subordinate at theta_R(t) "
+                 "in the regions of its cell (its box; at p)",
+                 z3.And([z3.Implies(z3.And(in_grid(d, here), in_box(theta_r, S.box(here))),
+                                    z3.Implies(link_r(x, theta_r, p),
+                                               member(region_r(here[0], here[1], x), p)))
+                         for x in LINKS])))
     target = z3.And([z3.Not(z3.And(link_l(x, theta_l, p), link_r(y, theta_r, p)))
                      for x in LINKS for y in LINKS])
     one, zero = z3.IntVal(1), z3.IntVal(0)
     # One layer, a one-cell grid, a one-cell path: where Z3 finds the models the vacuity check
-    # and the negative tests ask for.
+    # and the negative controls ask for.
     pins = ((d.N, one), (d.m, one), (d.n, one), (L.length, one), (start[0], zero),
             (start[1], zero), (goal[0], zero), (goal[1], zero))
-    return VC(f"composition_{variant}", _dedupe(hyps), target, key_premise=key, witness=pins,
-              counter_witness=pins)
+    # The vacuity check's model also at rest, at t = 0 (finding one for the regions' points is
+    # otherwise left to Z3's model search, which one seed of three missed in 20 s).
+    rz, r1 = z3.RealVal(0), z3.RealVal(1)
+    at_rest = ((t, rz), (k, zero), (P.dt, r1), (P.omega[0], r1), (P.omega[1], r1),
+               (P.start[0], rz), (P.start[1], rz), (P.goal[0], rz), (P.goal[1], rz))
+    return VC(f"composition_{variant}", _dedupe(hyps), target, key_premise=key,
+              witness=pins + at_rest, counter_witness=pins)
 
 
 # --- the obligations ---------------------------------------------------------------------------
@@ -1504,7 +1545,7 @@ def _subordinate_query() -> Z3Query:
 
 
 def _separation_query() -> Z3Query:
-    return Z3Query((separation_lemma().vc,))
+    return Z3Query(tuple(L.vc for L in separation_lemmas()))
 
 
 def _composition_query(variant: str) -> Z3Query:
@@ -1542,9 +1583,9 @@ def safety_obligations() -> list[Obligation]:
         "A point (u, v) of link 1's or link 2's rectangle (docs/model.md §2: half-width r = w/2, "
         "extended by r past both joints; R_base, R_elbow the §2 reach) at any configuration "
         "theta of a box [lo1, hi1] x [lo2, hi2] lies in the region impl.swept_region builds for "
-        "the box: the lattice A_q + i g_q (0 < g_q <= 3.14) with impl.lattice_range's indices "
-        "(floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP), checked against lattice_range on "
-        "samples), the link's rectangle at every lattice configuration grown by Delta = "
+        "the box: the lattice A_q + i g_q (0 < g_q <= 3.14) with the indices of "
+        "impl.lattice_range, read by running lattice_range itself on the symbols "
+        "(floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP)), the link's rectangle at every lattice configuration grown by Delta = "
         "impl.sweep_margin, and their convex hull. The point is exhibited as a convex "
         "combination of points of the grown rectangles at the corners of the lattice cell that "
         "holds theta clamped onto the lattice's span (four corners for link 2, two for link 1, "
@@ -1571,10 +1612,15 @@ def safety_obligations() -> list[Obligation]:
         Z, P, region_query))
     out.append(Obligation(
         "Safety.separation", GROUP, "docs/model.md §4.3, §10 (d)",
-        "If every point of a region A is more than eps = 1e-9 m from every point of a region B "
-        "(dist(A, B) > eps, how BuiltDR decides a cell free; the regions are compact), then a "
-        "link lying in A and a link lying in B share no point (at any point p). Regions and "
-        "links are opaque; Z3 instantiates the distance's quantifier at (p, p).",
+        "What eps buys. (eps_margin) BuiltDR frees a pair of regions when the distance it "
+        "computes in doubles (or a lower bound of it: a box gap, a separating-axis gap) exceeds "
+        "eps = spec.EPS = 1e-9 m; with that float value within err = spec.DISTANCE_ERROR_M "
+        "(64 rounding units per metre of coordinate, for coordinates up to 4000 m: about "
+        "2.8e-11 m; ledger A12, checked against exact rational arithmetic on random polygons) of "
+        "the exact value, the exact distance is then > 0. Both constants are read from the code; "
+        "any eps below err is refuted. (no_common_point) Regions at a positive distance hold "
+        "links that share no point (the distance of compact sets is attained; definitional). "
+        "Regions and links are opaque.",
         Z, P, _separation_query))
     for v in VARIANTS:
         rest = ("the principal at rest at its goal" if v == "tight" else "layer N-1's region")
@@ -1589,11 +1635,14 @@ def safety_obligations() -> list[Obligation]:
             "at step k to the one held at k + 1, k = floor(t / dt) (time_step: k dt <= t <= "
             "(k+1) dt, and t >= N dt once k >= N). Composed by substitution from "
             f"Safety.{v}.principal_in_layer_box (motion for k < N, rest from N dt on), "
-            "Safety.subordinate_in_cell_box (on_path, neighbour_move), "
-            "Def4.is_path_fixed_safe and Safety.separation (for the four link pairs, in layer k "
-            "and in the rest layer); Safety.region_soundness enters as its statement for the "
-            "regions involved (a link at a configuration of a region's box lies in the region), "
-            "instantiated at theta_L(t), theta_R(t) and the point, its links and regions "
-            "opaque here; Z3 instantiates the postcondition's quantifier.",
+            "Safety.subordinate_in_cell_box (neighbour_move; the fixed is_path gives the "
+            "cells) and the time step; the free test is BuiltDR's own (float distance > eps), "
+            "carried to the exact distance by Safety.separation's premises (eps, err, A12 at the "
+            "eight pairs of regions of layer k and of the rest layer, what a positive distance "
+            "means). Safety.region_soundness enters as its statement for the regions involved "
+            "(a link at a configuration of a region's box lies in the region), instantiated at "
+            "theta_L(t), theta_R(t) and the point, its links and regions opaque here. Every "
+            "hypothesis that is not a proved lemma's instance is needed: cfmpa prove's negative "
+            "controls drop each and require the composition without it not proved.",
             Z, P, lambda v=v: _composition_query(v)))
     return out

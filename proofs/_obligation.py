@@ -217,6 +217,7 @@ class VCResult:
     cvc5_reason: str = ""
     solvers: tuple[str, ...] = ()
     note: str = ""                 # why a second solver does not confirm it, if it does not
+    nonlinear: bool = False        # nonlinear real or integer arithmetic (_depth.is_nonlinear)
 
 
 @dataclass(frozen=True)
@@ -524,7 +525,7 @@ def _short_text(f: z3.ExprRef, width: int = 50) -> str:
 
 def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
             ) -> tuple[dict[str, Any], list[Any], list[Any]]:
-    from ._depth import deepest, vc_depth
+    from ._depth import deepest, is_nonlinear, vc_depth
 
     if not q.vcs:
         return (dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
@@ -578,7 +579,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
             note = f"cvc5 undecided when pinned ({why}); not re-run"
         results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
                                 cvc5=cvc5, cvc5_reason=why,
-                                solvers=("z3",) if str(ans) == want else (), note=note))
+                                solvers=("z3",) if str(ans) == want else (), note=note,
+                                nonlinear=is_nonlinear(hyps + [vc.goal])))
     smoke = [_smoke(sm, stats) for sm in q.smoke]      # each in a context of its own
     dead = [r.name for r in smoke if r.answer == "unsat"]
     undecided = [r.name for r in smoke if r.answer == "unknown"]

@@ -37,6 +37,7 @@ from ._obl_witness import witness_obligations
 from ._obl_tolerance import tolerance_obligations
 from ._obl_safety import safety_obligations
 from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
+from ._controls import Control, ControlResult, run_control
 from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
 from ._pins import LOCK, Mismatch, check_pins, cvc5_skips, load_lock
 from ._pins import repin as repin_lock
@@ -44,6 +45,7 @@ from ._pins import repin as repin_lock
 __all__ = [
     "BUNDLED_DIR",
     "BUNDLED_SCENARIOS",
+    "DEFINITIONAL",
     "EXPECTED_VERDICTS",
     "FIXED_IDS",
     "ProveRun",
@@ -51,6 +53,7 @@ __all__ = [
     "default_workers",
     "expected_ids",
     "is_bundled",
+    "kind_of",
     "pinned_verdict",
     "render_report",
     "run_obligations",
@@ -87,6 +90,28 @@ EXPECTED_VERDICTS: dict[str, Verdict] = {
     "Safety.region_soundness": _P, "Safety.separation": _P, "Safety.original.composition": _P,
     "Safety.modified.composition": _P, "Safety.tight.composition": _P,
 }
+
+#: Obligations whose proof is definitional: true by a definition's own clauses, a termination
+#: measure or a named choice instance rather than a theorem about the robot (docs/model.md
+#: §10). Kept by hand beside EXPECTED_VERDICTS, with why; results.json, the summary and the
+#: report count them apart from the theorems.
+DEFINITIONAL: dict[str, str] = {
+    "Thm1.termination": "a termination measure: counted loops end",
+    "Thm3.termination": "a termination measure: counted loops end",
+    "Thm3.termination_tight": "a termination measure: counted loops end",
+    "Prop2.endpoints": "a conjunct of is_path restated",
+    "Prop3.layer_free": "a conjunct of is_path restated",
+    "Prop5.optpath_is_path": "a choice instance: Hilbert choice at the named optimum",
+    "Prop6.opt_layer_free": "a choice instance composed with a conjunct of is_path",
+    "Prop8.intersection_monotone": "the definition of a subset, at a point",
+    "Def1.segment": "the definition's weights named",
+}
+
+
+def kind_of(ident: str) -> str:
+    """``definitional`` for the ids of DEFINITIONAL, else ``theorem``."""
+    return "definitional" if ident in DEFINITIONAL else "theorem"
+
 
 #: The obligations every run must produce, besides the per-scenario ones.
 FIXED_IDS: tuple[str, ...] = tuple(EXPECTED_VERDICTS)
@@ -185,12 +210,14 @@ class ProveRun:
     record: dict[str, Any] = field(default_factory=dict)   # results.json's "run" (run_record)
     pin_mismatch: tuple[Mismatch, ...] = ()  # statement not the one obligations.lock pins
     repinned: tuple[str, ...] | None = None  # --repin: what it changed in the lock
+    controls: tuple[ControlResult, ...] = ()  # the negative controls (proofs/_controls.py)
 
     @property
     def ok(self) -> bool:
         return (all(p.as_expected for p in self.proofs) and not self.missing_ids
                 and not self.unexpected_ids and not self.verdict_mismatch
-                and not self.duplicate_ids and not self.pin_mismatch)
+                and not self.duplicate_ids and not self.pin_mismatch
+                and all(c.ok for c in self.controls))
 
 
 def compare_ids(ids: Sequence[str], expected: Sequence[str]
@@ -219,13 +246,16 @@ def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
 def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                     expected: Sequence[str], *, note: str = "",
                     record: dict[str, Any] | None = None, lock: str | Path | None = None,
-                    repin: bool = False, workers: int = 1) -> ProveRun:
+                    repin: bool = False, workers: int = 1,
+                    controls: Sequence[Control] = ()) -> ProveRun:
     """Discharge each obligation (in ``workers`` forked processes side by side; the results do
     not depend on how many), save its query and the results, compare with the last run;
     every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``,
     and every statement against the lock (``lock``, default proofs/obligations.lock), which
     ``repin`` rewrites first (for the obligations run; after a whole run, dropping the rest).
-    cvc5 replays each VC in the background while Z3 goes on (``_cvc5.Cvc5Pool``)."""
+    cvc5 replays each VC in the background while Z3 goes on (``_cvc5.Cvc5Pool``). Then the
+    negative ``controls`` run (side by side too); the run is OK only if each ends as it
+    expects. ``repin`` never touches what a control expects."""
     from ._cvc5 import Cvc5Pool
 
     out = Path(out_dir)
@@ -242,6 +272,7 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
         with Cvc5Pool() as pool:
             pending = [discharge_pending(o, pool, skip) for o in obligations]
             proofs = tuple(p.settle() for p in pending)
+    checked = _controls_side_by_side(controls, workers)
     seconds = time.perf_counter() - t0
     repinned = None
     if repin:
@@ -271,7 +302,7 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                    seconds=seconds, verdict_mismatch=tuple(mismatch),
                    duplicate_ids=tuple(sorted(repeated)),
                    scenarios_note=note, record=dict(record or {}), pin_mismatch=pins,
-                   repinned=repinned)
+                   repinned=repinned, controls=checked)
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run
 
@@ -332,6 +363,43 @@ def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, s
     return tuple(out)  # type: ignore[arg-type]
 
 
+def _control_worker_start() -> None:
+    from ..impl import set_kernel_threads
+
+    set_kernel_threads(1)
+
+
+def _control_worker(index: int) -> ControlResult:
+    return run_control(_SHARED["controls"][index])
+
+
+def _controls_side_by_side(controls: Sequence[Control], jobs: int) -> tuple[ControlResult, ...]:
+    """Each control run (in ``jobs`` forked processes when more than one); a control whose
+    process dies ends ``error``, which no control expects."""
+    if jobs <= 1 or len(controls) <= 1:
+        return tuple(run_control(c) for c in controls)
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    _SHARED.update(controls=controls)
+    out: list[ControlResult] = []
+    try:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(controls)),
+                                 mp_context=multiprocessing.get_context("fork"),
+                                 initializer=_control_worker_start) as ex:
+            futures = [ex.submit(_control_worker, i) for i in range(len(controls))]
+            for c, fut in zip(controls, futures):
+                try:
+                    out.append(fut.result())
+                except Exception as exc:  # noqa: BLE001 - a dead worker is a result, not a crash
+                    out.append(ControlResult(c.id, c.checker, c.what, c.expected, "error",
+                                             f"its worker process ended ({type(exc).__name__})",
+                                             0.0))
+    finally:
+        _SHARED.clear()
+    return tuple(out)
+
+
 def _query_file(p: Proof) -> str:
     return f"{p.id}.smt2" if p.method is Method.Z3 else f"{p.id}.txt"
 
@@ -390,8 +458,10 @@ def _proof_json(p: Proof, ob: Obligation, change: str) -> dict[str, Any]:
         "reason_unknown": p.reason_unknown,
         "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer, "depth": v.depth,
                  "sha256": v.sha256, "solvers": list(v.solvers), "cvc5": v.cvc5,
-                 "cvc5_reason": v.cvc5_reason, "note": v.note} for v in p.vcs],
+                 "cvc5_reason": v.cvc5_reason, "note": v.note, "nonlinear": v.nonlinear}
+                for v in p.vcs],
         "depth": p.depth, "label": p.label, "solvers": list(p.solvers),
+        "kind": kind_of(p.id), "kind_why": DEFINITIONAL.get(p.id, ""),
         "smoke": [{"name": s.name, "answer": s.answer, "how": s.how} for s in p.smoke],
         "cvc5_seconds": p.cvc5_seconds,
     }
@@ -408,6 +478,7 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
         "sympy": sympy.__version__, "ok": run.ok, "run": run.record,
         "summary": {g: _counts(ps) for g, ps in _groups(run.proofs).items()},
         "totals": _counts(run.proofs),
+        "kinds": kind_counts(run.proofs),
         "missing_ids": list(run.missing_ids), "unexpected_ids": list(run.unexpected_ids),
         "verdict_mismatch": list(run.verdict_mismatch), "duplicate_ids": list(run.duplicate_ids),
         "scenarios_note": run.scenarios_note,
@@ -416,6 +487,8 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
         "pins": {"mismatch": [{"id": i, "what": w} for i, w in run.pin_mismatch],
                  "repinned": None if run.repinned is None else list(run.repinned)},
         "obligations": entries + carried,
+        "controls": [c.as_json() for c in run.controls],
+        "controls_summary": control_summary(run.controls),
         "assumptions": [{"id": a.id, "what": a.what, "why": a.why, "used_by": a.used_by}
                         for a in run.assumptions],
         "seconds": round(run.seconds, 3),
@@ -423,19 +496,46 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
     return json.dumps(doc, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
 
 
+def kind_counts(proofs: Iterable[Proof]) -> dict[str, int]:
+    """How many obligations are theorems and how many definitional (DEFINITIONAL)."""
+    out = {"theorem": 0, "definitional": 0}
+    for p in proofs:
+        out[kind_of(p.id)] += 1
+    return out
+
+
+def control_summary(controls: Sequence[ControlResult]) -> dict[str, int]:
+    """How the negative controls ended: as expected or not, and by which outcome."""
+    out = {"total": len(controls), "as_expected": sum(c.ok for c in controls)}
+    for c in controls:
+        out[c.outcome] = out.get(c.outcome, 0) + 1
+    return out
+
+
+#: What ``depth`` measures, said in results.json beside the table.
+DEPTH_MEASURES = ("quantifier instantiation: the weakest reasoning that proves a VC, "
+                  "propositional (its Boolean skeleton), ground (theories, no quantifier "
+                  "instantiated) or full (quantifiers instantiated); nonlinear arithmetic is "
+                  "counted apart (nonlinear_vcs)")
+
+
 def depth_table(proofs: Iterable[Proof]) -> dict[str, Any]:
-    """Counts per depth level (_depth.LEVELS) of the proved Z3 obligations and of their VCs."""
+    """Counts per depth level (_depth.LEVELS) of the proved Z3 obligations and of their VCs,
+    and how many of those VCs hold nonlinear arithmetic."""
     from ._depth import LEVELS
 
     obs = dict.fromkeys(LEVELS, 0)
     vcs = dict.fromkeys(LEVELS, 0)
+    nonlinear = 0
     for p in proofs:
         if p.depth is not None:
             obs[p.depth] += 1
             for v in p.vcs:
                 if v.depth is not None:
                     vcs[v.depth] += 1
-    return {"obligations": obs, "vcs": vcs}
+                    nonlinear += v.nonlinear
+    return {"measures": DEPTH_MEASURES, "obligations": obs, "vcs": vcs,
+            "nonlinear_vcs": nonlinear}
 
 
 def solver_table(proofs: Iterable[Proof]) -> dict[str, Any]:
@@ -480,7 +580,9 @@ def render_report(run: ProveRun) -> str:
               "VC): " + ", ".join(f"{n} {lv}" for lv, n in dt["obligations"].items())
               + "; their VCs: " + ", ".join(f"{n} {lv}" for lv, n in dt["vcs"].items()),
               "Propositional obligations (proved by their Boolean skeleton alone): "
-              f"{dt['obligations']['propositional']}"]
+              f"{dt['obligations']['propositional']}",
+              "Depth measures quantifier instantiation; proved VCs with nonlinear arithmetic: "
+              f"{dt['nonlinear_vcs']}"]
     st = solver_table(run.proofs)
     lines += [f"Second solver (cvc5 {st['cvc5'] or 'not installed'}) on the standard SMT-LIB: "
               f"{st['z3_and_cvc5']} VCs confirmed by Z3 and cvc5, {st['z3_and_sos']} by Z3 and "
@@ -527,9 +629,29 @@ def render_report(run: ProveRun) -> str:
         lines += [f"    {ln}" for ln in run.repinned]
     for ident, what in run.pin_mismatch:
         lines.append(f"STATEMENT NOT PINNED: {ident}: {what} (review, then cfmpa prove --repin)")
+    if run.controls:
+        cs = control_summary(run.controls)
+        lines += ["", "Negative controls (wrong inputs each checker must reject; each safety "
+                  "composition without one of its premises, which must not be proved)", "",
+                  f"{cs['as_expected']} of {cs['total']} as expected: "
+                  + ", ".join(f"{v} {k}" for k, v in cs.items()
+                              if k not in ("total", "as_expected"))]
+        cw = max(len(c.id) for c in run.controls)
+        for c in run.controls:
+            flag = "" if c.ok else f"  << expected {' or '.join(c.expected)}"
+            lines.append(f"{c.id:<{cw}}  {c.outcome:<9} {c.seconds:6.2f}s  {c.what}{flag}")
+            if not c.ok or c.outcome == "unknown":
+                lines.append(f"{'':<{cw}}  {c.detail}")
     lines += ["", "Assumptions (not proved)", ""]
     for a in run.assumptions:
         lines += [f"{a.id}: {a.what}", f"    why: {a.why}", f"    used by: {a.used_by}"]
+    kinds = kind_counts(run.proofs)
+    defs = [p.id for p in run.proofs if kind_of(p.id) == "definitional"]
+    if defs:
+        lines += ["", f"Definitional (counted apart from the theorems): {', '.join(defs)}"]
     verdict = "OK: every verdict as expected" if run.ok else "NOT OK"
-    lines += ["", f"{verdict}; {len(run.proofs)} obligations in {run.seconds:.1f} s"]
+    lines += ["", f"{verdict}; {len(run.proofs)} obligations ({kinds['theorem']} theorems, "
+              f"{kinds['definitional']} definitional) in {run.seconds:.1f} s"
+              + (f"; {sum(c.ok for c in run.controls)} of {len(run.controls)} negative "
+                 "controls as expected" if run.controls else "")]
     return "\n".join(lines) + "\n"

@@ -81,6 +81,19 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "inequality (the path's cost >= the least goal label)", "spec/_witness.py",
                (("    return (cost[0] == least[0]) & (cost[1] == least[1])\n",
                  "    return (cost[0] >= least[0]) & (cost[1] >= least[1])\n"),)),
+    # --- issue 21 item 9: faults in what the safety theorem reads ---
+    CodeMutant("modified_box_half_step", "the modified variant's layer box covers half its time "
+               "step (a + s omega dt / 2)", "spec/_grid.py",
+               (("    end = a + if_then(up, 1.0, -1.0) * step\n",
+                 "    end = a + if_then(up, 1.0, -1.0) * (0.5 * step)\n"),)),
+    CodeMutant("lattice_snap_widened", "impl.lattice_range snaps box ends within 1000 SNAP g of "
+               "a lattice point (the margin pays for SNAP g)", "impl/_regions.py",
+               (("        i_lo = floor_of((lo - anchor) / g + SNAP)\n"
+                 "        i_hi = ceil_of((hi - anchor) / g - SNAP)\n",
+                 "        i_lo = floor_of((lo - anchor) / g + 1000 * SNAP)\n"
+                 "        i_hi = ceil_of((hi - anchor) / g - 1000 * SNAP)\n"),)),
+    CodeMutant("eps_zero", "BuiltDR frees a cell at any positive float distance (EPS = 0)",
+               "spec/_grid.py", (("\nEPS = 1e-9\n", "\nEPS = 0.0\n"),)),
 )
 
 #: The checks a mutant is run through, in this order.
@@ -197,7 +210,9 @@ def _run(cmd: Sequence[str], copy: Path, cwd: Path, timeout_s: float) -> tuple[i
 def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool | None, str]:
     out = work / "proofs"
     select = [a for i in only for a in ("--only", i)]
-    code, text = _run([*_PYTHON, "-m", "cfmpa", "prove", "--out", str(out), *select],
+    # --repin (in the copy, on the copy's own lock): a mutant is caught by a failing obligation
+    # or negative control, never by a changed statement hash that a review would accept.
+    code, text = _run([*_PYTHON, "-m", "cfmpa", "prove", "--repin", "--out", str(out), *select],
                       copy, work, 1800)
     if code not in (0, 1):
         return None, f"cfmpa prove exited {code}: {text.strip().splitlines()[-1:]}"
@@ -205,12 +220,15 @@ def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool
     try:
         doc = json.loads((out / "results.json").read_text())
         failed = [o["id"] for o in doc["obligations"] if not o.get("as_expected", True)]
+        failed += [c["id"] for c in doc.get("controls", []) if not c.get("ok", True)]
     except (OSError, ValueError, KeyError):
         pass
     if code == 0:
         return False, "every verdict as expected"
-    return True, (f"exit 1; {len(failed)} obligation(s) not as expected: "
-                  + ", ".join(failed[:4]) + (", ..." if len(failed) > 4 else ""))
+    if not failed:
+        return True, "exit 1, with every verdict and control as expected (an id missing or extra)"
+    return True, (f"exit 1 under --repin; {len(failed)} obligation(s) or control(s) not as "
+                  "expected: " + ", ".join(failed[:4]) + (", ..." if len(failed) > 4 else ""))
 
 
 def _check_contracts(copy: Path, work: Path) -> tuple[bool | None, str]:

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ..scenarios import SELFCHECK_WORKCELLS
 from ..errors import CertificateViolation, CfmpaError, ContractViolation
 from ..impl import build_dr, search_opt_path
 from ..spec import Grid, Scenario, Variant, exact_tf, make_grid, parse_scenario
@@ -40,27 +41,9 @@ __all__ = ["FAULTS", "Fault", "FaultNotMade", "Mutant", "Outcome", "SAMPLE", "Se
 #: Cells of the sampled mode's random sample in the self-check (the seed is 0).
 SAMPLE = 64
 
-_ARM = {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0]}
-_TWO_PI = [0.0, 6.283185307179586]
-
-#: The self-check's workcells, as scenario documents (docs/model.md §3).
-WORKCELLS: dict[str, dict[str, Any]] = {
-    "small": {
-        "name": "selftest-small", "dt": 0.25,
-        "purpose": "the default workcell at dt = 0.25 s, with a path of 15 cells (longer than N)",
-        "left": {**_ARM, "base": [0.0, 0.0], "start": [0.3, 0.8], "goal": [1.6, 2.2]},
-        "right": {**_ARM, "base": [0.6, 0.0], "limits": [_TWO_PI, _TWO_PI],
-                  "start_cell": [2, 8], "goal_cell": [13, 5]},
-    },
-    "early-arrival": {
-        "name": "selftest-early-arrival", "dt": 0.11,
-        "purpose": "scenarios/early-arrival.toml at dt = 0.11 s: the shortest list reaches the "
-                   "goal before the principal swings through it",
-        "left": {**_ARM, "base": [0.0, 0.0], "start": [-0.8, 0.0], "goal": [0.8, 0.0]},
-        "right": {**_ARM, "base": [0.9, 0.0], "limits": [_TWO_PI, _TWO_PI],
-                  "start_cell": [27, 0], "goal_cell": [29, 0]},
-    },
-}
+#: The self-check's workcells, as scenario documents (docs/model.md §3); cfmpa prove's negative
+#: controls use them too (cfmpa.scenarios).
+WORKCELLS = SELFCHECK_WORKCELLS
 
 DR = npt.NDArray[np.uint8]
 Cell = tuple[int, int]

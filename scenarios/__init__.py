@@ -7,8 +7,9 @@ docs/model.md §3 for the file format.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
-__all__ = ["BUNDLED_DIR", "bundled_names", "resolve"]
+__all__ = ["BUNDLED_DIR", "SELFCHECK_WORKCELLS", "bundled_names", "resolve"]
 
 #: Where the bundled files are: the checkout's scenarios/ or, installed, the package's folder.
 BUNDLED_DIR = Path(__file__).resolve().parent
@@ -28,3 +29,27 @@ def resolve(arg: str | Path) -> Path:
         return p
     bundled = BUNDLED_DIR / f"{p.name}.toml"
     return bundled if bundled.is_file() else p
+
+
+_ARM = {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0]}
+_TWO_PI = [0.0, 6.283185307179586]
+
+#: Built-in workcells of the self-checks (``cfmpa selftest``, the negative controls of
+#: ``cfmpa prove``), as scenario documents (docs/model.md §3): small enough for seconds.
+SELFCHECK_WORKCELLS: dict[str, dict[str, Any]] = {
+    "small": {
+        "name": "selftest-small", "dt": 0.25,
+        "purpose": "the default workcell at dt = 0.25 s, with a path of 15 cells (longer than N)",
+        "left": {**_ARM, "base": [0.0, 0.0], "start": [0.3, 0.8], "goal": [1.6, 2.2]},
+        "right": {**_ARM, "base": [0.6, 0.0], "limits": [_TWO_PI, _TWO_PI],
+                  "start_cell": [2, 8], "goal_cell": [13, 5]},
+    },
+    "early-arrival": {
+        "name": "selftest-early-arrival", "dt": 0.11,
+        "purpose": "scenarios/early-arrival.toml at dt = 0.11 s: the shortest list reaches the "
+                   "goal before the principal swings through it",
+        "left": {**_ARM, "base": [0.0, 0.0], "start": [-0.8, 0.0], "goal": [0.8, 0.0]},
+        "right": {**_ARM, "base": [0.9, 0.0], "limits": [_TWO_PI, _TWO_PI],
+                  "start_cell": [27, 0], "goal_cell": [29, 0]},
+    },
+}

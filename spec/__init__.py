@@ -5,8 +5,9 @@ The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 
 from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
 from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
-from ._grid import (EPS, Grid, Variant, VariantRule, cell_box, exact_n, exact_tf, joint_points,
-                    left_angles, left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
+from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
+                    VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
+                    left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
 from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
 from ._trajectory import (Trajectory, certify_trajectory, csv_column_order, executed_trajectory,
@@ -30,7 +31,8 @@ from ._witness import (KEY_BASE, LABEL_LIMITS, WITNESS_FORMAT, Witness, check_wi
 
 __all__ = [
     # scenario, grids and motion (docs/model.md §2-§3)
-    "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "EPS", "Arm", "Grid", "LeftArm", "RightArm",
+    "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "DISTANCE_ERROR_M", "EPS", "MAX_COORD_M",
+    "UNIT_ROUNDOFF", "Arm", "Grid", "LeftArm", "RightArm",
     "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
     "MAX_EXTRA_POINTS", "decimal", "joint_grid",
     "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_box", "right_box",

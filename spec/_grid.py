@@ -41,10 +41,29 @@ __all__ = [
     "rule_of",
     "VariantRule",
     "EPS",
+    "DISTANCE_ERROR_M",
+    "MAX_COORD_M",
+    "UNIT_ROUNDOFF",
 ]
 
 #: A cell is free only when the regions' Euclidean distance exceeds this (metres), docs/model.md §4.
 EPS = 1e-9
+
+#: The unit roundoff of IEEE doubles rounded to nearest: each +, -, *, /, sqrt is exact times
+#: (1 + d) with |d| <= UNIT_ROUNDOFF.
+UNIT_ROUNDOFF = 2.0 ** -53
+#: A bound (metres) on every coordinate of every polygon BuiltDR compares, for any scenario the
+#: reader accepts: a base within 1000 m in each coordinate (spec._scenario.MAX_BASE_M), two links
+#: of at most 100 m with their half-widths, and a sweep margin below r g^2 / 8 with g <= 3.14
+#: (together under 1400 m); 4000 m leaves room (docs/model.md §4.3).
+MAX_COORD_M = 4000.0
+#: What the float computation of a distance (or of a lower bound of it: a box gap, a
+#: separating-axis gap) may be off from the exact value of the same formula on the same doubles:
+#: 64 rounding units per metre of coordinate (ledger A12; the deepest formula, the vertex-edge
+#: distance, rounds about 15 times). tests/spec/test_distance_error.py checks it against exact
+#: rational arithmetic; Safety.separation proves that EPS above it makes "float distance > EPS"
+#: imply "true distance > 0".
+DISTANCE_ERROR_M = 64 * UNIT_ROUNDOFF * MAX_COORD_M
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -82,3 +82,31 @@ def test_refutations_and_checks_have_no_depth():
     obs = collect_obligations("/nonexistent", ["Def1.segment_printed", "Margin.naive_hull"])
     for ob in obs:
         assert discharge(ob).depth is None
+
+
+# --- the nonlinear flag (not what depth measures) ------------------------------------------------
+
+def test_nonlinear_flags_products_and_divisions_of_unknowns():
+    from cfmpa.proofs._depth import is_nonlinear
+
+    x, y = z3.Reals("x y")
+    assert is_nonlinear([x * y > 0])
+    assert is_nonlinear([x / y > 1])
+    assert is_nonlinear([z3.ForAll([x], x * x >= y)])           # inside a quantifier too
+    assert not is_nonlinear([2 * x + y / 4 > 0, (-x) * 3 <= y])  # constants scale linearly
+    assert not is_nonlinear([z3.Real("a") + 1 == y])
+
+
+def test_results_record_the_flag_per_vc(tmp_path):
+    from cfmpa.proofs import Method, Obligation, Verdict, VC, Z3Query, run_obligations
+
+    x, y = z3.Reals("x y")
+    ob = Obligation("T.nonlinear", "t", "test", "x y > 0 from x, y > 0", Method.Z3,
+                    Verdict.PROVED, lambda: Z3Query((
+                        VC("square", (("x > 0", x > 0), ("y > 0", y > 0)), x * y > 0),
+                        VC("sum", (("x > 0", x > 0), ("y > 0", y > 0)), x + y > 0))))
+    run = run_obligations([ob], tmp_path, ["T.nonlinear"], lock=tmp_path / "lock")
+    assert [v.nonlinear for v in run.proofs[0].vcs] == [True, False]
+    doc = __import__("json").loads((tmp_path / "results.json").read_text())
+    assert [v["nonlinear"] for v in doc["obligations"][0]["vcs"]] == [True, False]
+    assert doc["depth"]["nonlinear_vcs"] == 1 and "quantifier" in doc["depth"]["measures"]

@@ -264,3 +264,31 @@ def test_workers_below_one_is_an_input_error(tmp_path: Path, capsys):
     rc = main(["prove", "--out", str(tmp_path), "--only", "Def1.segment", "--workers", "0"])
     assert rc == 2 and "--workers" in capsys.readouterr().err
     assert not (tmp_path / "results.json").exists()
+
+
+# --- definitional obligations, counted apart ------------------------------------------------------
+
+def test_definitional_ids_are_registered_obligations_with_reasons():
+    from cfmpa.proofs import FIXED_IDS
+    from cfmpa.proofs._runner import DEFINITIONAL, kind_of
+
+    assert set(DEFINITIONAL) <= set(FIXED_IDS)
+    assert all(why.strip() for why in DEFINITIONAL.values())
+    assert kind_of("Thm1.termination") == "definitional"
+    assert kind_of("Safety.modified.composition") == "theorem"
+
+
+def test_the_summary_and_results_count_definitional_apart(tmp_path):
+    import json
+
+    from cfmpa.proofs import collect_obligations, render_report, run_obligations
+
+    obs = collect_obligations("/nonexistent", ["Def1.segment", "Def2.is_convex"])
+    run = run_obligations(obs, tmp_path, [o.id for o in obs])
+    doc = json.loads((tmp_path / "results.json").read_text())
+    assert doc["kinds"] == {"theorem": 1, "definitional": 1}
+    kinds = {o["id"]: o["kind"] for o in doc["obligations"]}
+    assert kinds == {"Def1.segment": "definitional", "Def2.is_convex": "theorem"}
+    text = render_report(run)
+    assert "(1 theorems, 1 definitional)" in text
+    assert "Definitional (counted apart from the theorems): Def1.segment" in text

@@ -292,10 +292,21 @@ def test_region_lemmas_need_their_key_premises():
 
 # --- (d), (e) ------------------------------------------------------------------------------------
 
-def test_separation_needs_the_distance():
-    L = S.separation_lemma()
-    assert _refuted(L.vc, L.vc.key_premise)
-    assert _refuted(L.vc, "(c) link a of the principal at theta_L lies in A (at p)")
+def test_separation_needs_the_rounding_bound_and_the_distance():
+    margin, common = S.separation_lemmas()
+    assert _refuted(margin.vc, margin.vc.key_premise)
+    assert _refuted(common.vc, common.vc.key_premise)
+    assert _refuted(common.vc, "(c) link a of the principal at theta_L lies in A (at p)")
+
+
+@pytest.mark.parametrize("eps", ["0", "1e-12", "2e-11"])
+def test_an_eps_below_the_rounding_bound_is_refuted(eps):
+    # Seeded fault: spec.EPS set below spec.DISTANCE_ERROR_M (2.8e-11 m); eps_margin must fail.
+    margin, _ = S.separation_lemmas()
+    vc = margin.vc
+    hyps = tuple((n, z3.Real("eps") == z3.RealVal(eps)) if n == S.EPS_HYP else (n, h)
+                 for n, h in vc.hypotheses)
+    assert _refuted(VC(vc.name, hyps, vc.goal))
 
 
 @pytest.mark.parametrize("variant", S.VARIANTS)
@@ -306,7 +317,7 @@ def test_composition_needs_the_postcondition_and_the_regions(variant):
     stripped = VC(vc.name, tuple(h for h in vc.hypotheses
                                  if not h[0].startswith("(c) Safety.region_soundness")),
                   vc.goal, counter_witness=vc.counter_witness)
-    assert len(stripped.hypotheses) == len(vc.hypotheses) - 6
+    assert len(stripped.hypotheses) == len(vc.hypotheses) - 3
     assert _refuted(stripped)
 
 
@@ -319,6 +330,6 @@ def test_composition_rests_on_the_proved_parts(queries):
     # The (a), (b), (d) lemmas and Def4.is_path_fixed_safe enter by substitution of their VCs.
     vc = S.composition_vc("modified")
     names = " | ".join(n for n, _ in vc.hypotheses)
-    for part in ("by motion at", "by rest at", "by on_path at", "by neighbour_move at",
-                 "by no_common_point at", "by Def4.is_path_fixed_safe at", "by time_step at"):
+    for part in ("by motion at", "by rest at", "by neighbour_move at", "by time_step at",
+                 S.EPS_HYP, S.ERR_HYP, "A12 at the eight pairs", "is_path L (fixed"):
         assert part in names

@@ -77,3 +77,19 @@ def test_cfmpa_prove_catches_every_mutant(tmp_path: Path):
     doc = json.loads(out.read_text())
     assert [r["mutant"] for r in doc["mutants"]] == [m.name for m in CODE_MUTANTS]
     assert all(r["caught"]["prove"] for r in doc["mutants"])
+
+
+#: Each fault in what the safety theorem reads, and the obligation that must fail on it under
+#: --repin (its statement re-pinned, so only a refuted or undecided VC can catch it).
+SAFETY_FAULTS = {"modified_box_half_step": "Safety.modified.principal_in_layer_box",
+                 "lattice_snap_widened": "Safety.region_soundness",
+                 "eps_zero": "Safety.separation",
+                 "witness_edge_loosened": "Witness.labels_sound"}
+
+
+@pytest.mark.slow     # one prove run per fault in a fresh copy: about a minute in all
+@pytest.mark.parametrize("name", list(SAFETY_FAULTS))
+def test_a_safety_fault_fails_its_obligation_under_repin(name: str):
+    rows = code_mutation_rows([name], checks=("prove",), prove_only=[SAFETY_FAULTS[name]])
+    assert rows[0].caught == {"prove": True}, rows[0].detail
+    assert SAFETY_FAULTS[name] in rows[0].detail["prove"]

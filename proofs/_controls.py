@@ -1,0 +1,299 @@
+"""Negative controls of ``cfmpa prove``: wrong inputs every checker must reject, and the safety
+compositions without each of their premises, which must not be proved (docs/model.md §10.3).
+
+A checker that accepts everything, or a composition whose conclusion follows without a premise
+it names, would pass every obligation: the controls are what show that the checks can fail.
+Each is a result in results.json (``controls``) and in the report; the run is not OK unless
+every control ends as expected. Expectations are written here, never pinned by ``--repin``.
+
+Checker controls run the spec's checkers (the ones ``cfmpa check`` and the contracts use) on a
+wrong input built from a correct one on the built-in workcell ``small`` (cfmpa.scenarios):
+- witness.forged: the optimal path with its genuine witness, one goal label lowered;
+- witness.worse_path: a valid path one wait longer than the optimum, with the optimum's genuine
+  witness;
+- dr.unsound_free_cell: D_R with one blocked cell, on the border of free space, set free;
+- path.through_blocked: the optimal path with one cell replaced by a blocked neighbour;
+- certificate.contact: the subordinate held, from the start, at a cell where the arms touch at
+  a layer's instant.
+Each construction asserts that the wrong input is what it says (else the control is FAILED, a
+bug in the control, never a pass).
+
+Premise controls: for each ``Safety.<variant>.composition`` and each of its hypotheses that is
+not an instance of a proved lemma, the composition without it. Expected: not proved, i.e. Z3
+finds a counter-model (``refuted``; with the composition's one-cell pins, then without them) or
+does not decide it within the control's budget (``unknown``: weaker evidence, said so). An
+instance of a proved lemma ("by time_step at t", "by motion at the step k") is a valid fact:
+dropping it cannot give a counter-model, and Z3 re-derives some of them within a second on one
+machine and not on another, so the composition without it measures how hard the lemma is for
+Z3, not whether the composition needs it; those are not controls (the lemma's own obligation
+proves it, and a wrong rule fails there).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+import z3
+
+from ..scenarios import SELFCHECK_WORKCELLS
+from ..spec import (J1, J2, MOVES, SearchResult, SearchStatus, Witness, arm_corners, certify,
+                    check_witness, dr_cell_failures, is_path, left_angles, make_grid,
+                    parse_scenario, path_violations, polygon_distance)
+
+__all__ = ["Control", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS", "checker_controls",
+           "collect_controls", "premise_controls", "run_control"]
+
+#: Z3's budget per premise control: with the composition's pins, then without them.
+PREMISE_PINNED_MS = 2_000
+PREMISE_FREE_MS = 1_500
+
+
+@dataclass(frozen=True)
+class Control:
+    """A seeded wrong input and the checker that must reject it (or a composition that must not
+    be proved). ``run`` returns (outcome, detail); ``expected`` lists the outcomes that pass."""
+
+    id: str
+    checker: str
+    what: str
+    expected: tuple[str, ...]
+    run: Callable[[], tuple[str, str]]
+
+
+@dataclass(frozen=True)
+class ControlResult:
+    """How a control ended: ``ok`` iff its outcome is one it expects."""
+
+    id: str
+    checker: str
+    what: str
+    expected: tuple[str, ...]
+    outcome: str
+    detail: str
+    seconds: float
+
+    @property
+    def ok(self) -> bool:
+        return self.outcome in self.expected
+
+    def as_json(self) -> dict[str, Any]:
+        return {"id": self.id, "checker": self.checker, "what": self.what,
+                "expected": list(self.expected), "outcome": self.outcome, "ok": self.ok,
+                "detail": self.detail, "seconds": round(self.seconds, 3)}
+
+
+class ControlNotMade(AssertionError):
+    """A control's wrong input is not what the control says (a bug in the control)."""
+
+
+def _require(ok: bool, what: str) -> None:
+    if not ok:
+        raise ControlNotMade(what)
+
+
+def run_control(c: Control) -> ControlResult:
+    """Run one control; an exception (a control that could not be built) is FAILED, saying why."""
+    t0 = time.perf_counter()
+    try:
+        outcome, detail = c.run()
+    except Exception as exc:  # noqa: BLE001 - a control must end in a result, not a crash
+        outcome, detail = "error", f"{type(exc).__name__}: {exc}"
+    return ControlResult(c.id, c.checker, c.what, c.expected, outcome, detail,
+                         time.perf_counter() - t0)
+
+
+# --- the checkers' controls --------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Case:
+    """The workcell, its D_R (reference BuiltDR, modified variant) and the optimal answer."""
+
+    scenario: Any
+    grid: Any
+    dr: np.ndarray
+    start: tuple[int, int]
+    goal: tuple[int, int]
+    best: SearchResult
+
+
+_CASE: list[_Case] = []
+
+
+def _case() -> _Case:
+    if not _CASE:
+        from ..impl import build_dr, search_opt_path
+
+        s = parse_scenario(SELFCHECK_WORKCELLS["small"], check_budget=False)
+        g = make_grid(s)
+        dr = build_dr(s, "modified", g)
+        start, goal = s.right.start_cell, s.right.goal_cell
+        best = search_opt_path(dr, start, goal, with_witness=True)
+        _require(best.status is SearchStatus.FOUND, "the small workcell has no path")
+        _CASE.append(_Case(s, g, dr, start, goal, best))
+    return _CASE[0]
+
+
+def _rejected(failures: list[Any]) -> tuple[str, str]:
+    if failures:
+        f = failures[0]
+        what = getattr(f, "condition", None) or getattr(f, "clause", None) or type(f).__name__
+        return "rejected", f"{what}: {getattr(f, 'message', f)}"
+    return "accepted", "the checker raised nothing"
+
+
+def _forged_witness() -> tuple[str, str]:
+    c = _case()
+    j1, j2 = c.best.witness.j1.copy(), c.best.witness.j2.copy()
+    N, (gi, gj) = c.dr.shape[0] - 1, c.goal
+    # Claim a better optimum: the goal's settled labels one below the path's cost.
+    settled = j1[N, :, gi, gj] == c.best.J1
+    _require(bool(settled.any()) and c.best.J1 > 0, "no goal label carries the path's J1")
+    j1[N, settled, gi, gj] -= 1
+    forged = Witness.of_labels(j1, j2)
+    _require(not np.array_equal(forged.j1, c.best.witness.j1), "the forgery changed nothing")
+    return _rejected(check_witness(c.dr, c.start, c.goal, c.best, forged))
+
+
+def _worse_path() -> tuple[str, str]:
+    c = _case()
+    path = list(c.best.path)
+    best = (c.best.J1, c.best.J2)
+    for at in range(len(path)):
+        longer = path[:at + 1] + path[at:]          # one wait at position at
+        # A wait while moving costs smoothness (J2); one at the start costs nothing.
+        if (J1(longer), J2(longer)) > best and is_path(longer, c.dr, c.start, c.goal):
+            break
+    else:
+        raise ControlNotMade("no single wait gives a valid path worse than the optimum")
+    worse = replace(c.best, path=tuple(longer), J1=J1(longer), J2=J2(longer))
+    out, detail = _rejected(check_witness(c.dr, c.start, c.goal, worse, c.best.witness))
+    return out, f"a wait at step {at}, (J1, J2) = ({J1(longer)}, {J2(longer)}); {detail}"
+
+
+def _unsound_free_cell() -> tuple[str, str]:
+    c = _case()
+    free = c.dr == 0
+    near = np.zeros_like(free)
+    near[:, 1:] |= free[:, :-1]
+    near[:, :-1] |= free[:, 1:]
+    border = np.argwhere((c.dr == 1) & near)
+    _require(len(border) > 0, "D_R has no blocked cell next to a free one")
+    k, i, j = (int(x) for x in border[len(border) // 2])
+    bad = c.dr.copy()
+    bad[k, i, j] = 0
+    _, failures = dr_cell_failures(c.scenario, "modified", c.grid, bad)
+    out, detail = _rejected(failures)
+    return out, f"layer {k}, cell ({i}, {j}) set free; {detail}"
+
+
+def _through_blocked() -> tuple[str, str]:
+    c = _case()
+    path = list(c.best.path)
+    m, n = c.dr.shape[1], c.dr.shape[2]
+    for k in range(1, len(path) - 1):
+        for di, dj in MOVES:
+            i, j = path[k][0] + di, path[k][1] + dj
+            if (di, dj) != (0, 0) and 0 <= i < m and 0 <= j < n and c.dr[min(k, len(c.dr) - 1), i, j]:
+                bad = path[:k] + [(i, j)] + path[k + 1:]
+                if all(abs(a[0] - b[0]) <= 1 and abs(a[1] - b[1]) <= 1
+                       for a, b in zip(bad, bad[1:])):
+                    out, detail = _rejected(path_violations(bad, c.dr, c.start, c.goal))
+                    return out, f"step {k} moved to the blocked cell ({i}, {j}); {detail}"
+    raise ControlNotMade("no blocked neighbour keeps the moves adjacent")
+
+
+def _contact() -> tuple[str, str]:
+    c = _case()
+    s, g = c.scenario, c.grid
+    m, n = c.dr.shape[1], c.dr.shape[2]
+    for k in range(c.dr.shape[0] - 1):
+        left = arm_corners(s.left, tuple(left_angles(s, k * s.dt)))
+        for i in range(m):
+            for j in range(n):
+                right = arm_corners(s.right, g.angles((i, j)))
+                if min(polygon_distance(a, b) for a in left for b in right) == 0.0:
+                    path = [(i, j)] * (k + 1)
+                    cert = certify(s, g, path)
+                    if cert.clear:
+                        return "accepted", f"held at ({i}, {j}) through layer {k}: certified clear"
+                    what = "a contact" if cert.contact is not None else "undecided intervals"
+                    return "rejected", f"held at ({i}, {j}) through layer {k}: not clear ({what})"
+    raise ControlNotMade("no cell of the grid touches the principal at a layer's instant")
+
+
+def checker_controls() -> list[Control]:
+    """One wrong input per checker the safety argument reads at run time."""
+    R = ("rejected",)
+    return [
+        Control("Control.witness.forged", "witness (spec.check_witness)",
+                "the optimal path with its witness, the goal's labels lowered by one", R,
+                _forged_witness),
+        Control("Control.witness.worse_path", "witness (spec.check_witness)",
+                "a valid path one wait longer than the optimum, with the optimum's genuine "
+                "witness", R, _worse_path),
+        Control("Control.dr.unsound_free_cell", "D_R postcondition (spec.dr_cell_failures)",
+                "D_R with one blocked cell on the border of free space set free", R,
+                _unsound_free_cell),
+        Control("Control.path.through_blocked", "path (spec.path_violations, fixed is_path)",
+                "the optimal path with one cell moved to a blocked neighbour", R,
+                _through_blocked),
+        Control("Control.certificate.contact", "certificate (spec.certify)",
+                "the subordinate held where the arms touch at a layer's instant", R, _contact),
+    ]
+
+
+# --- the compositions without a premise --------------------------------------------------------
+
+
+def _without(variant: str, index: int) -> tuple[str, str]:
+    from ._obl_safety import composition_vc
+    from ._obligation import _solver
+
+    vc = composition_vc(variant)
+    rest = [h for i, (_, h) in enumerate(vc.hypotheses) if i != index]
+    answers = []
+    for label, pins, ms in (("with the one-cell pins", vc.counter_witness, PREMISE_PINNED_MS),
+                            ("without pins", (), PREMISE_FREE_MS)):
+        s = _solver(ms, formulas=rest + [z3.Not(vc.goal)] + [c == v for c, v in pins])
+        r = s.check()
+        if r == z3.sat:
+            return "refuted", f"a counter-model {label}"
+        answers.append(f"{r} {label}" + (f" ({s.reason_unknown()})" if r == z3.unknown else ""))
+    if "unsat without pins" in answers:
+        return "proved", "the conclusion follows without it: " + "; ".join(answers)
+    return "unknown", "; ".join(answers)
+
+
+#: How a hypothesis that instantiates a proved lemma is named (``_obl_safety.Lemma.use``).
+LEMMA_INSTANCE = "by "
+
+
+def premise_controls() -> list[Control]:
+    """For each composition, one control per hypothesis that is not a proved lemma's instance:
+    the composition without it."""
+    from ._obl_safety import VARIANTS, composition_vc
+
+    out = []
+    for v in VARIANTS:
+        for i, (name, _) in enumerate(composition_vc(v).hypotheses):
+            if name.startswith(LEMMA_INSTANCE):
+                continue
+            out.append(Control(f"Control.Safety.{v}.composition.without[{i}]",
+                               f"Safety.{v}.composition", f"without: {name}",
+                               ("refuted", "unknown"),
+                               lambda v=v, i=i: _without(v, i)))
+    return out
+
+
+def collect_controls(only: Sequence[str] | None = None) -> list[Control]:
+    """The controls of ``cfmpa prove``, checkers' first: all, or (``only``, as ``--only``) those
+    whose id or whose composition is selected."""
+    from ._runner import selected
+
+    return [c for c in checker_controls() + premise_controls()
+            if selected(c.id, only) or selected(c.checker, only)]
