@@ -1,116 +1,45 @@
-"""The command line: ``cfmpa`` -> ``main(argv)`` -> one function per subcommand returning the exit code.
+"""The command line: ``cfmpa`` -> ``main(argv)`` -> one ``cmd_*`` per subcommand.
 
-Exit codes: 0 success, 1 a check failed (a violation, a failed proof), 2 bad input or usage.
+The command line parses and prints only: each ``cmd_*`` turns the parsed options into one call
+of a ``run_*`` of runs/, report/ or proofs/ (which computes, prints on the streams it is given
+and returns the exit code); ``cfmpa.errors.handled`` turns an exception into its exit code and
+message, in one place. Exit codes: 0 success, 1 a check failed (a violation, a failed proof),
+2 bad input or usage.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import time
-from collections.abc import Callable, Sequence
-from pathlib import Path
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import Any
 
 from . import __version__
-from .errors import CfmpaError, InputError
+from .errors import InputError, handled
 from .scenarios import resolve
-
-if TYPE_CHECKING:
-    from .spec import Certificate
 
 __all__ = ["main"]
 
 
-def _variant(value: str) -> str:
-    from .spec import Variant
-
-    try:
-        return Variant(value).value
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"--variant must be one of {', '.join(v.value for v in Variant)}, got {value!r}") from None
+# --- the commands: options -> one run_* call ---------------------------------------------------
 
 
 def cmd_dr(args: argparse.Namespace) -> int:
     """Build D_R for one scenario and variant; write DIR/dr.npy."""
-    from .files import save_npy_atomic
-    from .impl import kernels
-    from .spec import load_scenario, make_grid
+    from .runs import run_dr
 
-    s = load_scenario(resolve(args.scenario))
-    g = make_grid(s)
-    build, _ = kernels(args.kernel)
-    t0 = time.perf_counter()
-    dr = build(s, args.variant, g)
-    seconds = time.perf_counter() - t0
-    out = save_npy_atomic(Path(args.out) / "dr.npy", dr)
-    free = 1.0 - float(dr.mean())
-    print(f"scenario  {s.name} ({args.scenario})")
-    print(f"variant   {args.variant} ({args.kernel} kernel)")
-    print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad"
-          f"  shape={tuple(dr.shape)}")
-    print(f"free      {free:.4%} of cells")
-    print(f"time      {seconds:.3f} s")
-    print(f"wrote     {out}")
-    return 0
+    return run_dr(resolve(args.scenario), args.variant, args.out, kernel=args.kernel,
+                  name=args.scenario)
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy and DIR/plan.json.
+    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy and DIR/plan.json (exit 1 on
+    a violation, the files written all the same as the evidence)."""
+    from .runs import run_plan
 
-    Exit 0 when nothing was violated; 1 when a contract failed or the certificate is not clear
-    (a contact or an undecided interval is a violation in every --contracts mode, off included);
-    the files are written all the same, as the evidence, and the summary says so.
-    """
-    from .impl import kernels
-    from .runs import plan, write_plan
-    from .spec import load_scenario
-
-    s = load_scenario(resolve(args.scenario))
-    build, search = kernels(args.kernel)
-    p = plan(s, args.variant, contracts=args.contracts, seed=args.seed, sample=args.sample,
-             stop=False, build=build, search=search, kernel=args.kernel,
-             witness=args.witness is not None)
-    dr_path, plan_path = write_plan(p, args.out, witness=args.witness)
-    violations = p.violations
-    g, r, t = p.grid, p.search, p.timings_s
-    print(f"scenario  {s.name} ({args.scenario})")
-    print(f"variant   {p.variant}")
-    print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad")
-    print(f"free      {p.free_fraction:.4%} of cells")
-    if r.reason is None:
-        print(f"status    {r.status}: J1={r.J1} J2={r.J2} length={len(r.path)} cells")
-    else:
-        print(f"status    {r.status}: {r.reason}")
-    if p.certificate is not None:
-        print(_clearance_line(p.certificate))
-    print(f"contracts {p.settings.mode.value}: {p.checked} checks, {len(violations)} violations")
-    print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()))
-    print(f"wrote     {dr_path}, {plan_path}" + (f", {args.witness}" if args.witness else ""))
-    for v in violations:
-        print(f"violation {v}", file=sys.stderr)
-    if violations:
-        print(f"result    {len(violations)} violation(s): exit 1; the files above are written as "
-              f"the evidence", file=sys.stderr)
-    return 1 if violations else 0
-
-
-def _clearance_line(c: Certificate) -> str:
-    """The certificate in one line: the PROVED lower bound first, then the least sampled distance
-    (an upper bound on the true minimum) and its instant."""
-    sampled = (f"sampled minimum {c.min_clearance_m * 1000:.6g} mm at t={c.t_min_s:.4f} s "
-               f"({c.intervals} intervals)")
-    if c.clear:
-        return (f"clearance clear: proved >= {c.lower_bound_m * 1000:.6g} mm at every instant; "
-                f"{sampled}")
-    if c.contact_detail is not None:
-        d = c.contact_detail
-        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, left link {d.links[0]} and "
-                f"right link {d.links[1]}, {d.segment}; {sampled}")
-    return (f"clearance NOT CLEAR: {len(c.undecided)} interval(s) neither proved clear nor in "
-            f"contact, first {c.undecided[0]} s; {sampled}")
+    return run_plan(resolve(args.scenario), args.variant, args.out, contracts=args.contracts,
+                    seed=args.seed, sample=args.sample, kernel=args.kernel,
+                    witness=args.witness, name=args.scenario)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -163,68 +92,17 @@ def cmd_selftest(args: argparse.Namespace) -> int:
 
 
 def cmd_prove(args: argparse.Namespace) -> int:
-    """Discharge every obligation; with --audit, also write the audit report."""
-    from .proofs import run_prove
-
-    if args.only and args.audit is not None:
-        # A report a reviewer trusts is of a whole run: a selection would show the rest missing.
-        raise InputError("--audit", args.audit, "needs every obligation; run it without --only")
+    """Discharge every obligation; with --audit, also write the audit report (side by side)."""
     if args.audit is None:
+        from .proofs import run_prove
+
         return run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
                          repin=args.repin, workers=args.workers)
-    import multiprocessing
+    from .report import run_prove_audit
 
-    from .impl import progress_silenced
-    from .report import run_audit
-
-    # The report's plans, pictures and campaign need no proof: a second process (forked, so it
-    # starts at once with everything imported) computes them while this one discharges the
-    # obligations, and reads results.json only once the gate opens. If the prove run stops with
-    # an error, the gate opens with `stopped` set and the report process ends writing nothing.
-    results = str(Path(args.out) / "results.json")
-    mp = multiprocessing.get_context("fork")
-    gate, stopped = mp.Event(), mp.Event()
-
-    def proofs_ready() -> str:
-        gate.wait()
-        if stopped.is_set():
-            raise InputError("--audit", args.audit, "not written: the prove run stopped")
-        return results
-
-    def audit() -> None:
-        from .impl import set_kernel_threads
-
-        set_kernel_threads(1)          # beside the prove run's processes
-        try:
-            code = run_audit(None, args.audit, argv=["cfmpa", *args.argv],
-                             proofs_json=proofs_ready, scenarios_dir=args.scenarios)
-        except BaseException as exc:   # said after the proofs, or not at all if they stopped
-            gate.wait()
-            if stopped.is_set():
-                os._exit(1)
-
-            def again() -> int:
-                raise exc
-            code = _handled(again)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code)
-
-    with progress_silenced():          # two processes' bars would cut up the summary
-        worker = mp.Process(target=audit, name="cfmpa-audit", daemon=True)
-        worker.start()
-        try:
-            code = run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
-                             repin=args.repin, workers=args.workers)
-        except BaseException:
-            stopped.set()
-            gate.set()
-            worker.join(timeout=5)
-            raise
-        print(flush=True)
-        gate.set()
-        worker.join()
-    return code or worker.exitcode or 0
+    return run_prove_audit(args.audit, out_dir=args.out, scenarios_dir=args.scenarios,
+                           only=args.only, repin=args.repin, workers=args.workers,
+                           argv=["cfmpa", *args.argv])
 
 
 def cmd_audit(args: argparse.Namespace) -> int:
@@ -239,16 +117,9 @@ def cmd_audit(args: argparse.Namespace) -> int:
 
 def cmd_scenarios(args: argparse.Namespace) -> int:
     """List the bundled scenarios: name, grid size and purpose."""
-    from .scenarios import BUNDLED_DIR, bundled_names
-    from .spec import load_scenario, make_grid
+    from .runs import run_scenarios
 
-    print(f"bundled scenarios in {BUNDLED_DIR} (give the name or a path to any command)")
-    for name in bundled_names():
-        s = load_scenario(BUNDLED_DIR / f"{name}.toml")
-        g = make_grid(s)
-        print(f"{name:<16} dt={s.dt:g} s  grid N={g.N} m={g.m} n={g.n}")
-        print(f"{'':<16} {s.purpose}")
-    return 0
+    return run_scenarios()
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
@@ -304,6 +175,53 @@ def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
         os.cpu_count() or 1), None
 
 
+# --- shared options ----------------------------------------------------------------------------
+
+
+def _variant(value: str) -> str:
+    from .spec import Variant
+
+    try:
+        return Variant(value).value
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--variant must be one of {', '.join(v.value for v in Variant)}, got {value!r}") from None
+
+
+def _scenario_argument(p: argparse.ArgumentParser,
+                       text: str = "scenario: a bundled name (cfmpa scenarios) or a TOML file"
+                       ) -> None:
+    p.add_argument("scenario", help=text)
+
+
+def _variant_argument(p: argparse.ArgumentParser) -> None:
+    """--variant, one of spec.Variant's members (default modified)."""
+    from .spec import Variant
+
+    p.add_argument("--variant", type=_variant, default="modified",
+                   help=f"{' | '.join(v.value for v in Variant)} (default: modified)")
+
+
+def _kernel_argument(p: argparse.ArgumentParser) -> None:
+    """--kernel, one of impl.KERNELS (the first the default)."""
+    from .impl import KERNELS
+
+    p.add_argument("--kernel", choices=list(KERNELS), default=KERNELS[0],
+                   help=f"{KERNELS[0]} (default; bit-identical to the reference) or "
+                        f"{', '.join(KERNELS[1:])}")
+
+
+def _out_argument(p: argparse.ArgumentParser, help: str, *, required: bool = True,
+                  default: str | None = None, metavar: str | None = None) -> None:
+    """--out, the folder (or file) a command writes."""
+    p.add_argument("--out", required=required, default=default, metavar=metavar, help=help)
+
+
+def _json_argument(p: argparse.ArgumentParser, help: str = "write the result as JSON") -> None:
+    """--json OUT, a file a command writes its result to."""
+    p.add_argument("--json", default=None, metavar="OUT", help=help)
+
+
 def _engine_arguments(p: argparse.ArgumentParser) -> None:
     """--workers, --scheduler, --connect-timeout (cfmpa compare, cfmpa check --batch)."""
     p.add_argument("--workers", type=_positive, default=None, metavar="K",
@@ -316,6 +234,15 @@ def _engine_arguments(p: argparse.ArgumentParser) -> None:
                    help="seconds to wait for the scheduler and its first worker (default 10)")
 
 
+def _trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",
+                          speed: str = "accept a trajectory whose joint speeds exceed omega"
+                          ) -> None:
+    """What certify, monitor and simulate share: the scenario, --traj and --allow-speed."""
+    _scenario_argument(p, "scenario (the geometry): a bundled name or a TOML file")
+    p.add_argument("--traj", required=True, metavar="FILE", help=traj)
+    p.add_argument("--allow-speed", action="store_true", help=speed)
+
+
 def _positive(value: str) -> int:
     try:
         n = int(value)
@@ -326,33 +253,32 @@ def _positive(value: str) -> int:
     return n
 
 
+# --- the parser --------------------------------------------------------------------------------
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="cfmpa", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     d = sub.add_parser("dr", help="build the collision-state database D_R (BuiltDR)")
-    d.add_argument("scenario", help="scenario: a bundled name (cfmpa scenarios) or a TOML file")
-    d.add_argument("--variant", type=_variant, default="modified",
-                   help="original | modified | tight (default: modified)")
-    d.add_argument("--out", required=True, help="output folder (dr.npy is written there)")
-    d.add_argument("--kernel", choices=["fast", "reference"], default="fast",
-                   help="fast (default; bit-identical to the reference) or reference")
+    _scenario_argument(d)
+    _variant_argument(d)
+    _out_argument(d, "output folder (dr.npy is written there)")
+    _kernel_argument(d)
     d.set_defaults(func=cmd_dr)
 
     pl = sub.add_parser("plan", help="plan the subordinate's path; write dr.npy and plan.json")
-    pl.add_argument("scenario", help="scenario: a bundled name (cfmpa scenarios) or a TOML file")
-    pl.add_argument("--variant", type=_variant, default="modified",
-                    help="original | modified | tight (default: modified)")
-    pl.add_argument("--out", required=True, help="output folder")
+    _scenario_argument(pl)
+    _variant_argument(pl)
+    _out_argument(pl, "output folder")
     pl.add_argument("--contracts", choices=["off", "sampled", "full"], default="full",
                     help="contract checking of BuiltDR and searchoptpath (default: full, every "
                          "cell and optimality through the witness)")
     pl.add_argument("--seed", type=int, default=0, help="seed of the sampled contracts")
     pl.add_argument("--sample", type=int, default=None,
                     help="cells checked by sampled contracts (default: the mode's own)")
-    pl.add_argument("--kernel", choices=["fast", "reference"], default="fast",
-                    help="fast (default; bit-identical to the reference) or reference")
+    _kernel_argument(pl)
     pl.add_argument("--witness", default=None, metavar="FILE",
                     help="also write the search's witness of its answer (npz, docs/model.md "
                          "§11); plan.json gets its witness_sha256")
@@ -371,8 +297,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--batch", default=None, metavar="DIR",
                    help="check every folder under DIR holding plan.json and dr.npy, one task "
                         "per plan; summary in DIR/check-batch.json")
-    c.add_argument("--json", default=None, metavar="OUT",
-                   help="with --batch: write the summary here instead")
+    _json_argument(c, "with --batch: write the summary here instead")
     _engine_arguments(c)
     c.set_defaults(func=cmd_check)
 
@@ -387,11 +312,12 @@ def _parser() -> argparse.ArgumentParser:
                     help="with --code: comma-separated, of prove,contracts,tests (default all)")
     st.add_argument("--prove-only", action="append", metavar="ID",
                     help="with --code: cfmpa prove on these obligations only (as its --only)")
-    st.add_argument("--json", metavar="OUT", help="with --code: the table as JSON")
+    _json_argument(st, "with --code: the table as JSON")
     st.set_defaults(func=cmd_selftest)
 
     pr = sub.add_parser("prove", help="discharge every obligation (make prove)")
-    pr.add_argument("--out", default="build/proofs", help="results folder (default build/proofs)")
+    _out_argument(pr, "results folder (default build/proofs)", required=False,
+                  default="build/proofs")
     pr.add_argument("--scenarios", default=None,
                     help="a folder of your workcells (*.toml) to prove: seven checks per file, "
                          "ids from the file names (default: the bundled workcells)")
@@ -411,7 +337,7 @@ def _parser() -> argparse.ArgumentParser:
     au.add_argument("scenarios", nargs="*",
                     help="scenario names or files (default: all bundled); the report shows the "
                          "per-scenario obligations of exactly these workcells")
-    au.add_argument("--out", required=True, help="output folder")
+    _out_argument(au, "output folder")
     au.add_argument("--proofs", default=None,
                     help="results.json of a prove run to report (default: prove afresh); it "
                          "must cover the given workcells' checks, others' rows are left out")
@@ -431,9 +357,8 @@ def _parser() -> argparse.ArgumentParser:
     co.add_argument("--dt", type=float, default=0.1,
                     help="time step of the workcells in s (default 0.1; the bundled default "
                          "scenario's is 0.02)")
-    co.add_argument("--out", default=None,
-                    help="folder for compare.json and the store compare.jsonl (a rerun of the "
-                         "same settings resumes from it)")
+    _out_argument(co, "folder for compare.json and the store compare.jsonl (a rerun of the "
+                      "same settings resumes from it)", required=False)
     _engine_arguments(co)
     co.set_defaults(func=cmd_compare)
 
@@ -442,19 +367,19 @@ def _parser() -> argparse.ArgumentParser:
     _trajectory_arguments(ce, "trajectory: CSV t,left1,left2,right1,right2 or the same columns "
                               "as JSON (docs/model.md §12)",
                           "certify even when a joint speed exceeds the scenario's omega")
-    ce.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
+    _json_argument(ce)
     ce.set_defaults(func=cmd_certify)
 
     mo = sub.add_parser("monitor", help="check a measured joint log against the certified tube")
     _trajectory_arguments(mo)
     mo.add_argument("--log", required=True, metavar="LOG",
                     help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
-    mo.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
+    _json_argument(mo)
     mo.set_defaults(func=cmd_monitor)
 
     si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")
     _trajectory_arguments(si)
-    si.add_argument("--out", required=True, metavar="LOG", help="the log file to write (CSV)")
+    _out_argument(si, "the log file to write (CSV)", metavar="LOG")
     si.add_argument("--lag", type=float, default=0.0, help="tracking lag in s (default 0)")
     si.add_argument("--noise", type=float, default=0.0,
                     help="bounded uniform noise per joint in rad (default 0)")
@@ -471,41 +396,14 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",
-                          speed: str = "accept a trajectory whose joint speeds exceed omega"
-                          ) -> None:
-    """What certify, monitor and simulate share: the scenario, --traj and --allow-speed."""
-    p.add_argument("scenario", help="scenario (the geometry): a bundled name or a TOML file")
-    p.add_argument("--traj", required=True, metavar="FILE", help=traj)
-    p.add_argument("--allow-speed", action="store_true", help=speed)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code (errors become messages, never tracebacks)."""
     parser = _parser()
     args = parser.parse_args(argv)
     # The provenance records what this call was given, not the process's sys.argv.
     args.argv = list(sys.argv[1:] if argv is None else argv)
-    return _handled(lambda: args.func(args))
-
-
-def _handled(run: Callable[[], int]) -> int:
-    """``run()``'s exit code; an error becomes its message on stderr and its exit code."""
-    try:
-        return int(run())
-    except InputError as exc:
-        print(exc.render(), file=sys.stderr)
-        return exc.exit_code
-    except CfmpaError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return exc.exit_code
-    except OSError as exc:
-        name = exc.filename if exc.filename is not None else "file"
-        print(f"{name}: error: {exc.strerror or exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        return 130
+    func: Any = args.func
+    return handled(lambda: func(args))
 
 
 if __name__ == "__main__":
