@@ -211,15 +211,69 @@ def _kernel_argument(p: argparse.ArgumentParser) -> None:
                         f"{', '.join(KERNELS[1:])}")
 
 
+#: What an output option names: a folder the command writes its files into, or one file.
+FOLDER, FILE = "folder", "file"
+
+
+def _output(p: argparse.ArgumentParser, dest: str, option: str, kind: str) -> None:
+    """Record that option ``option`` (attribute ``dest``) names an output ``kind``; main checks
+    every recorded one before the command runs (``_check_outputs``)."""
+    p.set_defaults(_outputs=(*(p.get_default("_outputs") or ()), (dest, option, kind)))
+
+
 def _out_argument(p: argparse.ArgumentParser, help: str, *, required: bool = True,
-                  default: str | None = None, metavar: str | None = None) -> None:
-    """--out, the folder (or file) a command writes."""
+                  default: str | None = None, metavar: str | None = None,
+                  kind: str = FOLDER) -> None:
+    """--out, the folder (or with ``kind=FILE`` the file) a command writes; checked before any
+    work."""
     p.add_argument("--out", required=required, default=default, metavar=metavar, help=help)
+    _output(p, "out", "--out", kind)
 
 
 def _json_argument(p: argparse.ArgumentParser, help: str = "write the result as JSON") -> None:
-    """--json OUT, a file a command writes its result to."""
+    """--json OUT, a file a command writes its result to; checked before any work."""
     p.add_argument("--json", default=None, metavar="OUT", help=help)
+    _output(p, "json", "--json", FILE)
+
+
+def _check_outputs(args: argparse.Namespace) -> None:
+    """InputError (exit 2, before any work) for the first output option given that cannot be
+    written: a folder that is a file, a file that is a folder, a dangling symbolic link, or a
+    place under a file or in a folder this user cannot write."""
+    for dest, option, kind in getattr(args, "_outputs", ()):
+        value = getattr(args, dest, None)
+        if value is not None:
+            _check_output(option, str(value), kind)
+
+
+def _check_output(option: str, value: str, kind: str) -> None:
+    import os
+    from pathlib import Path
+
+    path = Path(value)
+
+    def refuse(why: str) -> InputError:
+        return InputError(option, value, why)
+
+    if path.is_symlink() and not path.exists():
+        raise refuse(f"is a dangling symbolic link (to {os.readlink(path)!r}); remove it or "
+                     f"give another {kind}")
+    if path.exists():
+        if kind == FOLDER and not path.is_dir():
+            raise refuse("is a file, not a folder (the command writes its files into it)")
+        if kind == FILE and path.is_dir():
+            raise refuse("is a folder, not a file")
+    # The nearest folder that exists is where the files (or the folders leading to them) and
+    # the atomic writer's temporary names are made.
+    here = path if kind == FOLDER else path.parent
+    while not here.exists() and not here.is_symlink() and here != here.parent:
+        here = here.parent
+    if here.is_symlink() and not here.exists():
+        raise refuse(f"cannot be written: {str(here)!r} is a dangling symbolic link")
+    if not here.is_dir():
+        raise refuse(f"cannot be written: {str(here)!r} is a file, not a folder")
+    if not os.access(here, os.W_OK | os.X_OK):
+        raise refuse(f"cannot be written: this user may not write in the folder {str(here)!r}")
 
 
 def _engine_arguments(p: argparse.ArgumentParser) -> None:
@@ -282,6 +336,7 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--witness", default=None, metavar="FILE",
                     help="also write the search's witness of its answer (npz, docs/model.md "
                          "§11); plan.json gets its witness_sha256")
+    _output(pl, "witness", "--witness", FILE)
     pl.set_defaults(func=cmd_plan)
 
     c = sub.add_parser("check", help="check another planner's dr.npy and plan.json (or a "
@@ -325,6 +380,7 @@ def _parser() -> argparse.ArgumentParser:
                     help="an obligation id, prefix or glob (repeatable)")
     pr.add_argument("--audit", metavar="DIR", default=None,
                     help="then write the audit report to DIR")
+    _output(pr, "audit", "--audit", FOLDER)
     pr.add_argument("--repin", action="store_true",
                     help="rewrite proofs/obligations.lock with the statements run and print "
                          "what changed (review the diff), instead of failing on a change")
@@ -379,7 +435,7 @@ def _parser() -> argparse.ArgumentParser:
 
     si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")
     _trajectory_arguments(si)
-    _out_argument(si, "the log file to write (CSV)", metavar="LOG")
+    _out_argument(si, "the log file to write (CSV)", metavar="LOG", kind=FILE)
     si.add_argument("--lag", type=float, default=0.0, help="tracking lag in s (default 0)")
     si.add_argument("--noise", type=float, default=0.0,
                     help="bounded uniform noise per joint in rad (default 0)")
@@ -403,7 +459,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     # The provenance records what this call was given, not the process's sys.argv.
     args.argv = list(sys.argv[1:] if argv is None else argv)
     func: Any = args.func
-    return handled(lambda: func(args))
+
+    def run() -> int:
+        _check_outputs(args)           # before any work: a bad output is exit 2 at once
+        return int(func(args))
+    return handled(run)
 
 
 if __name__ == "__main__":

@@ -249,3 +249,153 @@ def test_prove_that_stops_opens_the_gate_with_stop_and_the_report_writes_nothing
     monkeypatch.setattr(cfmpa.proofs, "run_prove", proving(False))
     assert main(["prove", "--out", str(tmp_path / "p"), "--audit", str(tmp_path / "a")]) == 0
     assert marker.read_text().endswith("results.json")
+
+
+# --- outputs checked before the work (issue 22.6) ---------------------------------------------
+
+def _no_work(monkeypatch):
+    """Every computation a command could start raises: a command that gets past its checks
+    fails the test loudly instead of computing."""
+    import cfmpa.proofs
+    import cfmpa.report
+    import cfmpa.runs
+
+    def computes(*args, **kw):
+        raise AssertionError("the command computed before refusing its output")
+    for module, name in [(cfmpa.runs, "run_dr"), (cfmpa.runs, "run_plan"),
+                         (cfmpa.runs, "run_batch"), (cfmpa.runs, "run_certify"),
+                         (cfmpa.runs, "run_monitor"), (cfmpa.runs, "run_simulate"),
+                         (cfmpa.runs, "run_code_selftest"), (cfmpa.report, "run_audit"),
+                         (cfmpa.report, "run_compare"), (cfmpa.report, "run_prove_audit"),
+                         (cfmpa.proofs, "run_prove")]:
+        monkeypatch.setattr(module, name, computes)
+
+
+#: (command line with {bad} for the output, the option named) for every output option.
+OUTPUTS = [
+    (["dr", "default", "--out", "{bad}"], "--out"),
+    (["plan", "default", "--out", "{bad}"], "--out"),
+    (["plan", "default", "--out", "{ok}", "--witness", "{bad}"], "--witness"),
+    (["check", "--batch", "{ok}", "--json", "{bad}"], "--json"),
+    (["selftest", "--code", "--json", "{bad}"], "--json"),
+    (["prove", "--out", "{bad}"], "--out"),
+    (["prove", "--out", "{ok}", "--audit", "{bad}"], "--audit"),
+    (["audit", "--out", "{bad}"], "--out"),
+    (["compare", "--out", "{bad}"], "--out"),
+    (["certify", "default", "--traj", "t.csv", "--json", "{bad}"], "--json"),
+    (["monitor", "default", "--traj", "t.csv", "--log", "l.csv", "--json", "{bad}"], "--json"),
+    (["simulate", "default", "--traj", "t.csv", "--out", "{bad}"], "--out"),
+]
+
+
+def _is_file_option(argv, option):
+    return option in ("--json", "--witness") or argv[0] == "simulate"
+
+
+@pytest.mark.parametrize("argv, option", OUTPUTS, ids=lambda x: " ".join(x)
+                         if isinstance(x, list) else x)
+@pytest.mark.parametrize("bad", ["wrong kind", "dangling link", "under a file"])
+def test_a_bad_output_is_exit_2_before_any_work(tmp_path, monkeypatch, capsys, argv, option,
+                                                 bad):
+    _no_work(monkeypatch)
+    ok = tmp_path / "ok"
+    ok.mkdir()
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file")
+    target = {"wrong kind": (ok if _is_file_option(argv, option) else blocker),
+              "dangling link": tmp_path / "link",
+              "under a file": blocker / "x"}[bad]
+    if bad == "dangling link":
+        target.symlink_to(tmp_path / "nowhere")
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    line = [a.format(bad=target, ok=ok) for a in argv]
+    assert main(line) == 2
+    err = capsys.readouterr().err
+    assert f"error: {option} " in err and str(target) in err and "Traceback" not in err
+    assert {"wrong kind": "not a", "dangling link": "dangling symbolic link",
+            "under a file": "is a file, not a folder"}[bad] in err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before       # nothing written
+
+
+def test_plan_into_an_existing_file_fails_before_planning(tmp_path, monkeypatch, capsys):
+    # The issue's case: `cfmpa plan default --out victim.txt` planned the whole workcell first.
+    _no_work(monkeypatch)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    assert main(["plan", "default", "--out", str(victim)]) == 2
+    assert "error: --out is a file, not a folder" in capsys.readouterr().err
+    assert victim.read_text() == "keep me"
+
+
+def test_an_unwritable_folder_is_exit_2_before_any_work(tmp_path, monkeypatch, capsys):
+    import os
+
+    _no_work(monkeypatch)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    if os.geteuid() == 0:
+        # root may write anywhere: stand in for the permission a user would lack.
+        real = os.access
+        monkeypatch.setattr(os, "access", lambda p, mode, **kw: (
+            False if Path(p) == locked and mode & os.W_OK else real(p, mode, **kw)))
+    try:
+        assert main(["plan", "default", "--out", str(locked / "plan")]) == 2
+        err = capsys.readouterr().err
+        assert "error: --out cannot be written: this user may not write in the folder" in err
+        assert main(["certify", "default", "--traj", "t.csv", "--json",
+                     str(locked / "c.json")]) == 2
+        assert "error: --json cannot be written" in capsys.readouterr().err
+    finally:
+        locked.chmod(0o755)
+    assert list(locked.iterdir()) == []
+
+
+def test_a_good_output_gets_through_the_check(tmp_path, monkeypatch, capsys):
+    # The check refuses only what cannot be written: a new folder under a writable one, an
+    # existing folder, an existing file to replace get through to the command (here a stub).
+    import cfmpa.runs
+
+    seen = []
+    monkeypatch.setattr(cfmpa.runs, "run_dr", lambda *a, **kw: seen.append(a[2]) or 0)
+    monkeypatch.setattr(cfmpa.runs, "run_certify", lambda *a, **kw: seen.append(kw["json_out"])
+                        or 0)
+    (tmp_path / "old.json").write_text("{}")
+    assert main(["dr", "default", "--out", str(tmp_path / "new" / "deeper")]) == 0
+    assert main(["dr", "default", "--out", str(tmp_path)]) == 0
+    assert main(["certify", "default", "--traj", "t", "--json", str(tmp_path / "old.json")]) == 0
+    assert len(seen) == 3
+
+
+# --- exceptions to exit codes, in one place (cfmpa.errors) ---------------------------------------
+
+@pytest.mark.parametrize("exc, code, said", [
+    (lambda: __import__("cfmpa.errors").errors.InputError("--n", 5, "is bad"), 2,
+     "error: --n is bad, got 5"),
+    (lambda: __import__("cfmpa.errors").errors.ContractViolation("T", "post.x: broke"), 1,
+     "error: T: post.x: broke"),
+    (lambda: OSError(28, "No space left on device", "/full/x"), 2,
+     "/full/x: error: No space left on device"),
+    (lambda: KeyboardInterrupt(), 130, "interrupted"),
+])
+def test_handled_maps_each_error_to_its_exit_code_and_one_line(exc, code, said):
+    import io
+
+    from cfmpa.errors import exit_code, handled
+
+    err = io.StringIO()
+
+    def run() -> int:
+        raise exc()
+    assert handled(run, err) == code and exit_code(exc()) == code
+    assert err.getvalue() == said + "\n"
+
+
+def test_handled_lets_a_bug_keep_its_traceback():
+    from cfmpa.errors import exit_code, handled
+
+    def run() -> int:
+        raise ZeroDivisionError("a bug")
+    assert exit_code(ZeroDivisionError()) is None
+    with pytest.raises(ZeroDivisionError):
+        handled(run)
