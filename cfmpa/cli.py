@@ -10,8 +10,11 @@ message, in one place. Exit codes: 0 success, 1 a check failed (a violation, a f
 from __future__ import annotations
 
 import argparse
+import functools
+import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from . import __version__
@@ -162,8 +165,6 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
     """(workers, scheduler) of --workers and --scheduler: a local cluster of one worker per CPU
     unless either is given; both at once is refused."""
-    import os
-
     if args.scheduler is not None and args.workers is not None:
         raise InputError("--workers", args.workers, "cannot be combined with --scheduler (the "
                          "cluster's own workers run the tasks)")
@@ -171,8 +172,7 @@ def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
         return 0, args.scheduler
     if args.workers is not None:
         return args.workers, None
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (
-        os.cpu_count() or 1), None
+    return _cpus(), None
 
 
 # --- shared options ----------------------------------------------------------------------------
@@ -184,8 +184,9 @@ def _variant(value: str) -> str:
     try:
         return Variant(value).value
     except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"--variant must be one of {', '.join(v.value for v in Variant)}, got {value!r}") from None
+        raise argparse.ArgumentTypeError(f"--variant must be one of "
+                                         f"{', '.join(v.value for v in Variant)}, got {value!r}"
+                                         ) from None
 
 
 def _scenario_argument(p: argparse.ArgumentParser,
@@ -215,10 +216,17 @@ def _kernel_argument(p: argparse.ArgumentParser) -> None:
 FOLDER, FILE = "folder", "file"
 
 
+def _checked(p: argparse.ArgumentParser, dest: str, option: str,
+             check: Callable[[str, Any], None]) -> None:
+    """Record that option ``option`` (attribute ``dest``) is checked by ``check(option, value)``
+    (which raises InputError); main runs every recorded check of the command before the command
+    itself, so a bad value is exit 2 before anything is computed, allocated or written."""
+    p.set_defaults(_checks=(*(p.get_default("_checks") or ()), (dest, option, check)))
+
+
 def _output(p: argparse.ArgumentParser, dest: str, option: str, kind: str) -> None:
-    """Record that option ``option`` (attribute ``dest``) names an output ``kind``; main checks
-    every recorded one before the command runs (``_check_outputs``)."""
-    p.set_defaults(_outputs=(*(p.get_default("_outputs") or ()), (dest, option, kind)))
+    """Record that option ``option`` names an output ``kind`` (``_check_output``)."""
+    _checked(p, dest, option, functools.partial(_check_output, kind=kind))
 
 
 def _out_argument(p: argparse.ArgumentParser, help: str, *, required: bool = True,
@@ -236,20 +244,84 @@ def _json_argument(p: argparse.ArgumentParser, help: str = "write the result as 
     _output(p, "json", "--json", FILE)
 
 
-def _check_outputs(args: argparse.Namespace) -> None:
-    """InputError (exit 2, before any work) for the first output option given that cannot be
-    written: a folder that is a file, a file that is a folder, a dangling symbolic link, or a
-    place under a file or in a folder this user cannot write."""
-    for dest, option, kind in getattr(args, "_outputs", ()):
+@dataclass(frozen=True)
+class Budget:
+    """The values a numeric option accepts, checked before the command allocates or writes
+    anything: finite, at least ``lo`` and at most ``hi`` (None: that bound is the run's own, or
+    none), and ``why`` the limit is what it is (said in the message)."""
+
+    lo: float | None
+    hi: float | None
+    why: str
+
+    def __call__(self, option: str, value: Any) -> None:
+        if isinstance(value, float) and not math.isfinite(value):
+            raise InputError(option, value, "must be a finite number")
+        if self.lo is not None and value < self.lo:
+            raise InputError(option, value, f"must be at least {_limit(self.lo)} ({self.why})")
+        if self.hi is not None and value > self.hi:
+            raise InputError(option, value, f"must be at most {_limit(self.hi)} ({self.why})")
+
+
+def _limit(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() and abs(x) >= 1 else f"{x:g}"
+
+
+def _cpus() -> int:
+    import os
+
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (
+        os.cpu_count() or 1)
+
+
+def _budgets() -> dict[str, Budget]:
+    """Every numeric option's budget, by name (the runs' own constants where they have one)."""
+    from .runs import MAX_DT, MAX_LOG_SAMPLES, MAX_WORKCELLS, MIN_PERIOD_S
+
+    workers = 4 * _cpus()
+    return {
+        "seed": Budget(0, 2**63 - 1, "a seed of numpy's generator"),
+        "sample": Budget(1, 2**53, "no grid has more cells; a sample of them all checks every "
+                                   "cell"),
+        "workers": Budget(0, workers, f"four processes per CPU; this machine has {_cpus()}"),
+        "prove_workers": Budget(None, workers, f"four processes per CPU; this machine has "
+                                               f"{_cpus()}"),
+        "connect_timeout": Budget(0, 86_400, "a day"),
+        "workcells": Budget(None, MAX_WORKCELLS, "the campaign's budget"),
+        "dt": Budget(None, MAX_DT, "the coarsest campaign time step"),
+        "lag": Budget(0, 3600, "an hour"),
+        "noise": Budget(0, round(2 * math.pi, 6), "a full turn"),
+        "tail": Budget(0, 3600, "an hour"),
+        "period": Budget(MIN_PERIOD_S, 3600, "a 1 MHz log at the finest, a sample an hour at "
+                                             "the coarsest"),
+        "samples": Budget(1, MAX_LOG_SAMPLES, "the simulated log's budget"),
+    }
+
+
+def _number(p: argparse.ArgumentParser, option: str, budget: Budget, *, type: Callable[[str], Any],
+            **kw: Any) -> None:
+    """A numeric option: parsed by ``type``, its value checked against ``budget`` before the
+    command runs."""
+    action = p.add_argument(option, type=type, **kw)
+    _checked(p, action.dest, option, budget)
+
+
+def _run_checks(args: argparse.Namespace) -> None:
+    """Every recorded check of the command on the values given (InputError at the first)."""
+    for dest, option, check in getattr(args, "_checks", ()):
         value = getattr(args, dest, None)
         if value is not None:
-            _check_output(option, str(value), kind)
+            check(option, value)
 
 
-def _check_output(option: str, value: str, kind: str) -> None:
+def _check_output(option: str, value: Any, kind: str) -> None:
+    """InputError for an output that cannot be written: a folder that is a file, a file that is
+    a folder, a dangling symbolic link, or a place under a file or in a folder this user cannot
+    write."""
     import os
     from pathlib import Path
 
+    value = str(value)
     path = Path(value)
 
     def refuse(why: str) -> InputError:
@@ -278,14 +350,15 @@ def _check_output(option: str, value: str, kind: str) -> None:
 
 def _engine_arguments(p: argparse.ArgumentParser) -> None:
     """--workers, --scheduler, --connect-timeout (cfmpa compare, cfmpa check --batch)."""
-    p.add_argument("--workers", type=_positive, default=None, metavar="K",
-                   help="worker processes of a local Dask cluster (default: one per CPU; 0: "
-                        "run in this process, no cluster)")
+    b = _budgets()
+    _number(p, "--workers", b["workers"], type=_positive, default=None, metavar="K",
+            help="worker processes of a local Dask cluster (default: one per CPU; 0: run in "
+                 "this process, no cluster)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on a running Dask cluster instead (tcp://HOST:PORT of `dask "
                         "scheduler`; its workers need cfmpa installed)")
-    p.add_argument("--connect-timeout", type=float, default=10.0, metavar="S",
-                   help="seconds to wait for the scheduler and its first worker (default 10)")
+    _number(p, "--connect-timeout", b["connect_timeout"], type=float, default=10.0, metavar="S",
+            help="seconds to wait for the scheduler and its first worker (default 10)")
 
 
 def _trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",
@@ -314,6 +387,7 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="cfmpa", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    b = _budgets()
 
     d = sub.add_parser("dr", help="build the collision-state database D_R (BuiltDR)")
     _scenario_argument(d)
@@ -329,9 +403,9 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--contracts", choices=["off", "sampled", "full"], default="full",
                     help="contract checking of BuiltDR and searchoptpath (default: full, every "
                          "cell and optimality through the witness)")
-    pl.add_argument("--seed", type=int, default=0, help="seed of the sampled contracts")
-    pl.add_argument("--sample", type=int, default=None,
-                    help="cells checked by sampled contracts (default: the mode's own)")
+    _number(pl, "--seed", b["seed"], type=int, default=0, help="seed of the sampled contracts")
+    _number(pl, "--sample", b["sample"], type=int, default=None,
+            help="cells checked by sampled contracts (default: the mode's own)")
     _kernel_argument(pl)
     pl.add_argument("--witness", default=None, metavar="FILE",
                     help="also write the search's witness of its answer (npz, docs/model.md "
@@ -384,9 +458,9 @@ def _parser() -> argparse.ArgumentParser:
     pr.add_argument("--repin", action="store_true",
                     help="rewrite proofs/obligations.lock with the statements run and print "
                          "what changed (review the diff), instead of failing on a change")
-    pr.add_argument("--workers", type=int, default=None, metavar="K",
-                    help="processes discharging obligations side by side (default 2 on a "
-                         "machine with two cores or more, else 1); the results do not depend on K")
+    _number(pr, "--workers", b["prove_workers"], type=int, default=None, metavar="K",
+            help="processes discharging obligations side by side (default 2 on a machine with "
+                 "two cores or more, else 1); the results do not depend on K")
     pr.set_defaults(func=cmd_prove)
 
     au = sub.add_parser("audit", help="write report.html and report.json")
@@ -397,8 +471,8 @@ def _parser() -> argparse.ArgumentParser:
     au.add_argument("--proofs", default=None,
                     help="results.json of a prove run to report (default: prove afresh); it "
                          "must cover the given workcells' checks, others' rows are left out")
-    au.add_argument("--compare-n", type=_positive, default=100,
-                    help="workcells in the campaign (0 skips it; default 100)")
+    _number(au, "--compare-n", b["workcells"], type=_positive, default=100,
+            help="workcells in the campaign (0 skips it; default 100)")
     au.add_argument("--campaign", metavar="DIR", default=None,
                     help="show the campaign `cfmpa compare --out DIR` recorded there (read "
                          "from its records, not run again) instead of running one")
@@ -408,11 +482,12 @@ def _parser() -> argparse.ArgumentParser:
     sc.set_defaults(func=cmd_scenarios)
 
     co = sub.add_parser("compare", help="original vs modified vs tight on random workcells")
-    co.add_argument("--n", type=_positive, default=100, help="workcells (default 100)")
-    co.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
-    co.add_argument("--dt", type=float, default=0.1,
-                    help="time step of the workcells in s (default 0.1; the bundled default "
-                         "scenario's is 0.02)")
+    _number(co, "--n", b["workcells"], type=_positive, default=100,
+            help="workcells (default 100)")
+    _number(co, "--seed", b["seed"], type=int, default=0, help="campaign seed (default 0)")
+    _number(co, "--dt", b["dt"], type=float, default=0.1,
+            help="time step of the workcells in s (default 0.1; the bundled default scenario's "
+                 "is 0.02)")
     _out_argument(co, "folder for compare.json and the store compare.jsonl (a rerun of the "
                       "same settings resumes from it)", required=False)
     _engine_arguments(co)
@@ -436,18 +511,19 @@ def _parser() -> argparse.ArgumentParser:
     si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")
     _trajectory_arguments(si)
     _out_argument(si, "the log file to write (CSV)", metavar="LOG", kind=FILE)
-    si.add_argument("--lag", type=float, default=0.0, help="tracking lag in s (default 0)")
-    si.add_argument("--noise", type=float, default=0.0,
-                    help="bounded uniform noise per joint in rad (default 0)")
-    si.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    _number(si, "--lag", b["lag"], type=float, default=0.0,
+            help="tracking lag in s (default 0)")
+    _number(si, "--noise", b["noise"], type=float, default=0.0,
+            help="bounded uniform noise per joint in rad (default 0)")
+    _number(si, "--seed", b["seed"], type=int, default=0, help="noise seed (default 0)")
     si.add_argument("--excursion", action="append", default=[], metavar="T:JOINT:RAD[:DURATION]",
                     help="add RAD to JOINT from T for DURATION s (default 0.05; repeatable)")
-    si.add_argument("--period", type=float, default=None,
-                    help="sample period in s (default 0.001)")
-    si.add_argument("--samples", type=int, default=None,
-                    help="this many evenly spaced samples instead of --period")
-    si.add_argument("--tail", type=float, default=0.0,
-                    help="keep sampling this many s after the trajectory ends (default 0)")
+    _number(si, "--period", b["period"], type=float, default=None,
+            help="sample period in s (default 0.001)")
+    _number(si, "--samples", b["samples"], type=int, default=None,
+            help="this many evenly spaced samples instead of --period")
+    _number(si, "--tail", b["tail"], type=float, default=0.0,
+            help="keep sampling this many s after the trajectory ends (default 0)")
     si.set_defaults(func=cmd_simulate)
     return p
 
@@ -461,7 +537,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     func: Any = args.func
 
     def run() -> int:
-        _check_outputs(args)           # before any work: a bad output is exit 2 at once
+        _run_checks(args)              # before any work: a bad value is exit 2 at once
         return int(func(args))
     return handled(run)
 

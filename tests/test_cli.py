@@ -399,3 +399,107 @@ def test_handled_lets_a_bug_keep_its_traceback():
     assert exit_code(ZeroDivisionError()) is None
     with pytest.raises(ZeroDivisionError):
         handled(run)
+
+
+# --- numeric budgets (issue 22.3) ----------------------------------------------------------------
+
+@pytest.fixture
+def rest_traj(tmp_path):
+    """A two-row trajectory of the default workcell at rest: simulate reads it in milliseconds."""
+    p = tmp_path / "traj.csv"
+    p.write_text("t,left1,left2,right1,right2\n0,0.1,0.2,0.3,0.4\n1,0.1,0.2,0.3,0.4\n")
+    return p
+
+
+@pytest.mark.parametrize("extra, said", [
+    (["--samples", "10000000000"], "--samples must be at most 1000000 (the simulated log's "
+                                   "budget), got 10000000000"),
+    (["--period", "1e-12"], "--period must be at least 1e-06"),
+    (["--period", "0.0001", "--tail", "3600"], "--period gives 3.601e+07 samples over 3601 s, "
+                                               "more than the simulated log's budget of 1000000"),
+    (["--lag", "nan"], "--lag must be a finite number, got nan"),
+    (["--noise", "inf"], "--noise must be a finite number"),
+    (["--seed", "-1"], "--seed must be at least 0"),
+])
+def test_simulate_over_budget_is_exit_2_and_writes_nothing(tmp_path, rest_traj, capsys, extra,
+                                                          said):
+    log = tmp_path / "log.csv"
+    assert main(["simulate", "default", "--traj", str(rest_traj), "--out", str(log),
+                 *extra]) == 2
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["traj.csv"]
+
+
+def test_simulate_within_budget_still_writes(tmp_path, rest_traj):
+    # The budget refuses what is over it, not what is at it: a million samples exactly pass
+    # the option's check (the run's own count is the same number).
+    from cfmpa.runs import MAX_LOG_SAMPLES, simulate_log
+    from cfmpa.spec import load_scenario, load_trajectory
+    from cfmpa.scenarios import resolve
+
+    traj = load_trajectory(rest_traj, load_scenario(resolve("default")))
+    assert len(simulate_log(traj, samples=MAX_LOG_SAMPLES)[0]) == MAX_LOG_SAMPLES
+    assert main(["simulate", "default", "--traj", str(rest_traj), "--out",
+                 str(tmp_path / "log.csv"), "--samples", "3"]) == 0
+    assert len((tmp_path / "log.csv").read_text().splitlines()) == 4
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["compare", "--n", "1000000000000"], "--n must be at most 1000000 (the campaign's budget)"),
+    (["compare", "--n", "2", "--workers", "100000"], "--workers must be at most"),
+    (["compare", "--n", "2", "--connect-timeout", "inf"], "--connect-timeout must be a finite"),
+    (["compare", "--n", "2", "--dt", "nan"], "--dt must be a finite number"),
+    (["compare", "--n", "2", "--seed", "-3"], "--seed must be at least 0"),
+])
+def test_compare_over_budget_is_exit_2_and_leaves_no_store(tmp_path, monkeypatch, capsys, argv,
+                                                           said):
+    _no_work(monkeypatch)
+    out = tmp_path / "c"
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_the_campaign_refuses_too_many_workcells_before_its_store(tmp_path):
+    # The run's own budget, for a caller that is not the command line.
+    from cfmpa.errors import InputError
+    from cfmpa.runs import MAX_WORKCELLS, run_campaign
+
+    with pytest.raises(InputError, match="--n must be at most"):
+        run_campaign(MAX_WORKCELLS + 1, out=tmp_path / "c")
+    assert not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["plan", "default", "--out", "{tmp}", "--sample", str(2**60)], "--sample must be at most"),
+    (["plan", "default", "--out", "{tmp}", "--seed", str(2**64)], "--seed must be at most"),
+    (["check", "--batch", "{tmp}", "--workers", "100000"], "--workers must be at most"),
+    (["prove", "--out", "{tmp}", "--workers", "100000"], "--workers must be at most"),
+    (["audit", "--out", "{tmp}", "--compare-n", str(10**9)], "--compare-n must be at most"),
+])
+def test_every_other_numeric_option_has_a_budget(tmp_path, monkeypatch, capsys, argv, said):
+    _no_work(monkeypatch)
+    assert main([a.format(tmp=tmp_path / "o") for a in argv]) == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_every_numeric_option_is_budgeted():
+    # Every option parsed as a number (int, float or the whole-number type) is recorded with a
+    # Budget: a new numeric option without one fails here.
+    import argparse
+
+    from cfmpa.cli import Budget, _parser
+
+    sub = next(a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction))
+    unbudgeted = []
+    for name, p in sub.choices.items():
+        checked = {(dest, option) for dest, option, check in p.get_default("_checks") or ()
+                   if isinstance(check, Budget)}
+        for a in p._actions:
+            if a.type in (int, float) or getattr(a.type, "__name__", "") == "_positive":
+                if (a.dest, a.option_strings[0]) not in checked:
+                    unbudgeted.append(f"{name} {a.option_strings[0]}")
+    assert unbudgeted == []
