@@ -383,20 +383,61 @@ def _positive(value: str) -> int:
 # --- the parser --------------------------------------------------------------------------------
 
 
+#: What `cfmpa --help` opens with: what the tool does, for a user.
+ABOUT = ("cfmpa plans the subordinate arm's collision-free motion in a dual-arm SCARA workcell "
+         "(BuiltDR and searchoptpath of Li et al.), checks each run against the paper's "
+         "contracts, certifies a motion's clearance at every instant, monitors measured joint "
+         "logs against the certified tube, and discharges the paper's proof obligations with "
+         "Z3.")
+
+#: What `cfmpa --help` closes with: a first command and the exit codes (errors.exit_code).
+FIRST_STEPS = """\
+a first command:
+  cfmpa plan default --out plan    plan the bundled default workcell into the folder plan/
+  cfmpa scenarios                  list the bundled workcells (or give a TOML file instead)
+  cfmpa COMMAND --help             a command's options and an example
+
+exit codes:
+  0    success (a plan that finds no path is an answer: exit 0)
+  1    a check failed: a contract violation, a clearance not proved, a log outside its
+       tube, an obligation not proved, a seeded fault not caught
+  2    bad input or usage (or a file the system refused), in one line naming the
+       option or the file and line, without a traceback
+  130  interrupted
+"""
+
+
+def _command(sub: Any, name: str, summary: str, example: str,
+             func: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
+    """The subparser of command ``name``: ``summary`` is its one line (in `cfmpa --help` and
+    atop its own help), ``example`` a command line shown under its options."""
+    p: argparse.ArgumentParser = sub.add_parser(
+        name, help=summary, description=summary[0].upper() + summary[1:] + ".",
+        epilog=f"example:\n  {example}", formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.set_defaults(func=func)
+    return p
+
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="cfmpa", description=__doc__.splitlines()[0])
+    import textwrap
+
+    p = argparse.ArgumentParser(prog="cfmpa", description=textwrap.fill(ABOUT, 79),
+                                epilog=FIRST_STEPS,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     b = _budgets()
 
-    d = sub.add_parser("dr", help="build the collision-state database D_R (BuiltDR)")
+    d = _command(sub, "dr", "build the collision-state database D_R (BuiltDR)",
+                 "cfmpa dr default --variant tight --out build/dr", cmd_dr)
     _scenario_argument(d)
     _variant_argument(d)
     _out_argument(d, "output folder (dr.npy is written there)")
     _kernel_argument(d)
-    d.set_defaults(func=cmd_dr)
 
-    pl = sub.add_parser("plan", help="plan the subordinate's path; write dr.npy and plan.json")
+    pl = _command(sub, "plan", "plan the subordinate's path; write dr.npy and plan.json",
+                  "cfmpa plan default --out plan", cmd_plan)
     _scenario_argument(pl)
     _variant_argument(pl)
     _out_argument(pl, "output folder")
@@ -411,10 +452,10 @@ def _parser() -> argparse.ArgumentParser:
                     help="also write the search's witness of its answer (npz, docs/model.md "
                          "§11); plan.json gets its witness_sha256")
     _output(pl, "witness", "--witness", FILE)
-    pl.set_defaults(func=cmd_plan)
 
-    c = sub.add_parser("check", help="check another planner's dr.npy and plan.json (or a "
-                                     "folder of plan folders with --batch)")
+    c = _command(sub, "check", "check another planner's dr.npy and plan.json (or a folder of "
+                               "plan folders with --batch)",
+                 "cfmpa check default --dr plan/dr.npy --plan plan/plan.json", cmd_check)
     c.add_argument("scenario", nargs="?", default=None,
                    help="scenario the outputs are for: a bundled name or a TOML file (with "
                         "--batch: optional, else each plan's bundled scenario by its name)")
@@ -428,9 +469,9 @@ def _parser() -> argparse.ArgumentParser:
                         "per plan; summary in DIR/check-batch.json")
     _json_argument(c, "with --batch: write the summary here instead")
     _engine_arguments(c)
-    c.set_defaults(func=cmd_check)
 
-    st = sub.add_parser("selftest", help="seed faults; show which check catches each")
+    st = _command(sub, "selftest", "seed faults; show which check catches each",
+                  "cfmpa selftest", cmd_selftest)
     st.add_argument("--code", action="store_true",
                     help="mutate a copy of the source instead (minutes): which of cfmpa prove, "
                          "the contracts and the tests catch each mutant; exit 1 unless prove "
@@ -442,9 +483,9 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("--prove-only", action="append", metavar="ID",
                     help="with --code: cfmpa prove on these obligations only (as its --only)")
     _json_argument(st, "with --code: the table as JSON")
-    st.set_defaults(func=cmd_selftest)
 
-    pr = sub.add_parser("prove", help="discharge every obligation (make prove)")
+    pr = _command(sub, "prove", "discharge every obligation (make prove)",
+                  "cfmpa prove --only Prop8 --out build/proofs", cmd_prove)
     _out_argument(pr, "results folder (default build/proofs)", required=False,
                   default="build/proofs")
     pr.add_argument("--scenarios", default=None,
@@ -461,9 +502,9 @@ def _parser() -> argparse.ArgumentParser:
     _number(pr, "--workers", b["prove_workers"], type=int, default=None, metavar="K",
             help="processes discharging obligations side by side (default 2 on a machine with "
                  "two cores or more, else 1); the results do not depend on K")
-    pr.set_defaults(func=cmd_prove)
 
-    au = sub.add_parser("audit", help="write report.html and report.json")
+    au = _command(sub, "audit", "write report.html and report.json",
+                  "cfmpa audit default --out build/audit --compare-n 0", cmd_audit)
     au.add_argument("scenarios", nargs="*",
                     help="scenario names or files (default: all bundled); the report shows the "
                          "per-scenario obligations of exactly these workcells")
@@ -476,12 +517,12 @@ def _parser() -> argparse.ArgumentParser:
     au.add_argument("--campaign", metavar="DIR", default=None,
                     help="show the campaign `cfmpa compare --out DIR` recorded there (read "
                          "from its records, not run again) instead of running one")
-    au.set_defaults(func=cmd_audit)
 
-    sc = sub.add_parser("scenarios", help="list the bundled scenarios and their purposes")
-    sc.set_defaults(func=cmd_scenarios)
+    sc = _command(sub, "scenarios", "list the bundled scenarios and their purposes",
+                  "cfmpa scenarios", cmd_scenarios)
 
-    co = sub.add_parser("compare", help="original vs modified vs tight on random workcells")
+    co = _command(sub, "compare", "original vs modified vs tight on random workcells",
+                  "cfmpa compare --n 20 --workers 0 --out build/compare", cmd_compare)
     _number(co, "--n", b["workcells"], type=_positive, default=100,
             help="workcells (default 100)")
     _number(co, "--seed", b["seed"], type=int, default=0, help="campaign seed (default 0)")
@@ -491,24 +532,25 @@ def _parser() -> argparse.ArgumentParser:
     _out_argument(co, "folder for compare.json and the store compare.jsonl (a rerun of the "
                       "same settings resumes from it)", required=False)
     _engine_arguments(co)
-    co.set_defaults(func=cmd_compare)
 
-    ce = sub.add_parser("certify", help="certify any trajectory file: proved clearance and "
-                                        "tolerance tube")
+    ce = _command(sub, "certify", "certify any trajectory file: proved clearance and "
+                                  "tolerance tube",
+                  "cfmpa certify default --traj plan/traj.csv --json certify.json", cmd_certify)
     _trajectory_arguments(ce, "trajectory: CSV t,left1,left2,right1,right2 or the same columns "
                               "as JSON (docs/model.md §12)",
                           "certify even when a joint speed exceeds the scenario's omega")
     _json_argument(ce)
-    ce.set_defaults(func=cmd_certify)
 
-    mo = sub.add_parser("monitor", help="check a measured joint log against the certified tube")
+    mo = _command(sub, "monitor", "check a measured joint log against the certified tube",
+                  "cfmpa monitor default --traj plan/traj.csv --log log.csv", cmd_monitor)
     _trajectory_arguments(mo)
     mo.add_argument("--log", required=True, metavar="LOG",
                     help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
     _json_argument(mo)
-    mo.set_defaults(func=cmd_monitor)
 
-    si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")
+    si = _command(sub, "simulate", "write a simulated measured log of a trajectory",
+                  "cfmpa simulate default --traj plan/traj.csv --out log.csv --noise 0.001",
+                  cmd_simulate)
     _trajectory_arguments(si)
     _out_argument(si, "the log file to write (CSV)", metavar="LOG", kind=FILE)
     _number(si, "--lag", b["lag"], type=float, default=0.0,
@@ -524,7 +566,6 @@ def _parser() -> argparse.ArgumentParser:
             help="this many evenly spaced samples instead of --period")
     _number(si, "--tail", b["tail"], type=float, default=0.0,
             help="keep sampling this many s after the trajectory ends (default 0)")
-    si.set_defaults(func=cmd_simulate)
     return p
 
 

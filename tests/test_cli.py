@@ -503,3 +503,42 @@ def test_every_numeric_option_is_budgeted():
                 if (a.dest, a.option_strings[0]) not in checked:
                     unbudgeted.append(f"{name} {a.option_strings[0]}")
     assert unbudgeted == []
+
+
+# --- help for users (issue 22.9) -----------------------------------------------------------------
+
+def _subparsers():
+    import argparse
+
+    from cfmpa.cli import _parser
+
+    p = _parser()
+    sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction))
+    return p, sub
+
+
+def test_the_top_help_says_what_the_tool_does_a_first_command_and_the_exit_codes(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["--help"])
+    assert info.value.code == 0
+    text = capsys.readouterr().out
+    assert "The command line" not in text and "main(argv)" not in text   # not the developer's
+    assert "cfmpa plans the subordinate arm's collision-free motion" in text
+    assert "cfmpa plan default --out plan" in text
+    codes = text[text.index("exit codes:"):]
+    for code, words in ((0, "success"), (1, "a check failed"), (2, "bad input"),
+                        (130, "interrupted")):
+        assert re.search(rf"^  {code} +{words}", codes, re.M), (code, codes)
+
+
+def test_every_subcommand_has_a_one_line_description_and_an_example_that_parses():
+    p, sub = _subparsers()
+    listed = {a.dest: a.help for a in sub._choices_actions}
+    assert set(listed) == set(sub.choices)
+    for name, sp in sub.choices.items():
+        assert listed[name] and "\n" not in listed[name], name
+        assert sp.description and sp.description.rstrip(".").lower() == listed[name].lower()
+        assert sp.epilog and sp.epilog.startswith("example:\n  cfmpa " + name), name
+        example = sp.epilog.splitlines()[1].split()[1:]
+        args = p.parse_args(example)             # the example is a command line the parser takes
+        assert args.command == name and args.func is sp.get_default("func")
