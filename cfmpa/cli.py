@@ -3,21 +3,20 @@
 The command line parses and prints only: each ``cmd_*`` turns the parsed options into one call
 of a ``run_*`` of runs/, report/ or proofs/ (which computes, prints on the streams it is given
 and returns the exit code); ``cfmpa.errors.handled`` turns an exception into its exit code and
-message, in one place. Exit codes: 0 success, 1 a check failed (a violation, a failed proof),
-2 bad input or usage.
+message, in one place. The options the subcommands share, and the checks of every output and
+every number before any work, are ``cfmpa._arguments``'s. Exit codes: 0 success, 1 a check
+failed (a violation, a failed proof), 2 bad input or usage.
 """
 
 from __future__ import annotations
 
 import argparse
-import functools
-import math
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from . import __version__
+from . import _arguments as opt
 from .errors import InputError, handled
 from .scenarios import resolve
 
@@ -172,212 +171,7 @@ def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
         return 0, args.scheduler
     if args.workers is not None:
         return args.workers, None
-    return _cpus(), None
-
-
-# --- shared options ----------------------------------------------------------------------------
-
-
-def _variant(value: str) -> str:
-    from .spec import Variant
-
-    try:
-        return Variant(value).value
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--variant must be one of "
-                                         f"{', '.join(v.value for v in Variant)}, got {value!r}"
-                                         ) from None
-
-
-def _scenario_argument(p: argparse.ArgumentParser,
-                       text: str = "scenario: a bundled name (cfmpa scenarios) or a TOML file"
-                       ) -> None:
-    p.add_argument("scenario", help=text)
-
-
-def _variant_argument(p: argparse.ArgumentParser) -> None:
-    """--variant, one of spec.Variant's members (default modified)."""
-    from .spec import Variant
-
-    p.add_argument("--variant", type=_variant, default="modified",
-                   help=f"{' | '.join(v.value for v in Variant)} (default: modified)")
-
-
-def _kernel_argument(p: argparse.ArgumentParser) -> None:
-    """--kernel, one of impl.KERNELS (the first the default)."""
-    from .impl import KERNELS
-
-    p.add_argument("--kernel", choices=list(KERNELS), default=KERNELS[0],
-                   help=f"{KERNELS[0]} (default; bit-identical to the reference) or "
-                        f"{', '.join(KERNELS[1:])}")
-
-
-#: What an output option names: a folder the command writes its files into, or one file.
-FOLDER, FILE = "folder", "file"
-
-
-def _checked(p: argparse.ArgumentParser, dest: str, option: str,
-             check: Callable[[str, Any], None]) -> None:
-    """Record that option ``option`` (attribute ``dest``) is checked by ``check(option, value)``
-    (which raises InputError); main runs every recorded check of the command before the command
-    itself, so a bad value is exit 2 before anything is computed, allocated or written."""
-    p.set_defaults(_checks=(*(p.get_default("_checks") or ()), (dest, option, check)))
-
-
-def _output(p: argparse.ArgumentParser, dest: str, option: str, kind: str) -> None:
-    """Record that option ``option`` names an output ``kind`` (``_check_output``)."""
-    _checked(p, dest, option, functools.partial(_check_output, kind=kind))
-
-
-def _out_argument(p: argparse.ArgumentParser, help: str, *, required: bool = True,
-                  default: str | None = None, metavar: str | None = None,
-                  kind: str = FOLDER) -> None:
-    """--out, the folder (or with ``kind=FILE`` the file) a command writes; checked before any
-    work."""
-    p.add_argument("--out", required=required, default=default, metavar=metavar, help=help)
-    _output(p, "out", "--out", kind)
-
-
-def _json_argument(p: argparse.ArgumentParser, help: str = "write the result as JSON") -> None:
-    """--json OUT, a file a command writes its result to; checked before any work."""
-    p.add_argument("--json", default=None, metavar="OUT", help=help)
-    _output(p, "json", "--json", FILE)
-
-
-@dataclass(frozen=True)
-class Budget:
-    """The values a numeric option accepts, checked before the command allocates or writes
-    anything: finite, at least ``lo`` and at most ``hi`` (None: that bound is the run's own, or
-    none), and ``why`` the limit is what it is (said in the message)."""
-
-    lo: float | None
-    hi: float | None
-    why: str
-
-    def __call__(self, option: str, value: Any) -> None:
-        if isinstance(value, float) and not math.isfinite(value):
-            raise InputError(option, value, "must be a finite number")
-        if self.lo is not None and value < self.lo:
-            raise InputError(option, value, f"must be at least {_limit(self.lo)} ({self.why})")
-        if self.hi is not None and value > self.hi:
-            raise InputError(option, value, f"must be at most {_limit(self.hi)} ({self.why})")
-
-
-def _limit(x: float) -> str:
-    return str(int(x)) if float(x).is_integer() and abs(x) >= 1 else f"{x:g}"
-
-
-def _cpus() -> int:
-    import os
-
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (
-        os.cpu_count() or 1)
-
-
-def _budgets() -> dict[str, Budget]:
-    """Every numeric option's budget, by name (the runs' own constants where they have one)."""
-    from .runs import MAX_DT, MAX_LOG_SAMPLES, MAX_WORKCELLS, MIN_PERIOD_S
-
-    workers = 4 * _cpus()
-    return {
-        "seed": Budget(0, 2**63 - 1, "a seed of numpy's generator"),
-        "sample": Budget(1, 2**53, "no grid has more cells; a sample of them all checks every "
-                                   "cell"),
-        "workers": Budget(0, workers, f"four processes per CPU; this machine has {_cpus()}"),
-        "prove_workers": Budget(None, workers, f"four processes per CPU; this machine has "
-                                               f"{_cpus()}"),
-        "connect_timeout": Budget(0, 86_400, "a day"),
-        "workcells": Budget(None, MAX_WORKCELLS, "the campaign's budget"),
-        "dt": Budget(None, MAX_DT, "the coarsest campaign time step"),
-        "lag": Budget(0, 3600, "an hour"),
-        "noise": Budget(0, round(2 * math.pi, 6), "a full turn"),
-        "tail": Budget(0, 3600, "an hour"),
-        "period": Budget(MIN_PERIOD_S, 3600, "a 1 MHz log at the finest, a sample an hour at "
-                                             "the coarsest"),
-        "samples": Budget(1, MAX_LOG_SAMPLES, "the simulated log's budget"),
-    }
-
-
-def _number(p: argparse.ArgumentParser, option: str, budget: Budget, *, type: Callable[[str], Any],
-            **kw: Any) -> None:
-    """A numeric option: parsed by ``type``, its value checked against ``budget`` before the
-    command runs."""
-    action = p.add_argument(option, type=type, **kw)
-    _checked(p, action.dest, option, budget)
-
-
-def _run_checks(args: argparse.Namespace) -> None:
-    """Every recorded check of the command on the values given (InputError at the first)."""
-    for dest, option, check in getattr(args, "_checks", ()):
-        value = getattr(args, dest, None)
-        if value is not None:
-            check(option, value)
-
-
-def _check_output(option: str, value: Any, kind: str) -> None:
-    """InputError for an output that cannot be written: a folder that is a file, a file that is
-    a folder, a dangling symbolic link, or a place under a file or in a folder this user cannot
-    write."""
-    import os
-    from pathlib import Path
-
-    value = str(value)
-    path = Path(value)
-
-    def refuse(why: str) -> InputError:
-        return InputError(option, value, why)
-
-    if path.is_symlink() and not path.exists():
-        raise refuse(f"is a dangling symbolic link (to {os.readlink(path)!r}); remove it or "
-                     f"give another {kind}")
-    if path.exists():
-        if kind == FOLDER and not path.is_dir():
-            raise refuse("is a file, not a folder (the command writes its files into it)")
-        if kind == FILE and path.is_dir():
-            raise refuse("is a folder, not a file")
-    # The nearest folder that exists is where the files (or the folders leading to them) and
-    # the atomic writer's temporary names are made.
-    here = path if kind == FOLDER else path.parent
-    while not here.exists() and not here.is_symlink() and here != here.parent:
-        here = here.parent
-    if here.is_symlink() and not here.exists():
-        raise refuse(f"cannot be written: {str(here)!r} is a dangling symbolic link")
-    if not here.is_dir():
-        raise refuse(f"cannot be written: {str(here)!r} is a file, not a folder")
-    if not os.access(here, os.W_OK | os.X_OK):
-        raise refuse(f"cannot be written: this user may not write in the folder {str(here)!r}")
-
-
-def _engine_arguments(p: argparse.ArgumentParser) -> None:
-    """--workers, --scheduler, --connect-timeout (cfmpa compare, cfmpa check --batch)."""
-    b = _budgets()
-    _number(p, "--workers", b["workers"], type=_positive, default=None, metavar="K",
-            help="worker processes of a local Dask cluster (default: one per CPU; 0: run in "
-                 "this process, no cluster)")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run on a running Dask cluster instead (tcp://HOST:PORT of `dask "
-                        "scheduler`; its workers need cfmpa installed)")
-    _number(p, "--connect-timeout", b["connect_timeout"], type=float, default=10.0, metavar="S",
-            help="seconds to wait for the scheduler and its first worker (default 10)")
-
-
-def _trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",
-                          speed: str = "accept a trajectory whose joint speeds exceed omega"
-                          ) -> None:
-    """What certify, monitor and simulate share: the scenario, --traj and --allow-speed."""
-    _scenario_argument(p, "scenario (the geometry): a bundled name or a TOML file")
-    p.add_argument("--traj", required=True, metavar="FILE", help=traj)
-    p.add_argument("--allow-speed", action="store_true", help=speed)
-
-
-def _positive(value: str) -> int:
-    try:
-        n = int(value)
-    except ValueError:
-        n = -1
-    if n < 0:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {value!r}")
-    return n
+    return opt.cpus(), None
 
 
 # --- the parser --------------------------------------------------------------------------------
@@ -427,31 +221,31 @@ def _parser() -> argparse.ArgumentParser:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    b = _budgets()
+    b = opt.budgets()
 
     d = _command(sub, "dr", "build the collision-state database D_R (BuiltDR)",
                  "cfmpa dr default --variant tight --out build/dr", cmd_dr)
-    _scenario_argument(d)
-    _variant_argument(d)
-    _out_argument(d, "output folder (dr.npy is written there)")
-    _kernel_argument(d)
+    opt.scenario_argument(d)
+    opt.variant_argument(d)
+    opt.out_argument(d, "output folder (dr.npy is written there)")
+    opt.kernel_argument(d)
 
     pl = _command(sub, "plan", "plan the subordinate's path; write dr.npy and plan.json",
                   "cfmpa plan default --out plan", cmd_plan)
-    _scenario_argument(pl)
-    _variant_argument(pl)
-    _out_argument(pl, "output folder")
+    opt.scenario_argument(pl)
+    opt.variant_argument(pl)
+    opt.out_argument(pl, "output folder")
     pl.add_argument("--contracts", choices=["off", "sampled", "full"], default="full",
                     help="contract checking of BuiltDR and searchoptpath (default: full, every "
                          "cell and optimality through the witness)")
-    _number(pl, "--seed", b["seed"], type=int, default=0, help="seed of the sampled contracts")
-    _number(pl, "--sample", b["sample"], type=int, default=None,
-            help="cells checked by sampled contracts (default: the mode's own)")
-    _kernel_argument(pl)
+    opt.number(pl, "--seed", b["seed"], type=int, default=0, help="seed of the sampled contracts")
+    opt.number(pl, "--sample", b["sample"], type=int, default=None,
+               help="cells checked by sampled contracts (default: the mode's own)")
+    opt.kernel_argument(pl)
     pl.add_argument("--witness", default=None, metavar="FILE",
                     help="also write the search's witness of its answer (npz, docs/model.md "
                          "§11); plan.json gets its witness_sha256")
-    _output(pl, "witness", "--witness", FILE)
+    opt.output(pl, "witness", "--witness", opt.FILE)
 
     c = _command(sub, "check", "check another planner's dr.npy and plan.json (or a folder of "
                                "plan folders with --batch)",
@@ -467,8 +261,8 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--batch", default=None, metavar="DIR",
                    help="check every folder under DIR holding plan.json and dr.npy, one task "
                         "per plan; summary in DIR/check-batch.json")
-    _json_argument(c, "with --batch: write the summary here instead")
-    _engine_arguments(c)
+    opt.json_argument(c, "with --batch: write the summary here instead")
+    opt.engine_arguments(c)
 
     st = _command(sub, "selftest", "seed faults; show which check catches each",
                   "cfmpa selftest", cmd_selftest)
@@ -482,12 +276,12 @@ def _parser() -> argparse.ArgumentParser:
                     help="with --code: comma-separated, of prove,contracts,tests (default all)")
     st.add_argument("--prove-only", action="append", metavar="ID",
                     help="with --code: cfmpa prove on these obligations only (as its --only)")
-    _json_argument(st, "with --code: the table as JSON")
+    opt.json_argument(st, "with --code: the table as JSON")
 
     pr = _command(sub, "prove", "discharge every obligation (make prove)",
                   "cfmpa prove --only Prop8 --out build/proofs", cmd_prove)
-    _out_argument(pr, "results folder (default build/proofs)", required=False,
-                  default="build/proofs")
+    opt.out_argument(pr, "results folder (default build/proofs)", required=False,
+                     default="build/proofs")
     pr.add_argument("--scenarios", default=None,
                     help="a folder of your workcells (*.toml) to prove: seven checks per file, "
                          "ids from the file names (default: the bundled workcells)")
@@ -495,12 +289,12 @@ def _parser() -> argparse.ArgumentParser:
                     help="an obligation id, prefix or glob (repeatable)")
     pr.add_argument("--audit", metavar="DIR", default=None,
                     help="then write the audit report to DIR")
-    _output(pr, "audit", "--audit", FOLDER)
+    opt.output(pr, "audit", "--audit", opt.FOLDER)
     pr.add_argument("--repin", action="store_true",
                     help="rewrite proofs/obligations.lock with the statements run and print "
                          "what changed (review the diff), instead of failing on a change")
-    _number(pr, "--workers", b["prove_workers"], type=int, default=None, metavar="K",
-            help="processes discharging obligations side by side (default 2 on a machine with "
+    opt.number(pr, "--workers", b["prove_workers"], type=int, default=None, metavar="K",
+               help="processes discharging obligations side by side (default 2 on a machine with "
                  "two cores or more, else 1); the results do not depend on K")
 
     au = _command(sub, "audit", "write report.html and report.json",
@@ -508,12 +302,12 @@ def _parser() -> argparse.ArgumentParser:
     au.add_argument("scenarios", nargs="*",
                     help="scenario names or files (default: all bundled); the report shows the "
                          "per-scenario obligations of exactly these workcells")
-    _out_argument(au, "output folder")
+    opt.out_argument(au, "output folder")
     au.add_argument("--proofs", default=None,
                     help="results.json of a prove run to report (default: prove afresh); it "
                          "must cover the given workcells' checks, others' rows are left out")
-    _number(au, "--compare-n", b["workcells"], type=_positive, default=100,
-            help="workcells in the campaign (0 skips it; default 100)")
+    opt.number(au, "--compare-n", b["workcells"], type=opt.positive, default=100,
+               help="workcells in the campaign (0 skips it; default 100)")
     au.add_argument("--campaign", metavar="DIR", default=None,
                     help="show the campaign `cfmpa compare --out DIR` recorded there (read "
                          "from its records, not run again) instead of running one")
@@ -523,49 +317,49 @@ def _parser() -> argparse.ArgumentParser:
 
     co = _command(sub, "compare", "original vs modified vs tight on random workcells",
                   "cfmpa compare --n 20 --workers 0 --out build/compare", cmd_compare)
-    _number(co, "--n", b["workcells"], type=_positive, default=100,
-            help="workcells (default 100)")
-    _number(co, "--seed", b["seed"], type=int, default=0, help="campaign seed (default 0)")
-    _number(co, "--dt", b["dt"], type=float, default=0.1,
-            help="time step of the workcells in s (default 0.1; the bundled default scenario's "
+    opt.number(co, "--n", b["workcells"], type=opt.positive, default=100,
+               help="workcells (default 100)")
+    opt.number(co, "--seed", b["seed"], type=int, default=0, help="campaign seed (default 0)")
+    opt.number(co, "--dt", b["dt"], type=float, default=0.1,
+               help="time step of the workcells in s (default 0.1; the bundled default scenario's "
                  "is 0.02)")
-    _out_argument(co, "folder for compare.json and the store compare.jsonl (a rerun of the "
+    opt.out_argument(co, "folder for compare.json and the store compare.jsonl (a rerun of the "
                       "same settings resumes from it)", required=False)
-    _engine_arguments(co)
+    opt.engine_arguments(co)
 
     ce = _command(sub, "certify", "certify any trajectory file: proved clearance and "
                                   "tolerance tube",
                   "cfmpa certify default --traj plan/traj.csv --json certify.json", cmd_certify)
-    _trajectory_arguments(ce, "trajectory: CSV t,left1,left2,right1,right2 or the same columns "
+    opt.trajectory_arguments(ce, "trajectory: CSV t,left1,left2,right1,right2 or the same columns "
                               "as JSON (docs/model.md §12)",
                           "certify even when a joint speed exceeds the scenario's omega")
-    _json_argument(ce)
+    opt.json_argument(ce)
 
     mo = _command(sub, "monitor", "check a measured joint log against the certified tube",
                   "cfmpa monitor default --traj plan/traj.csv --log log.csv", cmd_monitor)
-    _trajectory_arguments(mo)
+    opt.trajectory_arguments(mo)
     mo.add_argument("--log", required=True, metavar="LOG",
                     help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
-    _json_argument(mo)
+    opt.json_argument(mo)
 
     si = _command(sub, "simulate", "write a simulated measured log of a trajectory",
                   "cfmpa simulate default --traj plan/traj.csv --out log.csv --noise 0.001",
                   cmd_simulate)
-    _trajectory_arguments(si)
-    _out_argument(si, "the log file to write (CSV)", metavar="LOG", kind=FILE)
-    _number(si, "--lag", b["lag"], type=float, default=0.0,
-            help="tracking lag in s (default 0)")
-    _number(si, "--noise", b["noise"], type=float, default=0.0,
-            help="bounded uniform noise per joint in rad (default 0)")
-    _number(si, "--seed", b["seed"], type=int, default=0, help="noise seed (default 0)")
+    opt.trajectory_arguments(si)
+    opt.out_argument(si, "the log file to write (CSV)", metavar="LOG", kind=opt.FILE)
+    opt.number(si, "--lag", b["lag"], type=float, default=0.0,
+               help="tracking lag in s (default 0)")
+    opt.number(si, "--noise", b["noise"], type=float, default=0.0,
+               help="bounded uniform noise per joint in rad (default 0)")
+    opt.number(si, "--seed", b["seed"], type=int, default=0, help="noise seed (default 0)")
     si.add_argument("--excursion", action="append", default=[], metavar="T:JOINT:RAD[:DURATION]",
                     help="add RAD to JOINT from T for DURATION s (default 0.05; repeatable)")
-    _number(si, "--period", b["period"], type=float, default=None,
-            help="sample period in s (default 0.001)")
-    _number(si, "--samples", b["samples"], type=int, default=None,
-            help="this many evenly spaced samples instead of --period")
-    _number(si, "--tail", b["tail"], type=float, default=0.0,
-            help="keep sampling this many s after the trajectory ends (default 0)")
+    opt.number(si, "--period", b["period"], type=float, default=None,
+               help="sample period in s (default 0.001)")
+    opt.number(si, "--samples", b["samples"], type=int, default=None,
+               help="this many evenly spaced samples instead of --period")
+    opt.number(si, "--tail", b["tail"], type=float, default=0.0,
+               help="keep sampling this many s after the trajectory ends (default 0)")
     return p
 
 
@@ -578,7 +372,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     func: Any = args.func
 
     def run() -> int:
-        _run_checks(args)              # before any work: a bad value is exit 2 at once
+        opt.run_checks(args)           # before any work: a bad value is exit 2 at once
         return int(func(args))
     return handled(run)
 

@@ -491,7 +491,8 @@ def test_every_numeric_option_is_budgeted():
     # Budget: a new numeric option without one fails here.
     import argparse
 
-    from cfmpa.cli import Budget, _parser
+    from cfmpa._arguments import Budget
+    from cfmpa.cli import _parser
 
     sub = next(a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction))
     unbudgeted = []
@@ -499,7 +500,7 @@ def test_every_numeric_option_is_budgeted():
         checked = {(dest, option) for dest, option, check in p.get_default("_checks") or ()
                    if isinstance(check, Budget)}
         for a in p._actions:
-            if a.type in (int, float) or getattr(a.type, "__name__", "") == "_positive":
+            if a.type in (int, float) or getattr(a.type, "__name__", "") == "positive":
                 if (a.dest, a.option_strings[0]) not in checked:
                     unbudgeted.append(f"{name} {a.option_strings[0]}")
     assert unbudgeted == []

@@ -35,7 +35,8 @@ LEAVES = {"cfmpa", "cfmpa.errors", "cfmpa.files", "cfmpa.gitstate", "cfmpa.scena
 #: computed (the campaign's engine is runs/_engine.py's), so it has no dask of its own; the
 #: command line parses and prints, so it starts no process (prove --audit's fork is
 #: report/_prove_audit.py's).
-FORBIDDEN = {"cfmpa.report": {"dask", "distributed"}, "cfmpa.cli": {"multiprocessing"}}
+FORBIDDEN = {"cfmpa.report": {"dask", "distributed"}, "cfmpa.cli": {"multiprocessing"},
+             "cfmpa._arguments": {"multiprocessing"}}
 
 
 def _modules() -> list[tuple[str, str, Path]]:
@@ -175,3 +176,4 @@ def test_the_cli_may_not_import_multiprocessing(planted: str):
         copy.unlink()
     assert any("cfmpa.cli may not import multiprocessing" in p for p in problems), problems
     assert _forbidden("cfmpa", "cfmpa.cli", real) == []
+    assert _forbidden("cfmpa", "cfmpa._arguments", ROOT / "cfmpa" / "_arguments.py") == []
