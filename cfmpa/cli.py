@@ -57,6 +57,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             if value is not None:
                 raise InputError(flag, value, "cannot be combined with --batch (each plan "
                                  "folder's own dr.npy and plan.json are checked)")
+        if args.json is None:          # the summary goes into DIR: it must be writable first
+            opt.check_output("--batch", args.batch, opt.FOLDER)
         workers, scheduler = _engine(args)
         return run_batch(args.batch, None if args.scenario is None else resolve(args.scenario),
                          json_out=args.json, workers=workers, scheduler=scheduler,

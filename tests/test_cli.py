@@ -543,3 +543,24 @@ def test_every_subcommand_has_a_one_line_description_and_an_example_that_parses(
         example = sp.epilog.splitlines()[1].split()[1:]
         args = p.parse_args(example)             # the example is a command line the parser takes
         assert args.command == name and args.func is sp.get_default("func")
+
+
+def test_a_batch_folder_that_cannot_take_its_summary_is_refused_before_any_check(
+        tmp_path, monkeypatch, capsys):
+    # Without --json the summary is written into DIR: a DIR this user may not write is exit 2
+    # before a plan is checked; with --json elsewhere the same DIR is only read.
+    import os
+
+    import cfmpa.runs
+
+    _no_work(monkeypatch)
+    locked = tmp_path / "plans"
+    locked.mkdir()
+    real = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode, **kw: (
+        False if Path(p) == locked and mode & os.W_OK else real(p, mode, **kw)))
+    assert main(["check", "--batch", str(locked), "--workers", "0"]) == 2
+    assert "error: --batch cannot be written" in capsys.readouterr().err
+    monkeypatch.setattr(cfmpa.runs, "run_batch", lambda *a, **kw: 0)
+    assert main(["check", "--batch", str(locked), "--workers", "0", "--json",
+                 str(tmp_path / "summary.json")]) == 0
