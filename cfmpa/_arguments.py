@@ -102,6 +102,10 @@ class Budget:
     why: str
 
     def __call__(self, option: str, value: Any) -> None:
+        if isinstance(value, (list, tuple)):      # nargs or append: each value on its own
+            for v in value:
+                self(option, v)
+            return
         if isinstance(value, float) and not math.isfinite(value):
             raise InputError(option, value, "must be a finite number")
         if self.lo is not None and value < self.lo:
@@ -144,6 +148,8 @@ def budgets() -> dict[str, Budget]:
         "period": Budget(MIN_PERIOD_S, 3600, "a 1 MHz log at the finest, a sample an hour at "
                                              "the coarsest"),
         "samples": Budget(1, MAX_LOG_SAMPLES, "the simulated log's budget"),
+        # A joint speed in rad/s (a --max-speed of monitor's): 100 rad/s is ~950 rpm at a joint.
+        "speed": Budget(0, 100, "a joint's speed in rad/s"),
     }
 
 

@@ -564,3 +564,15 @@ def test_a_batch_folder_that_cannot_take_its_summary_is_refused_before_any_check
     monkeypatch.setattr(cfmpa.runs, "run_batch", lambda *a, **kw: 0)
     assert main(["check", "--batch", str(locked), "--workers", "0", "--json",
                  str(tmp_path / "summary.json")]) == 0
+
+
+def test_a_budget_checks_each_value_of_a_repeated_option():
+    from cfmpa._arguments import Budget
+    from cfmpa.errors import InputError
+
+    b = Budget(0, 10, "why")
+    b("--x", [1.0, 10.0])
+    with pytest.raises(InputError, match=r"--x must be at most 10 \(why\), got 11.0"):
+        b("--x", [1.0, 11.0])
+    with pytest.raises(InputError, match="--x must be a finite number"):
+        b("--x", (float("nan"),))
