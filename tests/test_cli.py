@@ -576,3 +576,23 @@ def test_a_budget_checks_each_value_of_a_repeated_option():
         b("--x", [1.0, 11.0])
     with pytest.raises(InputError, match="--x must be a finite number"):
         b("--x", (float("nan"),))
+
+
+# --- every run_* prints on the streams it is given ------------------------------------------------
+
+def test_the_commands_runs_print_on_the_streams_they_are_given(tiny_file, tmp_path, capsys):
+    import io
+
+    from cfmpa.runs import run_check, run_dr, run_plan, run_scenarios
+
+    out, err = io.StringIO(), io.StringIO()
+    assert run_dr(tiny_file, "tight", tmp_path / "d", kernel="reference", stdout=out) == 0
+    assert "variant   tight (reference kernel)" in out.getvalue()
+    assert run_plan(tiny_file, "modified", tmp_path / "p", contracts="off", stdout=out,
+                    stderr=err) == 0
+    assert "contracts off:" in out.getvalue() and err.getvalue() == ""
+    assert run_check(tiny_file, tmp_path / "p" / "dr.npy", tmp_path / "p" / "plan.json",
+                     stdout=out) == 0
+    assert "result: all checks hold" in out.getvalue()
+    assert run_scenarios(stdout=out) == 0 and "bundled scenarios in" in out.getvalue()
+    assert capsys.readouterr() == ("", "")        # nothing went to the process's own streams
