@@ -1,8 +1,8 @@
 """The command line: ``cfmpa`` -> ``main(argv)`` -> one ``cmd_*`` per subcommand.
 
 The command line parses and prints only: each ``cmd_*`` turns the parsed options into one call
-of a ``run_*`` of runs/, report/ or proofs/ (which computes, prints on the streams it is given
-and returns the exit code); ``cfmpa.errors.handled`` turns an exception into its exit code and
+of a ``run_*`` of runs/, report/ or proofs/ (which computes, prints and returns the exit
+code); ``cfmpa.errors.handled`` turns an exception into its exit code and
 message, in one place. The options the subcommands share, and the checks of every output and
 every number before any work, are ``cfmpa._arguments``'s. Exit codes: 0 success, 1 a check
 failed (a violation, a failed proof), 2 bad input or usage.
