@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+import sys
+from collections.abc import Callable, Mapping
+from typing import Any, TextIO
 
 __all__ = [
     "CfmpaError",
@@ -11,6 +12,11 @@ __all__ = [
     "MISSING",
     "ContractViolation",
     "CertificateViolation",
+    "INTERRUPTED",
+    "USAGE",
+    "exit_code",
+    "error_text",
+    "handled",
 ]
 
 
@@ -79,3 +85,51 @@ class ContractViolation(CfmpaError):
 
 class CertificateViolation(ContractViolation):
     """The continuous-time certificate found the arms' link rectangles in contact."""
+
+
+#: Exit code of bad input or usage (argparse's own), and of an interrupted run (128 + SIGINT).
+USAGE = 2
+INTERRUPTED = 130
+
+
+def exit_code(exc: BaseException) -> int | None:
+    """The exit code an exception stands for, None for one that is a bug (a traceback).
+
+    The one place exceptions become exit codes: the project's own errors carry theirs (a
+    violation 1, bad input 2), an OSError is input the system refused (an unreadable file, a
+    full disk: 2), an interrupt is 130.
+    """
+    if isinstance(exc, CfmpaError):
+        return exc.exit_code
+    if isinstance(exc, OSError):
+        return USAGE
+    if isinstance(exc, KeyboardInterrupt):
+        return INTERRUPTED
+    return None
+
+
+def error_text(exc: BaseException) -> str:
+    """The one line said on stderr for an exception that ``exit_code`` maps."""
+    if isinstance(exc, InputError):
+        return exc.render()
+    if isinstance(exc, CfmpaError):
+        return f"error: {exc}"
+    if isinstance(exc, OSError):
+        name = exc.filename if exc.filename is not None else "file"
+        return f"{name}: error: {exc.strerror or exc}"
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted"
+    return f"error: {exc}"
+
+
+def handled(run: Callable[[], int], stderr: TextIO | None = None) -> int:
+    """``run()``'s exit code; an exception ``exit_code`` maps becomes its message on ``stderr``
+    (default sys.stderr) and its exit code; any other propagates (a bug keeps its traceback)."""
+    try:
+        return int(run())
+    except BaseException as exc:
+        code = exit_code(exc)
+        if code is None:
+            raise
+        print(error_text(exc), file=sys.stderr if stderr is None else stderr)
+        return code

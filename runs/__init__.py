@@ -20,9 +20,15 @@ check          ``run_check`` (another planner's files)      ``runs/_check.py``
 campaign       ``run_campaign`` (`cfmpa compare`'s work)    ``runs/_campaign.py``
 report         ``report.run_audit``                         ``report/_audit.py``
 =============  ==========================================  ======================
+
+Each command of the CLI is one ``run_*`` here (``run_dr``, ``run_plan``, ``run_scenarios``,
+``run_check``, ...): it takes the command's values and the streams to print on, prints, and
+returns the exit code; bad input raises InputError, which ``cfmpa.errors.handled`` turns into
+exit 2.
 """
 
-from ._campaign import (COMPARE_DT, CONTACT_NOTE, KERNEL, MAX_DRAWS, MAX_DT, STORE_NAME, Campaign,
+from ._campaign import (COMPARE_DT, CONTACT_NOTE, KERNEL, MAX_DRAWS, MAX_DT, MAX_WORKCELLS,
+                        STORE_NAME, Campaign,
                         CaseError, CaseResult, VariantOutcome, load_campaign, plan_workcell,
                         random_workcell, run_campaign, workcell_task)
 from ._store import Store, open_store, read_store
@@ -32,8 +38,11 @@ from ._engine import (CONNECT_TIMEOUT_S, RETRIES, Engine, ProgressBar, TaskLost,
                       check_scheduler_address, error_message)
 from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json,
                          optimality_failures, violation_json)
-from ._plan import CERTIFICATE, PlanResult, plan, plan_json, versions, write_plan
-from ._trajectory_runs import (BLOCK_ROWS, Excursion, MonitorResult, certify_json, log_csv,
+from ._plan import (CERTIFICATE, PlanResult, clearance_line, plan, plan_json, run_dr, run_plan,
+                    versions, write_plan)
+from ._bundled import run_scenarios
+from ._trajectory_runs import (BLOCK_ROWS, MAX_LOG_SAMPLES, MIN_PERIOD_S, Excursion,
+                               MonitorResult, certify_json, log_csv,
                                monitor_json, monitor_log, parse_excursion, run_certify,
                                run_monitor, run_simulate, simulate_log)
 from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
@@ -47,6 +56,8 @@ __all__ = [
     "CERTIFICATE", "DEFAULT_SAMPLE", "Mode", "PlanResult", "Settings", "TripleRun",
     "contracts_json", "optimality_failures", "plan", "plan_json", "versions", "violation_json",
     "write_plan",
+    # the commands' runs: each prints on the streams it is given and returns the exit code
+    "clearance_line", "run_dr", "run_plan", "run_scenarios",
     # another planner's files
     "CheckReport", "check_outputs", "read_dr", "read_plan", "run_check",
     "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
@@ -54,10 +65,12 @@ __all__ = [
     "check_scheduler_address", "error_message",
     # the campaign of `cfmpa compare` and its resumable store (docs/model.md §13)
     "COMPARE_DT", "CONTACT_NOTE", "Campaign", "CaseError", "CaseResult", "KERNEL", "MAX_DRAWS",
-    "MAX_DT", "STORE_NAME", "Store", "VariantOutcome", "load_campaign", "open_store",
+    "MAX_DT", "MAX_WORKCELLS", "STORE_NAME", "Store", "VariantOutcome", "load_campaign",
+    "open_store",
     "plan_workcell", "random_workcell", "read_store", "run_campaign", "workcell_task",
     # any planner's trajectory (docs/model.md §12)
-    "BLOCK_ROWS", "Excursion", "MonitorResult", "certify_json", "log_csv", "monitor_json",
+    "BLOCK_ROWS", "Excursion", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult",
+    "certify_json", "log_csv", "monitor_json",
     "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",
     "simulate_log",
     # seeded faults

@@ -43,12 +43,16 @@ from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, 
 from ._engine import CONNECT_TIMEOUT_S, Engine, ProgressBar, TaskLost, error_message
 from ._store import Store, open_store, read_store
 
-__all__ = ["COMPARE_DT", "CONTACT_NOTE", "KERNEL", "MAX_DRAWS", "MAX_DT", "STORE_NAME",
+__all__ = ["COMPARE_DT", "CONTACT_NOTE", "KERNEL", "MAX_DRAWS", "MAX_DT", "MAX_WORKCELLS",
+           "STORE_NAME",
            "Campaign", "CaseError", "CaseResult", "VariantOutcome", "load_campaign",
            "plan_workcell", "random_workcell", "run_campaign", "workcell_task"]
 
 #: Time step of campaign workcells (s): grids of about 10-30 layers of 60-80 x 50-65 cells.
 COMPARE_DT = 0.1
+#: The most workcells a campaign plans (--n): its bookkeeping is O(n) before the first task, and
+#: a million is days of planning on a cluster; more is refused before the store is opened.
+MAX_WORKCELLS = 1_000_000
 #: The coarsest --dt accepted (s); the finest is what the cell budget allows (CFMPA_MAX_CELLS).
 MAX_DT = 1.0
 #: Draws of a start or goal cell before the campaign keeps a pose in contact (then counted).
@@ -344,6 +348,8 @@ def _env_faults() -> dict[int, str]:
 def _check_settings(n: Any, seed: Any, dt: Any) -> tuple[int, int, float]:
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise InputError("--n", n, "must be an integer >= 1")
+    if n > MAX_WORKCELLS:
+        raise InputError("--n", n, f"must be at most {MAX_WORKCELLS} (the campaign's budget)")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError("--seed", seed, "must be an integer >= 0")
     if (isinstance(dt, bool) or not isinstance(dt, (int, float)) or not math.isfinite(dt)

@@ -20,7 +20,7 @@ import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 import numpy.typing as npt
@@ -88,27 +88,25 @@ class CheckReport:
 
 
 def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | Path,
-              witness_path: str | Path | None = None) -> int:
-    """Check the outputs, print the listing; 0 all hold, 1 some failed, 2 unreadable input.
-    ``witness_path``: a witness file (`cfmpa plan --witness`) to verify instead of computing one."""
-    try:
-        s = load_scenario(scenario_path)
-        dr = read_dr(dr_path)
-        dr_sha = _file_sha256(dr_path)
-        doc = read_plan(plan_path)
-        witness = witness_sha = None
-        if witness_path is not None:
-            witness = load_witness(witness_path)
-            witness_sha = _file_sha256(witness_path, "witness")
-    except InputError as exc:
-        print(exc.render(), file=sys.stderr)
-        return 2
-    print(f"check     {Path(dr_path)} and {Path(plan_path)} against {s.name} ({scenario_path}), "
-          f"variant {doc.variant.value}"
-          + ("" if witness_path is None else f", witness {Path(witness_path)}"))
+              witness_path: str | Path | None = None, *, stdout: TextIO | None = None) -> int:
+    """Check the outputs, print the listing on ``stdout``; 0 all hold, 1 some failed; unreadable
+    input raises InputError (exit 2) before anything is printed. ``witness_path``: a witness
+    file (`cfmpa plan --witness`) to verify instead of computing one."""
+    so = sys.stdout if stdout is None else stdout
+    s = load_scenario(scenario_path)
+    dr = read_dr(dr_path)
+    dr_sha = _file_sha256(dr_path)
+    doc = read_plan(plan_path)
+    witness = witness_sha = None
+    if witness_path is not None:
+        witness = load_witness(witness_path)
+        witness_sha = _file_sha256(witness_path, "witness")
+    print(f"check     {Path(dr_path)} and {Path(plan_path)} against {s.name} "
+          f"({scenario_path}), variant {doc.variant.value}"
+          + ("" if witness_path is None else f", witness {Path(witness_path)}"), file=so)
     report = check_outputs(s, dr, doc, dr_sha256=dr_sha, witness=witness,
                            witness_sha256=witness_sha)
-    print(report.text())
+    print(report.text(), file=so)
     return 0 if report.ok else 1
 
 

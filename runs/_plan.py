@@ -12,11 +12,12 @@ from __future__ import annotations
 import functools
 import hashlib
 import platform
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, TextIO, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -35,7 +36,8 @@ from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_b
 
 R = TypeVar("R")
 
-__all__ = ["CERTIFICATE", "TRAJ_CSV", "PlanResult", "plan", "plan_json", "write_plan", "versions"]
+__all__ = ["CERTIFICATE", "TRAJ_CSV", "PlanResult", "clearance_line", "plan", "plan_json",
+           "run_dr", "run_plan", "write_plan", "versions"]
 
 
 @dataclass(frozen=True)
@@ -293,3 +295,98 @@ def write_plan(p: PlanResult, out: str | Path, *,
     plan_path = write_bytes_atomic(out / "plan.json",
                                    dumps_json(plan_json(p, data, proof)).encode())
     return dr_path, plan_path
+
+
+# --- cfmpa dr, cfmpa plan ---------------------------------------------------------------------
+
+
+def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *,
+           kernel: str = "fast", name: str | None = None, stdout: TextIO | None = None) -> int:
+    """`cfmpa dr`: build D_R of the scenario file for ``variant`` with the ``kernel`` pair
+    (``impl.KERNELS``), write ``out``/dr.npy atomically and print the grid and the free
+    fraction; 0 (bad input raises InputError). ``name``: the scenario as the user gave it."""
+    from ..files import save_npy_atomic
+    from ..impl import kernels
+    from ..spec import load_scenario
+
+    so = sys.stdout if stdout is None else stdout
+    v = Variant(variant)
+    s = load_scenario(scenario_path)
+    g = make_grid(s)
+    build, _ = kernels(kernel)
+    t0 = time.perf_counter()
+    dr = build(s, v.value, g)
+    seconds = time.perf_counter() - t0
+    path = save_npy_atomic(Path(out) / "dr.npy", dr)
+    free = 1.0 - float(dr.mean())
+    print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)
+    print(f"variant   {v.value} ({kernel} kernel)", file=so)
+    print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad"
+          f"  shape={tuple(dr.shape)}", file=so)
+    print(f"free      {free:.4%} of cells", file=so)
+    print(f"time      {seconds:.3f} s", file=so)
+    print(f"wrote     {path}", file=so)
+    return 0
+
+
+def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path, *,
+             contracts: Mode | str = "full", seed: int = 0, sample: int | None = None,
+             kernel: str = "fast", witness: str | Path | None = None, name: str | None = None,
+             stdout: TextIO | None = None, stderr: TextIO | None = None) -> int:
+    """`cfmpa plan`: ``plan`` with the ``kernel`` pair, not stopping at a violation, then
+    ``write_plan`` into ``out`` (and the witness file); print the summary.
+
+    0 when nothing was violated; 1 when a contract failed or the certificate is not clear (a
+    contact or an undecided interval is a violation in every contracts mode, off included); the
+    files are written all the same, as the evidence, and the summary says so on ``stderr``.
+    Bad input raises InputError. ``name``: the scenario as the user gave it.
+    """
+    from ..impl import kernels
+    from ..spec import load_scenario
+
+    so = sys.stdout if stdout is None else stdout
+    se = sys.stderr if stderr is None else stderr
+    s = load_scenario(scenario_path)
+    build, search = kernels(kernel)
+    p = plan(s, variant, contracts=contracts, seed=seed, sample=sample, stop=False, build=build,
+             search=search, kernel=kernel, witness=witness is not None)
+    dr_path, plan_path = write_plan(p, out, witness=witness)
+    violations = p.violations
+    g, r, t = p.grid, p.search, p.timings_s
+    print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)
+    print(f"variant   {p.variant}", file=so)
+    print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad",
+          file=so)
+    print(f"free      {p.free_fraction:.4%} of cells", file=so)
+    if r.reason is None:
+        print(f"status    {r.status}: J1={r.J1} J2={r.J2} length={len(r.path)} cells", file=so)
+    else:
+        print(f"status    {r.status}: {r.reason}", file=so)
+    if p.certificate is not None:
+        print(clearance_line(p.certificate), file=so)
+    print(f"contracts {p.settings.mode.value}: {p.checked} checks, {len(violations)} violations",
+          file=so)
+    print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()), file=so)
+    print(f"wrote     {dr_path}, {plan_path}" + (f", {witness}" if witness else ""), file=so)
+    for v in violations:
+        print(f"violation {v}", file=se)
+    if violations:
+        print(f"result    {len(violations)} violation(s): exit 1; the files above are written as "
+              f"the evidence", file=se)
+    return 1 if violations else 0
+
+
+def clearance_line(c: Certificate) -> str:
+    """The certificate in one line: the PROVED lower bound first, then the least sampled distance
+    (an upper bound on the true minimum) and its instant."""
+    sampled = (f"sampled minimum {c.min_clearance_m * 1000:.6g} mm at t={c.t_min_s:.4f} s "
+               f"({c.intervals} intervals)")
+    if c.clear:
+        return (f"clearance clear: proved >= {c.lower_bound_m * 1000:.6g} mm at every instant; "
+                f"{sampled}")
+    if c.contact_detail is not None:
+        d = c.contact_detail
+        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, left link {d.links[0]} and "
+                f"right link {d.links[1]}, {d.segment}; {sampled}")
+    return (f"clearance NOT CLEAR: {len(c.undecided)} interval(s) neither proved clear nor in "
+            f"contact, first {c.undecided[0]} s; {sampled}")

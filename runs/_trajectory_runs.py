@@ -30,9 +30,15 @@ from ..spec import (TRAJECTORY_COLUMNS, Certificate, Scenario, Trajectory, certi
                     csv_column_order, load_scenario, load_trajectory, tolerance_rad,
                     trajectory_distances, tube_lipschitz)
 
-__all__ = ["BLOCK_ROWS", "Excursion", "MonitorResult", "certify_json", "log_csv", "monitor_json",
-           "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",
-           "simulate_log"]
+__all__ = ["BLOCK_ROWS", "Excursion", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult",
+           "certify_json", "log_csv", "monitor_json", "monitor_log", "parse_excursion",
+           "run_certify", "run_monitor", "run_simulate", "simulate_log"]
+
+#: The most samples `cfmpa simulate` writes: the log is built in memory (about 0.5 KB a sample
+#: at its peak, a 100 MB CSV), so a count beyond is refused before anything is allocated.
+MAX_LOG_SAMPLES = 1_000_000
+#: The shortest --period (s): a 1 MHz log; finer is no measured robot's.
+MIN_PERIOD_S = 1e-6
 
 #: Log rows parsed per numpy block by the monitor.
 BLOCK_ROWS = 16_384
@@ -383,12 +389,20 @@ def simulate_log(traj: Trajectory, *, lag: float = 0.0, noise: float = 0.0, seed
     if samples is not None:
         if samples < 1:
             raise InputError("--samples", samples, "must be >= 1")
+        if samples > MAX_LOG_SAMPLES:
+            raise InputError("--samples", samples, f"must be at most {MAX_LOG_SAMPLES} (the "
+                             f"simulated log's budget)")
         t = t0 + (t1 - t0) * np.arange(samples) / max(samples - 1, 1) if samples > 1 else (
             np.array([t0]))
     else:
         p = 0.001 if period is None else period
         if not p > 0:
             raise InputError("--period", p, "must be > 0")
+        # Counted before np.arange allocates them: --period 1e-12 is 1e13 samples a second.
+        count = math.floor((t1 - t0) / p + 1e-9) + 1 if math.isfinite(t1 - t0) else math.inf
+        if count > MAX_LOG_SAMPLES:
+            raise InputError("--period", p, f"gives {count:.4g} samples over {t1 - t0:g} s, more "
+                             f"than the simulated log's budget of {MAX_LOG_SAMPLES}")
         t = t0 + p * np.arange(int(math.floor((t1 - t0) / p + 1e-9)) + 1)
     if len(t) > 1 and not np.all(np.diff(t) > 0):
         raise InputError("--samples", samples, "gives times that do not increase")

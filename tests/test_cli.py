@@ -249,3 +249,350 @@ def test_prove_that_stops_opens_the_gate_with_stop_and_the_report_writes_nothing
     monkeypatch.setattr(cfmpa.proofs, "run_prove", proving(False))
     assert main(["prove", "--out", str(tmp_path / "p"), "--audit", str(tmp_path / "a")]) == 0
     assert marker.read_text().endswith("results.json")
+
+
+# --- outputs checked before the work (issue 22.6) ---------------------------------------------
+
+def _no_work(monkeypatch):
+    """Every computation a command could start raises: a command that gets past its checks
+    fails the test loudly instead of computing."""
+    import cfmpa.proofs
+    import cfmpa.report
+    import cfmpa.runs
+
+    def computes(*args, **kw):
+        raise AssertionError("the command computed before refusing its output")
+    for module, name in [(cfmpa.runs, "run_dr"), (cfmpa.runs, "run_plan"),
+                         (cfmpa.runs, "run_batch"), (cfmpa.runs, "run_certify"),
+                         (cfmpa.runs, "run_monitor"), (cfmpa.runs, "run_simulate"),
+                         (cfmpa.runs, "run_code_selftest"), (cfmpa.report, "run_audit"),
+                         (cfmpa.report, "run_compare"), (cfmpa.report, "run_prove_audit"),
+                         (cfmpa.proofs, "run_prove")]:
+        monkeypatch.setattr(module, name, computes)
+
+
+#: (command line with {bad} for the output, the option named) for every output option.
+OUTPUTS = [
+    (["dr", "default", "--out", "{bad}"], "--out"),
+    (["plan", "default", "--out", "{bad}"], "--out"),
+    (["plan", "default", "--out", "{ok}", "--witness", "{bad}"], "--witness"),
+    (["check", "--batch", "{ok}", "--json", "{bad}"], "--json"),
+    (["selftest", "--code", "--json", "{bad}"], "--json"),
+    (["prove", "--out", "{bad}"], "--out"),
+    (["prove", "--out", "{ok}", "--audit", "{bad}"], "--audit"),
+    (["audit", "--out", "{bad}"], "--out"),
+    (["compare", "--out", "{bad}"], "--out"),
+    (["certify", "default", "--traj", "t.csv", "--json", "{bad}"], "--json"),
+    (["monitor", "default", "--traj", "t.csv", "--log", "l.csv", "--json", "{bad}"], "--json"),
+    (["simulate", "default", "--traj", "t.csv", "--out", "{bad}"], "--out"),
+]
+
+
+def _is_file_option(argv, option):
+    return option in ("--json", "--witness") or argv[0] == "simulate"
+
+
+@pytest.mark.parametrize("argv, option", OUTPUTS, ids=lambda x: " ".join(x)
+                         if isinstance(x, list) else x)
+@pytest.mark.parametrize("bad", ["wrong kind", "dangling link", "under a file"])
+def test_a_bad_output_is_exit_2_before_any_work(tmp_path, monkeypatch, capsys, argv, option,
+                                                 bad):
+    _no_work(monkeypatch)
+    ok = tmp_path / "ok"
+    ok.mkdir()
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file")
+    target = {"wrong kind": (ok if _is_file_option(argv, option) else blocker),
+              "dangling link": tmp_path / "link",
+              "under a file": blocker / "x"}[bad]
+    if bad == "dangling link":
+        target.symlink_to(tmp_path / "nowhere")
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    line = [a.format(bad=target, ok=ok) for a in argv]
+    assert main(line) == 2
+    err = capsys.readouterr().err
+    assert f"error: {option} " in err and str(target) in err and "Traceback" not in err
+    assert {"wrong kind": "not a", "dangling link": "dangling symbolic link",
+            "under a file": "is a file, not a folder"}[bad] in err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before       # nothing written
+
+
+def test_plan_into_an_existing_file_fails_before_planning(tmp_path, monkeypatch, capsys):
+    # The issue's case: `cfmpa plan default --out victim.txt` planned the whole workcell first.
+    _no_work(monkeypatch)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    assert main(["plan", "default", "--out", str(victim)]) == 2
+    assert "error: --out is a file, not a folder" in capsys.readouterr().err
+    assert victim.read_text() == "keep me"
+
+
+def test_an_unwritable_folder_is_exit_2_before_any_work(tmp_path, monkeypatch, capsys):
+    import os
+
+    _no_work(monkeypatch)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    if os.geteuid() == 0:
+        # root may write anywhere: stand in for the permission a user would lack.
+        real = os.access
+        monkeypatch.setattr(os, "access", lambda p, mode, **kw: (
+            False if Path(p) == locked and mode & os.W_OK else real(p, mode, **kw)))
+    try:
+        assert main(["plan", "default", "--out", str(locked / "plan")]) == 2
+        err = capsys.readouterr().err
+        assert "error: --out cannot be written: this user may not write in the folder" in err
+        assert main(["certify", "default", "--traj", "t.csv", "--json",
+                     str(locked / "c.json")]) == 2
+        assert "error: --json cannot be written" in capsys.readouterr().err
+    finally:
+        locked.chmod(0o755)
+    assert list(locked.iterdir()) == []
+
+
+def test_a_good_output_gets_through_the_check(tmp_path, monkeypatch, capsys):
+    # The check refuses only what cannot be written: a new folder under a writable one, an
+    # existing folder, an existing file to replace get through to the command (here a stub).
+    import cfmpa.runs
+
+    seen = []
+    monkeypatch.setattr(cfmpa.runs, "run_dr", lambda *a, **kw: seen.append(a[2]) or 0)
+    monkeypatch.setattr(cfmpa.runs, "run_certify", lambda *a, **kw: seen.append(kw["json_out"])
+                        or 0)
+    (tmp_path / "old.json").write_text("{}")
+    assert main(["dr", "default", "--out", str(tmp_path / "new" / "deeper")]) == 0
+    assert main(["dr", "default", "--out", str(tmp_path)]) == 0
+    assert main(["certify", "default", "--traj", "t", "--json", str(tmp_path / "old.json")]) == 0
+    assert len(seen) == 3
+
+
+# --- exceptions to exit codes, in one place (cfmpa.errors) ---------------------------------------
+
+@pytest.mark.parametrize("exc, code, said", [
+    (lambda: __import__("cfmpa.errors").errors.InputError("--n", 5, "is bad"), 2,
+     "error: --n is bad, got 5"),
+    (lambda: __import__("cfmpa.errors").errors.ContractViolation("T", "post.x: broke"), 1,
+     "error: T: post.x: broke"),
+    (lambda: OSError(28, "No space left on device", "/full/x"), 2,
+     "/full/x: error: No space left on device"),
+    (lambda: KeyboardInterrupt(), 130, "interrupted"),
+])
+def test_handled_maps_each_error_to_its_exit_code_and_one_line(exc, code, said):
+    import io
+
+    from cfmpa.errors import exit_code, handled
+
+    err = io.StringIO()
+
+    def run() -> int:
+        raise exc()
+    assert handled(run, err) == code and exit_code(exc()) == code
+    assert err.getvalue() == said + "\n"
+
+
+def test_handled_lets_a_bug_keep_its_traceback():
+    from cfmpa.errors import exit_code, handled
+
+    def run() -> int:
+        raise ZeroDivisionError("a bug")
+    assert exit_code(ZeroDivisionError()) is None
+    with pytest.raises(ZeroDivisionError):
+        handled(run)
+
+
+# --- numeric budgets (issue 22.3) ----------------------------------------------------------------
+
+@pytest.fixture
+def rest_traj(tmp_path):
+    """A two-row trajectory of the default workcell at rest: simulate reads it in milliseconds."""
+    p = tmp_path / "traj.csv"
+    p.write_text("t,left1,left2,right1,right2\n0,0.1,0.2,0.3,0.4\n1,0.1,0.2,0.3,0.4\n")
+    return p
+
+
+@pytest.mark.parametrize("extra, said", [
+    (["--samples", "10000000000"], "--samples must be at most 1000000 (the simulated log's "
+                                   "budget), got 10000000000"),
+    (["--period", "1e-12"], "--period must be at least 1e-06"),
+    (["--period", "0.0001", "--tail", "3600"], "--period gives 3.601e+07 samples over 3601 s, "
+                                               "more than the simulated log's budget of 1000000"),
+    (["--lag", "nan"], "--lag must be a finite number, got nan"),
+    (["--noise", "inf"], "--noise must be a finite number"),
+    (["--seed", "-1"], "--seed must be at least 0"),
+])
+def test_simulate_over_budget_is_exit_2_and_writes_nothing(tmp_path, rest_traj, capsys, extra,
+                                                          said):
+    log = tmp_path / "log.csv"
+    assert main(["simulate", "default", "--traj", str(rest_traj), "--out", str(log),
+                 *extra]) == 2
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["traj.csv"]
+
+
+def test_simulate_within_budget_still_writes(tmp_path, rest_traj):
+    # The budget refuses what is over it, not what is at it: a million samples exactly pass
+    # the option's check (the run's own count is the same number).
+    from cfmpa.runs import MAX_LOG_SAMPLES, simulate_log
+    from cfmpa.spec import load_scenario, load_trajectory
+    from cfmpa.scenarios import resolve
+
+    traj = load_trajectory(rest_traj, load_scenario(resolve("default")))
+    assert len(simulate_log(traj, samples=MAX_LOG_SAMPLES)[0]) == MAX_LOG_SAMPLES
+    assert main(["simulate", "default", "--traj", str(rest_traj), "--out",
+                 str(tmp_path / "log.csv"), "--samples", "3"]) == 0
+    assert len((tmp_path / "log.csv").read_text().splitlines()) == 4
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["compare", "--n", "1000000000000"], "--n must be at most 1000000 (the campaign's budget)"),
+    (["compare", "--n", "2", "--workers", "100000"], "--workers must be at most"),
+    (["compare", "--n", "2", "--connect-timeout", "inf"], "--connect-timeout must be a finite"),
+    (["compare", "--n", "2", "--dt", "nan"], "--dt must be a finite number"),
+    (["compare", "--n", "2", "--seed", "-3"], "--seed must be at least 0"),
+])
+def test_compare_over_budget_is_exit_2_and_leaves_no_store(tmp_path, monkeypatch, capsys, argv,
+                                                           said):
+    _no_work(monkeypatch)
+    out = tmp_path / "c"
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_the_campaign_refuses_too_many_workcells_before_its_store(tmp_path):
+    # The run's own budget, for a caller that is not the command line.
+    from cfmpa.errors import InputError
+    from cfmpa.runs import MAX_WORKCELLS, run_campaign
+
+    with pytest.raises(InputError, match="--n must be at most"):
+        run_campaign(MAX_WORKCELLS + 1, out=tmp_path / "c")
+    assert not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["plan", "default", "--out", "{tmp}", "--sample", str(2**60)], "--sample must be at most"),
+    (["plan", "default", "--out", "{tmp}", "--seed", str(2**64)], "--seed must be at most"),
+    (["check", "--batch", "{tmp}", "--workers", "100000"], "--workers must be at most"),
+    (["prove", "--out", "{tmp}", "--workers", "100000"], "--workers must be at most"),
+    (["audit", "--out", "{tmp}", "--compare-n", str(10**9)], "--compare-n must be at most"),
+])
+def test_every_other_numeric_option_has_a_budget(tmp_path, monkeypatch, capsys, argv, said):
+    _no_work(monkeypatch)
+    assert main([a.format(tmp=tmp_path / "o") for a in argv]) == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_every_numeric_option_is_budgeted():
+    # Every option parsed as a number (int, float or the whole-number type) is recorded with a
+    # Budget: a new numeric option without one fails here.
+    import argparse
+
+    from cfmpa._arguments import Budget
+    from cfmpa.cli import _parser
+
+    sub = next(a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction))
+    unbudgeted = []
+    for name, p in sub.choices.items():
+        checked = {(dest, option) for dest, option, check in p.get_default("_checks") or ()
+                   if isinstance(check, Budget)}
+        for a in p._actions:
+            if a.type in (int, float) or getattr(a.type, "__name__", "") == "positive":
+                if (a.dest, a.option_strings[0]) not in checked:
+                    unbudgeted.append(f"{name} {a.option_strings[0]}")
+    assert unbudgeted == []
+
+
+# --- help for users (issue 22.9) -----------------------------------------------------------------
+
+def _subparsers():
+    import argparse
+
+    from cfmpa.cli import _parser
+
+    p = _parser()
+    sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction))
+    return p, sub
+
+
+def test_the_top_help_says_what_the_tool_does_a_first_command_and_the_exit_codes(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["--help"])
+    assert info.value.code == 0
+    text = capsys.readouterr().out
+    assert "The command line" not in text and "main(argv)" not in text   # not the developer's
+    assert "cfmpa plans the subordinate arm's collision-free motion" in text
+    assert "cfmpa plan default --out plan" in text
+    codes = text[text.index("exit codes:"):]
+    for code, words in ((0, "success"), (1, "a check failed"), (2, "bad input"),
+                        (130, "interrupted")):
+        assert re.search(rf"^  {code} +{words}", codes, re.M), (code, codes)
+
+
+def test_every_subcommand_has_a_one_line_description_and_an_example_that_parses():
+    p, sub = _subparsers()
+    listed = {a.dest: a.help for a in sub._choices_actions}
+    assert set(listed) == set(sub.choices)
+    for name, sp in sub.choices.items():
+        assert listed[name] and "\n" not in listed[name], name
+        assert sp.description and sp.description.rstrip(".").lower() == listed[name].lower()
+        assert sp.epilog and sp.epilog.startswith("example:\n  cfmpa " + name), name
+        example = sp.epilog.splitlines()[1].split()[1:]
+        args = p.parse_args(example)             # the example is a command line the parser takes
+        assert args.command == name and args.func is sp.get_default("func")
+
+
+def test_a_batch_folder_that_cannot_take_its_summary_is_refused_before_any_check(
+        tmp_path, monkeypatch, capsys):
+    # Without --json the summary is written into DIR: a DIR this user may not write is exit 2
+    # before a plan is checked; with --json elsewhere the same DIR is only read.
+    import os
+
+    import cfmpa.runs
+
+    _no_work(monkeypatch)
+    locked = tmp_path / "plans"
+    locked.mkdir()
+    real = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode, **kw: (
+        False if Path(p) == locked and mode & os.W_OK else real(p, mode, **kw)))
+    assert main(["check", "--batch", str(locked), "--workers", "0"]) == 2
+    assert "error: --batch cannot be written" in capsys.readouterr().err
+    monkeypatch.setattr(cfmpa.runs, "run_batch", lambda *a, **kw: 0)
+    assert main(["check", "--batch", str(locked), "--workers", "0", "--json",
+                 str(tmp_path / "summary.json")]) == 0
+
+
+def test_a_budget_checks_each_value_of_a_repeated_option():
+    from cfmpa._arguments import Budget
+    from cfmpa.errors import InputError
+
+    b = Budget(0, 10, "why")
+    b("--x", [1.0, 10.0])
+    with pytest.raises(InputError, match=r"--x must be at most 10 \(why\), got 11.0"):
+        b("--x", [1.0, 11.0])
+    with pytest.raises(InputError, match="--x must be a finite number"):
+        b("--x", (float("nan"),))
+
+
+# --- every run_* prints on the streams it is given ------------------------------------------------
+
+def test_the_commands_runs_print_on_the_streams_they_are_given(tiny_file, tmp_path, capsys):
+    import io
+
+    from cfmpa.runs import run_check, run_dr, run_plan, run_scenarios
+
+    out, err = io.StringIO(), io.StringIO()
+    assert run_dr(tiny_file, "tight", tmp_path / "d", kernel="reference", stdout=out) == 0
+    assert "variant   tight (reference kernel)" in out.getvalue()
+    assert run_plan(tiny_file, "modified", tmp_path / "p", contracts="off", stdout=out,
+                    stderr=err) == 0
+    assert "contracts off:" in out.getvalue() and err.getvalue() == ""
+    assert run_check(tiny_file, tmp_path / "p" / "dr.npy", tmp_path / "p" / "plan.json",
+                     stdout=out) == 0
+    assert "result: all checks hold" in out.getvalue()
+    assert run_scenarios(stdout=out) == 0 and "bundled scenarios in" in out.getvalue()
+    assert capsys.readouterr() == ("", "")        # nothing went to the process's own streams

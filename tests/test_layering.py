@@ -32,8 +32,11 @@ ALLOWED = {
 }
 LEAVES = {"cfmpa", "cfmpa.errors", "cfmpa.files", "cfmpa.gitstate", "cfmpa.scenarios"}
 #: Libraries a module may not import, by module name prefix: the report presents what runs/
-#: computed (the campaign's engine is runs/_engine.py's), so it has no dask of its own.
-FORBIDDEN = {"cfmpa.report": {"dask", "distributed"}}
+#: computed (the campaign's engine is runs/_engine.py's), so it has no dask of its own; the
+#: command line parses and prints, so it starts no process (prove --audit's fork is
+#: report/_prove_audit.py's).
+FORBIDDEN = {"cfmpa.report": {"dask", "distributed"}, "cfmpa.cli": {"multiprocessing"},
+             "cfmpa._arguments": {"multiprocessing"}}
 
 
 def _modules() -> list[tuple[str, str, Path]]:
@@ -150,3 +153,27 @@ def test_the_rule_lets_a_public_import_through():
         assert _problems("cfmpa.impl", "cfmpa.impl._planted_for_test", planted) == []
     finally:
         planted.unlink()
+
+
+@pytest.mark.parametrize("planted", ["import multiprocessing\n",
+                                     "    from multiprocessing import get_context\n",
+                                     "    import multiprocessing.pool\n"])
+def test_the_cli_may_not_import_multiprocessing(planted: str):
+    # A copy of the real cli.py with the import planted in main's body (or at the top): the
+    # rule names it; the real file passes.
+    real = ROOT / "cfmpa" / "cli.py"
+    source = real.read_text()
+    if planted.startswith(" "):
+        at = source.index("    parser = _parser()\n")
+        source = source[:at] + planted + source[at:]
+    else:
+        source = planted + source
+    copy = ROOT / "cfmpa" / "_planted_for_test.py"
+    copy.write_text(source)
+    try:
+        problems = _forbidden("cfmpa", "cfmpa.cli", copy)
+    finally:
+        copy.unlink()
+    assert any("cfmpa.cli may not import multiprocessing" in p for p in problems), problems
+    assert _forbidden("cfmpa", "cfmpa.cli", real) == []
+    assert _forbidden("cfmpa", "cfmpa._arguments", ROOT / "cfmpa" / "_arguments.py") == []

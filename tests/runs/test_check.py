@@ -10,11 +10,17 @@ import numpy as np
 import pytest
 
 import factory
+from cfmpa.errors import handled
 from cfmpa.runs._check import check_outputs, read_plan, run_check
 from cfmpa.runs._plan import plan, write_plan
 from cfmpa.runs._selftest import FAULTS, WORKCELLS
 from cfmpa.spec import load_scenario, make_grid
 from cfmpa.spec._paths import J1, J2
+
+
+def checked(*args, **kw) -> int:
+    """run_check's exit code as the CLI gives it: bad input (InputError) is exit 2 there."""
+    return handled(lambda: run_check(*args, **kw))
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +45,7 @@ def _run(outputs: Path, tmp_path: Path, capsys, *, dr=None, doc=None, text=None)
     if doc is not None or text is not None:
         plan_path = tmp_path / "plan.json"
         plan_path.write_text(text if text is not None else json.dumps(doc))
-    code = run_check(outputs / "small.toml", dr_path, plan_path)
+    code = checked(outputs / "small.toml", dr_path, plan_path)
     out, err = capsys.readouterr()
     assert "Traceback" not in out + err
     return code, out, err
@@ -182,7 +188,7 @@ def test_a_contact_fails_the_certificate(outputs, tmp_path, capsys):
     p = plan(s, fault.variant, contracts="off", stop=False,
              search=fault.make(s, fault.variant, make_grid(s)).search)
     write_plan(p, tmp_path / "out")
-    code = run_check(tmp_path / "early.toml", tmp_path / "out" / "dr.npy",
+    code = checked(tmp_path / "early.toml", tmp_path / "out" / "dr.npy",
                      tmp_path / "out" / "plan.json")
     out = capsys.readouterr().out
     assert code == 1
@@ -205,7 +211,7 @@ def test_unreadable_input_exits_2_naming_the_file(outputs, tmp_path, capsys, wha
     paths[spec[0]] = spec[1]
     if len(spec) == 3:
         spec[1].write_text(spec[2])
-    code = run_check(outputs / "small.toml", paths["dr"], paths["plan"])
+    code = checked(outputs / "small.toml", paths["dr"], paths["plan"])
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and "Traceback" not in err
     assert err.startswith(f"{spec[1]}") and message in err
@@ -227,7 +233,7 @@ def test_wrong_keys_exit_2(outputs, tmp_path, capsys, change, field):
 
 
 def test_a_bad_scenario_exits_2(outputs, tmp_path, capsys):
-    code = run_check(tmp_path / "none.toml", outputs / "ref" / "dr.npy",
+    code = checked(tmp_path / "none.toml", outputs / "ref" / "dr.npy",
                      outputs / "ref" / "plan.json")
     assert code == 2 and "cannot be read" in capsys.readouterr().err
 
@@ -275,7 +281,7 @@ def witnessed(outputs):
 
 
 def _run_witnessed(outputs, witnessed, capsys, witness=None):
-    code = run_check(outputs / "small.toml", witnessed / "dr.npy", witnessed / "plan.json",
+    code = checked(outputs / "small.toml", witnessed / "dr.npy", witnessed / "plan.json",
                      witness if witness is not None else witnessed / "witness.npz")
     out, err = capsys.readouterr()
     assert "Traceback" not in out + err
