@@ -39,13 +39,14 @@ from . import _figures as F
 from ._compare import campaign_json, format_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
-from ._obligations import ProofData, load_proofs, load_selftest, read_results, summary_table
+from ._obligations import (ProofData, card_groups, load_proofs, load_selftest, read_results,
+                           summary_table)
 from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
            "render_html", "run_audit", "write_report", "default_scenarios_dir",
            "MONITOR_SCENARIO", "MONITOR_SIMULATION", "MONITOR_EXCURSION", "tube_problems",
-           "monitor_problems"]
+           "monitor_problems", "workcell_summary"]
 
 #: report.json's format name and version (bump the version when a key changes meaning).
 FORMAT = {"name": "cfmpa-audit-report", "version": 1}
@@ -161,6 +162,8 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     _relate(doc["findings"], proofs)
     doc["triples"] = _triples(plans)
     doc["verdict"] = _verdict(doc)
+    # Section 1 (first on the page): computed last, from the parts above.
+    doc = {"format": doc["format"], "summary": workcell_summary(loaded, doc), **doc}
     return AuditResult(doc=doc, figures=figures)
 
 
@@ -171,8 +174,11 @@ def render_html(result: AuditResult) -> str:
                              lstrip_blocks=True, keep_trailing_newline=True)
     env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, anchor=_anchor)
     text = resources.files("cfmpa.report").joinpath("template.html").read_text(encoding="utf-8")
-    return env.from_string(text).render(doc=result.doc, figures=result.figures,
-                                        columns=result.doc["obligations"]["summary"]["columns"])
+    ob = result.doc["obligations"]
+    by_id = {r["id"]: r for r in ob["items"]}
+    cards = [{**g, "rows": [by_id[i] for i in g["ids"]]} for g in ob["cards"]]
+    return env.from_string(text).render(doc=result.doc, figures=result.figures, cards=cards,
+                                        columns=ob["summary"]["columns"])
 
 
 def _proof_sections(proofs: ProofData) -> dict[str, Any]:
@@ -181,6 +187,7 @@ def _proof_sections(proofs: ProofData) -> dict[str, Any]:
         "obligations": {
             "available": proofs.available, "source": proofs.source, "note": proofs.note,
             "summary": summary_table(proofs.rows),
+            "cards": card_groups(proofs.rows),
             "items": [r.as_json() for r in proofs.rows],
             "missing_ids": list(proofs.missing_ids), "unexpected_ids": list(proofs.unexpected_ids),
             "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
@@ -198,6 +205,99 @@ def _relate(findings: list[dict[str, Any]], proofs: ProofData) -> None:
     for f in findings:
         f["related_obligations"] = [{"id": r.id, "verdict": r.verdict} for r in proofs.rows
                                     if any(r.id.startswith(pre) for pre in f["related"])]
+
+
+# --- Section 1: the verdict per workcell -------------------------------------------------------
+
+#: What a row's verdict rests on, by ledger id prefix (docs/model.md §6.3, §10): a found plan's
+#: safety is the certificate's (§7.2) and the end-to-end theorem's, whose scope (A11) is A1's
+#: model, A2, A3 and A4; A5 (the while-language models) is not needed where cfmpa prove checked
+#: the compiled code's output for that workcell and variant (translation validation, §7.4).
+#: "No path" rests on the cells' float decisions (A2) and on the search's contract (A6) unless a
+#: witness was checked (the contracts' post.optimal, or the translation check).
+_SAFETY_ASSUMPTIONS = ("A1", "A2", "A3", "A4", "A11")
+_NO_PATH_ASSUMPTIONS = ("A1", "A2")
+
+
+def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Section 1: a row per (workcell, variant) with its status, the proved clearance (the
+    certificate's lower bound, mm; None unless clear), the least sampled clearance (mm, an upper
+    bound on the true minimum), the tolerance in rad, degrees and mm at the tool tip (delta
+    times L, the largest R_base + R_elbow: the most a deviation of delta in every joint moves a
+    link point), the ledger ids it rests on, its verdict and why.
+
+    ``ok`` is True for a found plan certified clear with no contract violation and none of its
+    obligations (the Safety.* of its variant, Tolerance.tube, its workcell's checks) other than
+    expected; False for a plan not certified clear, a violation or such an obligation; None for
+    "no path" (nothing moves, so nothing is claimed safe)."""
+    from ..proofs import ASSUMPTIONS
+
+    ledger = {a.id.split(".")[0]: a.id for a in ASSUMPTIONS}
+    ob = doc["obligations"]
+    verdicts = {i["id"]: i for i in ob["items"]} if ob["available"] else {}
+    rows = []
+    for s, entry in zip(loaded, doc["scenarios"]):
+        stem = Path(s.source).stem
+        reach = tube_lipschitz(s)
+        for v in entry["variants"]:
+            name = v["variant"]
+            related = [i for k, i in verdicts.items()
+                       if k.startswith((f"Safety.{name}.", f"Scenario.{stem}."))
+                       or k in ("Safety.subordinate_in_cell_box", "Safety.region_soundness",
+                                "Safety.separation", "Tolerance.tube")]
+            related = [i for i in related if not i["id"].startswith(f"Scenario.{stem}.translation_")
+                       or i["id"].endswith(f"_{name}")]
+            wrong = [i["id"] for i in related if not i["as_expected"]]
+            translated = verdicts.get(f"Scenario.{stem}.translation_{name}", {}).get(
+                "verdict") == "proved"
+            cl = v["clearance"]
+            violations = (v["contracts"] or {}).get("violations") or []
+            tol = v.get("tolerance_rad")
+            needs: tuple[str, ...] = ()
+            if v["status"] == "found" and cl and cl["clear"] and not violations:
+                ok, needs = (not wrong), _SAFETY_ASSUMPTIONS + (() if translated else ("A5",))
+                why = ["certified clear in continuous time",
+                       f"contracts held ({(v['contracts'] or {}).get('mode', 'not recorded')})"]
+            elif v["status"] == "found":
+                ok = False
+                why = ["not certified clear" if not (cl and cl["clear"]) else
+                       "certified clear", f"{len(violations)} contract violation(s)"]
+            elif v["status"] == "no_path":
+                ok = None if not violations else False
+                witnessed = translated or _held(v["contracts"], "post.optimal")
+                needs = _NO_PATH_ASSUMPTIONS + (() if translated else ("A5",)) + (
+                    () if witnessed else ("A6",))
+                why = [f"no path ({v['reason']})" if v["reason"] else "no path",
+                       "its absence checked by a witness" if witnessed else
+                       "its absence taken from the search's contract"]
+            else:
+                ok, why = False, [f"the plan stopped: {v['reason']}"]
+            if ob["available"] and related:
+                why.append(f"{len(related) - len(wrong)} of {len(related)} of its obligations "
+                           "as expected" + (f" (not: {', '.join(wrong)})" if wrong else ""))
+            else:
+                why.append("its obligations not in this run's proof data")
+            found = v["status"] == "found" and tol is not None
+            rows.append({
+                "scenario": entry["name"], "variant": name, "status": v["status"],
+                "lower_bound_mm": 1000 * cl["lower_bound_m"] if cl and cl["clear"] else None,
+                "min_mm": 1000 * cl["min_m"] if cl else None,
+                "tolerance_rad": tol if found else None,
+                "tolerance_deg": math.degrees(tol) if found else None,
+                "tolerance_tip_mm": 1000 * reach * tol if found else None,
+                "reach_m_per_rad": reach,
+                "assumptions": [ledger[a] for a in needs if a in ledger],
+                "ok": ok, "verdict": {True: "safe", False: "FAILED", None: "no plan"}[ok],
+                "why": "; ".join(why),
+            })
+    return rows
+
+
+def _held(contracts: Mapping[str, Any] | None, condition: str) -> bool:
+    """Whether a plan's contract record checked ``condition`` and it held."""
+    checks = [c for tr in (contracts or {}).get("triples", []) for c in tr["checks"]
+              if c["condition"] == condition]
+    return bool(checks) and all(c["ok"] is True for c in checks)
 
 
 # --- plans ----------------------------------------------------------------------------------------
