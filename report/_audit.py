@@ -172,7 +172,7 @@ def render_html(result: AuditResult) -> str:
     env = jinja2.Environment(autoescape=jinja2.select_autoescape(["html"], default=True),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True)
-    env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, anchor=_anchor)
+    env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, s3=_s3, anchor=_anchor)
     text = resources.files("cfmpa.report").joinpath("template.html").read_text(encoding="utf-8")
     ob = result.doc["obligations"]
     by_id = {r["id"]: r for r in ob["items"]}
@@ -870,6 +870,11 @@ def _mm(x: Any, digits: int = 2) -> str:
 
 def _secs(x: Any) -> str:
     return "–" if x is None else f"{x:.3f} s"
+
+
+def _s3(x: Any) -> str:
+    """Seconds under a heading that says "(s)"."""
+    return "–" if x is None else f"{x:.3f}"
 
 
 def _anchor(name: str) -> str:

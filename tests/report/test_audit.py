@@ -200,10 +200,24 @@ def test_summary_counts_match_the_obligations(report):
 def test_scenario_section_reports_each_variant(report):
     (s,) = report["doc"]["scenarios"]
     assert [v["variant"] for v in s["variants"]] == ["original", "modified", "tight"]
+    html = report["html"]
+    table = html[html.index("<h4>Results per variant</h4>"):]
+    table = table[:table.index("</table>")]
+    heads = re.findall(r"<th[^>]*>([^<]*)</th>", table)
+    # The proved bound before the sampled minimum; no two columns under one heading.
+    assert heads.index("proved clearance (certificate's lower bound)") < heads.index(
+        "sampled minimum (upper bound)")
+    assert "certificate verdict" in heads and "certificate time (s)" in heads
+    assert len(heads) == len(set(heads)), heads
     for v in s["variants"]:
         if v["status"] == "found":
             assert v["J1"] is not None and v["clearance"]["clear"] is True
-            assert f'{1000 * v["clearance"]["min_m"]:.2f} mm' in report["html"]
+            row = table[table.index(f"<tr><td>{v['variant']}</td>"):]
+            row = row[:row.index("</tr>")]
+            bound = f'≥ {1000 * v["clearance"]["lower_bound_m"]:.2f} mm'
+            sampled = f'{1000 * v["clearance"]["min_m"]:.2f} mm'
+            assert bound in row and sampled in row
+            assert row.index(bound) < row.rindex(sampled)
     assert {f["id"].rsplit("-", 1)[1] for f in s["figures"]} == {"workcell", "cspace", "variants",
                                                                 "clearance"}
 
