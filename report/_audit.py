@@ -16,14 +16,16 @@ given, else a fresh run).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import io
 import math
-from collections.abc import Callable, Mapping, Sequence
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import jinja2
 import numpy as np
@@ -75,6 +77,29 @@ class AuditResult:
     figures: dict[str, F.Figure]
 
 
+class _Progress:
+    """A line per finished stage with its wall-clock time, on the stream given (None: silent).
+    Lines are written when a stage ends, so a nested stage (a plan) comes before its caller's."""
+
+    def __init__(self, stream: TextIO | None) -> None:
+        self.stream = stream
+        self.start = time.perf_counter()
+
+    @contextlib.contextmanager
+    def stage(self, label: str) -> Iterator[None]:
+        t0 = time.perf_counter()
+        yield
+        self._line(label, time.perf_counter() - t0)
+
+    def total(self) -> None:
+        self._line("audit, in all", time.perf_counter() - self.start)
+
+    def _line(self, label: str, seconds: float) -> None:
+        if self.stream is not None:
+            self.stream.write(f"audit: {label:<52} {seconds:7.1f} s\n")
+            self.stream.flush()
+
+
 def default_scenarios_dir() -> Path:
     """The bundled scenarios (the checkout's scenarios/, or the installed package's)."""
     return BUNDLED_DIR
@@ -85,7 +110,7 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
               scenarios_dir: str | None = None,
               contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
               compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
-              campaign: str | Path | None = None) -> int:
+              campaign: str | Path | None = None, progress: TextIO | None = None) -> int:
     """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
 
     ``scenarios``: scenario files (None: every scenarios/*.toml). ``proofs_json``: a results.json
@@ -94,12 +119,16 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
     either way), 2 for bad input. ``expected_ids``: the obligation ids the report must find
     (None: every obligation of the prove machinery). ``campaign``: a folder written by
     ``cfmpa compare --out``, whose recorded campaign the report shows instead of running one.
+    ``progress``: where to write a line per stage with its time (``cfmpa audit``: stderr).
     """
+    stages = _Progress(progress)
     result = build_audit(scenarios, argv=argv, proofs_json=proofs_json,
                          scenarios_dir=scenarios_dir, contracts=contracts, compare_n=compare_n,
                          compare_seed=compare_seed, expected_ids=expected_ids,
-                         campaign=campaign)
-    html_path, json_path = write_report(result, out_dir)
+                         campaign=campaign, progress=stages)
+    with stages.stage("write report.html and report.json"):
+        html_path, json_path = write_report(result, out_dir)
+    stages.total()
     v = result.doc["verdict"]
     for item in v["items"]:
         state = {True: "ok", False: "FAILED", None: "not available"}[item["ok"]]
@@ -121,9 +150,13 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
               scenarios_dir: str | None = None,
                 contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
                 compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
-                campaign: str | Path | None = None) -> AuditResult:
+                campaign: str | Path | None = None,
+                progress: TextIO | _Progress | None = None) -> AuditResult:
     """Compute everything the report shows (no files written). A callable ``proofs_json`` is
-    called for the results.json path once everything else is computed."""
+    called for the results.json path once everything else is computed. ``progress``: a stream
+    for a line per stage (findings, each plan, each scenario's figures, the monitored run, the
+    campaign, the proofs) with its time."""
+    stages = progress if isinstance(progress, _Progress) else _Progress(progress)
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
     paths = _scenario_paths(scenarios, sdir)
     loaded = [load_scenario(p) for p in paths]          # input errors before any work
@@ -138,21 +171,28 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     recorded = None if campaign is None else load_campaign(campaign)   # input errors first
     if isinstance(proofs_json, (str, Path)):
         read_results(proofs_json)        # unreadable results: said now, not after the plans
-    plans = _Plans(contracts)
+    plans = _Plans(contracts, stages)
     figures: dict[str, F.Figure] = {}
     # The plans, pictures and campaign first: they do not need the proofs, so `cfmpa prove
     # --audit` computes them while the obligations are discharged (``proofs_json`` callable).
-    parts = {
-        "findings": _findings(sdir, loaded, plans, figures),
-        "selftest": load_selftest(),
-        "scenarios": [_scenario_entry(s, plans, figures) for s in loaded],
-        "monitor": _monitor(sdir, loaded, plans, figures),
-        "compare": _compare(compare_n, compare_seed, figures, recorded, campaign),
-    }
+    with stages.stage("findings (their plans listed above)"):
+        findings = _findings(sdir, loaded, plans, figures)
+    with stages.stage("mutation self-check"):
+        selftest = load_selftest()
+    scenario_parts = [_scenario_entry(s, plans, figures, stages) for s in loaded]
+    with stages.stage("monitored run"):
+        monitor = _monitor(sdir, loaded, plans, figures)
+    with stages.stage("campaign" + (f" (recorded in {campaign})" if recorded is not None else
+                                    f" ({compare_n} workcells)" if compare_n else " (not run)")):
+        compare = _compare(compare_n, compare_seed, figures, recorded, campaign)
+    parts = {"findings": findings, "selftest": selftest, "scenarios": scenario_parts,
+             "monitor": monitor, "compare": compare}
     # The user's workcells are the ones to prove: given files bring their own per-scenario
     # obligations (the bundled set, by default, its pinned ones).
-    proofs = load_proofs(proofs_json() if callable(proofs_json) else proofs_json, sdir,
-                         expected_ids, files=paths if scenarios else None)
+    with stages.stage("proofs (" + ("discharged afresh" if proofs_json is None else
+                                    "read from the prove run") + ")"):
+        proofs = load_proofs(proofs_json() if callable(proofs_json) else proofs_json, sdir,
+                             expected_ids, files=paths if scenarios else None)
     doc = {
         "format": FORMAT,
         "provenance": provenance(argv, loaded),
@@ -305,8 +345,9 @@ def _held(contracts: Mapping[str, Any] | None, condition: str) -> bool:
 class _Plans:
     """Plans by (scenario file, variant), each computed once; a contract violation is kept."""
 
-    def __init__(self, contracts: str) -> None:
+    def __init__(self, contracts: str, progress: _Progress | None = None) -> None:
         self.contracts = contracts
+        self.progress = progress or _Progress(None)
         self._done: dict[tuple[str, str, Variant], Any] = {}
 
     def get(self, s: Scenario, v: Variant) -> Any:
@@ -314,11 +355,12 @@ class _Plans:
         from ..runs import plan
         key = (s.source, s.sha256, v)
         if key not in self._done:
-            try:
-                # stop=False: every failed postcondition is recorded, not only the first.
-                self._done[key] = plan(s, v, contracts=self.contracts, seed=0, stop=False)
-            except CfmpaError as exc:
-                self._done[key] = exc
+            with self.progress.stage(f"plan {s.name}, {v.value}"):
+                try:
+                    # stop=False: every failed postcondition is recorded, not only the first.
+                    self._done[key] = plan(s, v, contracts=self.contracts, seed=0, stop=False)
+                except CfmpaError as exc:
+                    self._done[key] = exc
         return self._done[key]
 
     def all(self) -> list[Any]:
@@ -367,7 +409,8 @@ def _findings(sdir: Path, loaded: Sequence[Scenario], plans: _Plans,
 
 # --- per scenario --------------------------------------------------------------------------------
 
-def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) -> dict[str, Any]:
+def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure],
+                    stages: _Progress | None = None) -> dict[str, Any]:
     from ..runs import plan_json
 
     results = {v: plans.get(s, v) for v in Variant}
@@ -401,9 +444,10 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
     }
     if any_plan is None:
         return entry
-    series = _clearance_series(s, ok)
-    entry["figures"] = _scenario_figures(s, ok, figures, series)
-    entry["tube"] = _tube_entry(s, ok, figures, series)
+    with (stages or _Progress(None)).stage(f"figures and tube of {s.name}"):
+        series = _clearance_series(s, ok)
+        entry["figures"] = _scenario_figures(s, ok, figures, series)
+        entry["tube"] = _tube_entry(s, ok, figures, series)
     return entry
 
 

@@ -76,12 +76,47 @@ def results_json(tmp_path_factory):
 def report(tiny_file, results_json, tmp_path_factory):
     out = tmp_path_factory.mktemp("audit")
     argv = ["cfmpa", "audit", str(tiny_file), "--out", str(out)]
+    progress = io.StringIO()
     result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
-                         compare_n=4, compare_seed=3, expected_ids=EXPECTED)
+                         compare_n=4, compare_seed=3, expected_ids=EXPECTED, progress=progress)
     write_report(result, out)
     doc = json.loads((out / "report.json").read_text())
     html = (out / "report.html").read_text()
-    return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv}
+    return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv,
+            "progress": progress.getvalue()}
+
+
+def test_the_audit_prints_a_line_per_stage_with_its_time(report):
+    lines = report["progress"].splitlines()
+    assert lines and all(re.fullmatch(r"audit: .+ +\d+\.\d s", line) for line in lines), lines
+    labels = [re.sub(r" +\d+\.\d s$", "", line).removeprefix("audit: ").rstrip()
+              for line in lines]
+    name = report["doc"]["scenarios"][0]["name"]
+    for stage in [*(f"plan {name}, {v}" for v in ("original", "modified", "tight")),
+                  f"figures and tube of {name}", "findings (their plans listed above)",
+                  "mutation self-check", "monitored run", "campaign (4 workcells)",
+                  "proofs (read from the prove run)"]:
+        assert labels.count(stage) == 1, (stage, labels)
+    # A plan's line comes before the stage that asked for it; the proofs are read last.
+    assert labels.index(f"plan {name}, modified") < labels.index(f"figures and tube of {name}")
+    assert labels[-1] == "proofs (read from the prove run)"
+
+
+def test_run_audit_adds_the_writing_and_the_total(report, tmp_path, monkeypatch, capsys):
+    import cfmpa.report._audit as audit
+
+    def built(*args, progress, **kw):
+        with progress.stage("plan x, modified"):
+            pass
+        return report["result"]
+    monkeypatch.setattr(audit, "build_audit", built)
+    stream = io.StringIO()
+    assert run_audit(None, str(tmp_path / "a"), progress=stream) == 0
+    labels = [line.split("  ")[0] for line in stream.getvalue().splitlines()]
+    assert labels == ["audit: plan x, modified", "audit: write report.html and report.json",
+                      "audit: audit, in all"]
+    # The progress goes to the stream given, never to stdout (which has the summary).
+    assert "audit: " not in capsys.readouterr().out
 
 
 def test_report_json_validates_against_the_schema(report):
