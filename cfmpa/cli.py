@@ -116,7 +116,7 @@ def cmd_audit(args: argparse.Namespace) -> int:
     files = [str(resolve(a)) for a in args.scenarios] or None
     return run_audit(files, args.out, argv=["cfmpa", *args.argv],
                      proofs_json=args.proofs, compare_n=args.compare_n,
-                     campaign=args.campaign)
+                     campaign=args.campaign, progress=sys.stderr)
 
 
 def cmd_scenarios(args: argparse.Namespace) -> int:

@@ -1,7 +1,8 @@
 """Proof obligations of the paper discharged by Z3, sympy and checks on data (`make prove`).
 
 ``run_prove`` is the command; ``collect_obligations`` and ``run_obligations`` give the report
-the same results as values (``Proof``, ``ProveRun``), and ``ASSUMPTIONS`` is the ledger.
+the same results as values (``Proof``, ``ProveRun``), ``ASSUMPTIONS`` is the ledger, and
+``obligation_summary`` gives each obligation's one plain sentence (the report's cards).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from ._obl_scenario import CHECKS as SCENARIO_CHECKS
 from ._obl_scenario import scenario_check_id, scenario_files, scenario_obligations
 from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proof, VCResult,
                           Verdict, Z3Query, discharge)
+from ._summaries import obligation_summary, summary_problems
 from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
                       collect_obligations, compare_ids, default_workers, expected_ids, is_bundled,
                       pinned_verdict, render_report, run_obligations, run_record, scenarios_note,
@@ -29,7 +31,8 @@ __all__ = [
     "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
     "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
     "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "default_workers",
-    "discharge", "expected_ids", "is_bundled", "pinned_verdict", "render_report",
+    "discharge", "expected_ids", "is_bundled", "obligation_summary", "pinned_verdict",
+    "render_report", "summary_problems",
     "run_obligations", "run_prove", "run_record", "scenarios_note", "selected",
 ]
 

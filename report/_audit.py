@@ -16,14 +16,16 @@ given, else a fresh run).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import io
 import math
-from collections.abc import Callable, Mapping, Sequence
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import jinja2
 import numpy as np
@@ -39,13 +41,14 @@ from . import _figures as F
 from ._compare import campaign_json, format_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
-from ._obligations import ProofData, load_proofs, load_selftest, read_results, summary_table
+from ._obligations import (ProofData, card_groups, load_proofs, load_selftest, read_results,
+                           summary_table)
 from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
            "render_html", "run_audit", "write_report", "default_scenarios_dir",
            "MONITOR_SCENARIO", "MONITOR_SIMULATION", "MONITOR_EXCURSION", "tube_problems",
-           "monitor_problems"]
+           "monitor_problems", "workcell_summary"]
 
 #: report.json's format name and version (bump the version when a key changes meaning).
 FORMAT = {"name": "cfmpa-audit-report", "version": 1}
@@ -74,6 +77,29 @@ class AuditResult:
     figures: dict[str, F.Figure]
 
 
+class _Progress:
+    """A line per finished stage with its wall-clock time, on the stream given (None: silent).
+    Lines are written when a stage ends, so a nested stage (a plan) comes before its caller's."""
+
+    def __init__(self, stream: TextIO | None) -> None:
+        self.stream = stream
+        self.start = time.perf_counter()
+
+    @contextlib.contextmanager
+    def stage(self, label: str) -> Iterator[None]:
+        t0 = time.perf_counter()
+        yield
+        self._line(label, time.perf_counter() - t0)
+
+    def total(self) -> None:
+        self._line("audit, in all", time.perf_counter() - self.start)
+
+    def _line(self, label: str, seconds: float) -> None:
+        if self.stream is not None:
+            self.stream.write(f"audit: {label:<52} {seconds:7.1f} s\n")
+            self.stream.flush()
+
+
 def default_scenarios_dir() -> Path:
     """The bundled scenarios (the checkout's scenarios/, or the installed package's)."""
     return BUNDLED_DIR
@@ -84,7 +110,7 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
               scenarios_dir: str | None = None,
               contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
               compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
-              campaign: str | Path | None = None) -> int:
+              campaign: str | Path | None = None, progress: TextIO | None = None) -> int:
     """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
 
     ``scenarios``: scenario files (None: every scenarios/*.toml). ``proofs_json``: a results.json
@@ -93,12 +119,16 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
     either way), 2 for bad input. ``expected_ids``: the obligation ids the report must find
     (None: every obligation of the prove machinery). ``campaign``: a folder written by
     ``cfmpa compare --out``, whose recorded campaign the report shows instead of running one.
+    ``progress``: where to write a line per stage with its time (``cfmpa audit``: stderr).
     """
+    stages = _Progress(progress)
     result = build_audit(scenarios, argv=argv, proofs_json=proofs_json,
                          scenarios_dir=scenarios_dir, contracts=contracts, compare_n=compare_n,
                          compare_seed=compare_seed, expected_ids=expected_ids,
-                         campaign=campaign)
-    html_path, json_path = write_report(result, out_dir)
+                         campaign=campaign, progress=stages)
+    with stages.stage("write report.html and report.json"):
+        html_path, json_path = write_report(result, out_dir)
+    stages.total()
     v = result.doc["verdict"]
     for item in v["items"]:
         state = {True: "ok", False: "FAILED", None: "not available"}[item["ok"]]
@@ -120,9 +150,13 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
               scenarios_dir: str | None = None,
                 contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
                 compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
-                campaign: str | Path | None = None) -> AuditResult:
+                campaign: str | Path | None = None,
+                progress: TextIO | _Progress | None = None) -> AuditResult:
     """Compute everything the report shows (no files written). A callable ``proofs_json`` is
-    called for the results.json path once everything else is computed."""
+    called for the results.json path once everything else is computed. ``progress``: a stream
+    for a line per stage (findings, each plan, each scenario's figures, the monitored run, the
+    campaign, the proofs) with its time."""
+    stages = progress if isinstance(progress, _Progress) else _Progress(progress)
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
     paths = _scenario_paths(scenarios, sdir)
     loaded = [load_scenario(p) for p in paths]          # input errors before any work
@@ -137,21 +171,28 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     recorded = None if campaign is None else load_campaign(campaign)   # input errors first
     if isinstance(proofs_json, (str, Path)):
         read_results(proofs_json)        # unreadable results: said now, not after the plans
-    plans = _Plans(contracts)
+    plans = _Plans(contracts, stages)
     figures: dict[str, F.Figure] = {}
     # The plans, pictures and campaign first: they do not need the proofs, so `cfmpa prove
     # --audit` computes them while the obligations are discharged (``proofs_json`` callable).
-    parts = {
-        "findings": _findings(sdir, loaded, plans, figures),
-        "selftest": load_selftest(),
-        "scenarios": [_scenario_entry(s, plans, figures) for s in loaded],
-        "monitor": _monitor(sdir, loaded, plans, figures),
-        "compare": _compare(compare_n, compare_seed, figures, recorded, campaign),
-    }
+    with stages.stage("findings (their plans listed above)"):
+        findings = _findings(sdir, loaded, plans, figures)
+    with stages.stage("mutation self-check"):
+        selftest = load_selftest()
+    scenario_parts = [_scenario_entry(s, plans, figures, stages) for s in loaded]
+    with stages.stage("monitored run"):
+        monitor = _monitor(sdir, loaded, plans, figures)
+    with stages.stage("campaign" + (f" (recorded in {campaign})" if recorded is not None else
+                                    f" ({compare_n} workcells)" if compare_n else " (not run)")):
+        compare = _compare(compare_n, compare_seed, figures, recorded, campaign)
+    parts = {"findings": findings, "selftest": selftest, "scenarios": scenario_parts,
+             "monitor": monitor, "compare": compare}
     # The user's workcells are the ones to prove: given files bring their own per-scenario
     # obligations (the bundled set, by default, its pinned ones).
-    proofs = load_proofs(proofs_json() if callable(proofs_json) else proofs_json, sdir,
-                         expected_ids, files=paths if scenarios else None)
+    with stages.stage("proofs (" + ("discharged afresh" if proofs_json is None else
+                                    "read from the prove run") + ")"):
+        proofs = load_proofs(proofs_json() if callable(proofs_json) else proofs_json, sdir,
+                             expected_ids, files=paths if scenarios else None)
     doc = {
         "format": FORMAT,
         "provenance": provenance(argv, loaded),
@@ -161,6 +202,8 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     _relate(doc["findings"], proofs)
     doc["triples"] = _triples(plans)
     doc["verdict"] = _verdict(doc)
+    # Section 1 (first on the page): computed last, from the parts above.
+    doc = {"format": doc["format"], "summary": workcell_summary(loaded, doc), **doc}
     return AuditResult(doc=doc, figures=figures)
 
 
@@ -169,10 +212,13 @@ def render_html(result: AuditResult) -> str:
     env = jinja2.Environment(autoescape=jinja2.select_autoescape(["html"], default=True),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True)
-    env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, anchor=_anchor)
+    env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, s3=_s3, anchor=_anchor)
     text = resources.files("cfmpa.report").joinpath("template.html").read_text(encoding="utf-8")
-    return env.from_string(text).render(doc=result.doc, figures=result.figures,
-                                        columns=result.doc["obligations"]["summary"]["columns"])
+    ob = result.doc["obligations"]
+    by_id = {r["id"]: r for r in ob["items"]}
+    cards = [{**g, "rows": [by_id[i] for i in g["ids"]]} for g in ob["cards"]]
+    return env.from_string(text).render(doc=result.doc, figures=result.figures, cards=cards,
+                                        columns=ob["summary"]["columns"])
 
 
 def _proof_sections(proofs: ProofData) -> dict[str, Any]:
@@ -181,6 +227,7 @@ def _proof_sections(proofs: ProofData) -> dict[str, Any]:
         "obligations": {
             "available": proofs.available, "source": proofs.source, "note": proofs.note,
             "summary": summary_table(proofs.rows),
+            "cards": card_groups(proofs.rows),
             "items": [r.as_json() for r in proofs.rows],
             "missing_ids": list(proofs.missing_ids), "unexpected_ids": list(proofs.unexpected_ids),
             "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
@@ -200,13 +247,107 @@ def _relate(findings: list[dict[str, Any]], proofs: ProofData) -> None:
                                     if any(r.id.startswith(pre) for pre in f["related"])]
 
 
+# --- Section 1: the verdict per workcell -------------------------------------------------------
+
+#: What a row's verdict rests on, by ledger id prefix (docs/model.md §6.3, §10): a found plan's
+#: safety is the certificate's (§7.2) and the end-to-end theorem's, whose scope (A11) is A1's
+#: model, A2, A3 and A4; A5 (the while-language models) is not needed where cfmpa prove checked
+#: the compiled code's output for that workcell and variant (translation validation, §7.4).
+#: "No path" rests on the cells' float decisions (A2) and on the search's contract (A6) unless a
+#: witness was checked (the contracts' post.optimal, or the translation check).
+_SAFETY_ASSUMPTIONS = ("A1", "A2", "A3", "A4", "A11")
+_NO_PATH_ASSUMPTIONS = ("A1", "A2")
+
+
+def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Section 1: a row per (workcell, variant) with its status, the proved clearance (the
+    certificate's lower bound, mm; None unless clear), the least sampled clearance (mm, an upper
+    bound on the true minimum), the tolerance in rad, degrees and mm at the tool tip (delta
+    times L, the largest R_base + R_elbow: the most a deviation of delta in every joint moves a
+    link point), the ledger ids it rests on, its verdict and why.
+
+    ``ok`` is True for a found plan certified clear with no contract violation and none of its
+    obligations (the Safety.* of its variant, Tolerance.tube, its workcell's checks) other than
+    expected; False for a plan not certified clear, a violation or such an obligation; None for
+    "no path" (nothing moves, so nothing is claimed safe)."""
+    from ..proofs import ASSUMPTIONS
+
+    ledger = {a.id.split(".")[0]: a.id for a in ASSUMPTIONS}
+    ob = doc["obligations"]
+    verdicts = {i["id"]: i for i in ob["items"]} if ob["available"] else {}
+    rows = []
+    for s, entry in zip(loaded, doc["scenarios"]):
+        stem = Path(s.source).stem
+        reach = tube_lipschitz(s)
+        for v in entry["variants"]:
+            name = v["variant"]
+            related = [i for k, i in verdicts.items()
+                       if k.startswith((f"Safety.{name}.", f"Scenario.{stem}."))
+                       or k in ("Safety.subordinate_in_cell_box", "Safety.region_soundness",
+                                "Safety.separation", "Tolerance.tube")]
+            related = [i for i in related if not i["id"].startswith(f"Scenario.{stem}.translation_")
+                       or i["id"].endswith(f"_{name}")]
+            wrong = [i["id"] for i in related if not i["as_expected"]]
+            translated = verdicts.get(f"Scenario.{stem}.translation_{name}", {}).get(
+                "verdict") == "proved"
+            cl = v["clearance"]
+            violations = (v["contracts"] or {}).get("violations") or []
+            tol = v.get("tolerance_rad")
+            needs: tuple[str, ...] = ()
+            if v["status"] == "found" and cl and cl["clear"] and not violations:
+                ok, needs = (not wrong), _SAFETY_ASSUMPTIONS + (() if translated else ("A5",))
+                why = ["certified clear in continuous time",
+                       f"contracts held ({(v['contracts'] or {}).get('mode', 'not recorded')})"]
+            elif v["status"] == "found":
+                ok = False
+                why = ["not certified clear" if not (cl and cl["clear"]) else
+                       "certified clear", f"{len(violations)} contract violation(s)"]
+            elif v["status"] == "no_path":
+                ok = None if not violations else False
+                witnessed = translated or _held(v["contracts"], "post.optimal")
+                needs = _NO_PATH_ASSUMPTIONS + (() if translated else ("A5",)) + (
+                    () if witnessed else ("A6",))
+                why = [f"no path ({v['reason']})" if v["reason"] else "no path",
+                       "its absence checked by a witness" if witnessed else
+                       "its absence taken from the search's contract"]
+            else:
+                ok, why = False, [f"the plan stopped: {v['reason']}"]
+            if ob["available"] and related:
+                why.append(f"{len(related) - len(wrong)} of {len(related)} of its obligations "
+                           "as expected" + (f" (not: {', '.join(wrong)})" if wrong else ""))
+            else:
+                why.append("its obligations not in this run's proof data")
+            found = v["status"] == "found" and tol is not None
+            rows.append({
+                "scenario": entry["name"], "variant": name, "status": v["status"],
+                "lower_bound_mm": 1000 * cl["lower_bound_m"] if cl and cl["clear"] else None,
+                "min_mm": 1000 * cl["min_m"] if cl else None,
+                "tolerance_rad": tol if found else None,
+                "tolerance_deg": math.degrees(tol) if found else None,
+                "tolerance_tip_mm": 1000 * reach * tol if found else None,
+                "reach_m_per_rad": reach,
+                "assumptions": [ledger[a] for a in needs if a in ledger],
+                "ok": ok, "verdict": {True: "safe", False: "FAILED", None: "no plan"}[ok],
+                "why": "; ".join(why),
+            })
+    return rows
+
+
+def _held(contracts: Mapping[str, Any] | None, condition: str) -> bool:
+    """Whether a plan's contract record checked ``condition`` and it held."""
+    checks = [c for tr in (contracts or {}).get("triples", []) for c in tr["checks"]
+              if c["condition"] == condition]
+    return bool(checks) and all(c["ok"] is True for c in checks)
+
+
 # --- plans ----------------------------------------------------------------------------------------
 
 class _Plans:
     """Plans by (scenario file, variant), each computed once; a contract violation is kept."""
 
-    def __init__(self, contracts: str) -> None:
+    def __init__(self, contracts: str, progress: _Progress | None = None) -> None:
         self.contracts = contracts
+        self.progress = progress or _Progress(None)
         self._done: dict[tuple[str, str, Variant], Any] = {}
 
     def get(self, s: Scenario, v: Variant) -> Any:
@@ -214,11 +355,12 @@ class _Plans:
         from ..runs import plan
         key = (s.source, s.sha256, v)
         if key not in self._done:
-            try:
-                # stop=False: every failed postcondition is recorded, not only the first.
-                self._done[key] = plan(s, v, contracts=self.contracts, seed=0, stop=False)
-            except CfmpaError as exc:
-                self._done[key] = exc
+            with self.progress.stage(f"plan {s.name}, {v.value}"):
+                try:
+                    # stop=False: every failed postcondition is recorded, not only the first.
+                    self._done[key] = plan(s, v, contracts=self.contracts, seed=0, stop=False)
+                except CfmpaError as exc:
+                    self._done[key] = exc
         return self._done[key]
 
     def all(self) -> list[Any]:
@@ -267,7 +409,8 @@ def _findings(sdir: Path, loaded: Sequence[Scenario], plans: _Plans,
 
 # --- per scenario --------------------------------------------------------------------------------
 
-def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) -> dict[str, Any]:
+def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure],
+                    stages: _Progress | None = None) -> dict[str, Any]:
     from ..runs import plan_json
 
     results = {v: plans.get(s, v) for v in Variant}
@@ -301,9 +444,10 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) ->
     }
     if any_plan is None:
         return entry
-    series = _clearance_series(s, ok)
-    entry["figures"] = _scenario_figures(s, ok, figures, series)
-    entry["tube"] = _tube_entry(s, ok, figures, series)
+    with (stages or _Progress(None)).stage(f"figures and tube of {s.name}"):
+        series = _clearance_series(s, ok)
+        entry["figures"] = _scenario_figures(s, ok, figures, series)
+        entry["tube"] = _tube_entry(s, ok, figures, series)
     return entry
 
 
@@ -770,6 +914,11 @@ def _mm(x: Any, digits: int = 2) -> str:
 
 def _secs(x: Any) -> str:
     return "–" if x is None else f"{x:.3f} s"
+
+
+def _s3(x: Any) -> str:
+    """Seconds under a heading that says "(s)"."""
+    return "–" if x is None else f"{x:.3f}"
 
 
 def _anchor(name: str) -> str:

@@ -30,7 +30,9 @@ __all__ = [
     "ObligationRow",
     "ProofData",
     "SUMMARY_COLUMNS",
+    "CARD_GROUPS",
     "audited_ids",
+    "card_groups",
     "check_ids",
     "load_proofs",
     "read_results",
@@ -72,6 +74,7 @@ class ObligationRow:
     solvers: tuple[str, ...] = ()  # the solvers confirming every VC (Z3 obligations)
     label: str = ""                # what the proof does not cover, in a few words
     z3_only: tuple[str, ...] = ()  # "VC: why" for each VC only Z3 confirms
+    summary: str | None = None     # one plain sentence (cfmpa.proofs.obligation_summary)
 
     @property
     def as_expected(self) -> bool:
@@ -84,7 +87,7 @@ class ObligationRow:
                 "seconds": self.seconds, "counterexample": self.counterexample,
                 "reason": self.reason, "sha256": self.sha256, "change": self.change,
                 "depth": self.depth, "solvers": list(self.solvers), "label": self.label,
-                "z3_only": list(self.z3_only)}
+                "z3_only": list(self.z3_only), "summary": self.summary}
 
 
 @dataclass(frozen=True)
@@ -178,6 +181,53 @@ def summary_table(rows: Iterable[ObligationRow]) -> dict[str, Any]:
             "total": total}
 
 
+@dataclass(frozen=True)
+class CardGroup:
+    """A group of obligation cards: what its obligations establish, in a reviewer's words."""
+
+    key: str
+    title: str
+    prefixes: tuple[str, ...]      # id prefixes (up to a dot); () with ``findings``: see below
+    findings: bool = False         # the paper's statements shown false (expected refuted)
+
+
+#: The cards' groups in the order shown, the safety theorem first. An obligation goes to the
+#: first group that takes it: the findings group takes every obligation expected to be refuted,
+#: then the prefixes decide; one no group takes is shown under "other".
+CARD_GROUPS: tuple[CardGroup, ...] = (
+    CardGroup("safety", "The safety theorem: no contact at any instant of the executed motion",
+              ("Safety",)),
+    CardGroup("tolerance", "How far the robot may deviate from its plan", ("Tolerance",)),
+    CardGroup("workcells", "Each workcell meets the theorems' premises, and the code's output "
+              "for it is checked", ("Scenario",)),
+    CardGroup("planner", "The planner computes what the paper claims (Theorems 1-4, "
+              "Properties 1-8, the search's witnesses)", ("Thm1", "Thm2", "Thm3", "Thm4",
+                                                           "Prop1", "Prop2", "Prop3", "Prop4",
+                                                           "Prop5", "Prop6", "Prop7", "Prop8",
+                                                           "Def4", "Witness")),
+    CardGroup("geometry", "The swept regions cover the motion between grid points (geometry)",
+              ("Def1", "Def2", "Def3", "Lemma1", "Lemma2", "Sep", "Margin", "Lemma")),
+    CardGroup("findings", "Statements of the paper shown false, as intended (the findings)",
+              (), findings=True),
+)
+_OTHER = CardGroup("other", "Other obligations", ())
+
+
+def card_groups(rows: Iterable[ObligationRow]) -> list[dict[str, Any]]:
+    """The cards by CARD_GROUPS (only groups with a card), each with its ids in the rows' order
+    and how many are not as expected (a group with one is shown open)."""
+    found: dict[str, list[ObligationRow]] = {}
+    for r in rows:
+        refuted = r.expected == "refuted as expected"
+        group = next((g for g in CARD_GROUPS if g.findings and refuted), None) or next(
+            (g for g in CARD_GROUPS if any(r.id.startswith(p + ".") for p in g.prefixes)),
+            _OTHER)
+        found.setdefault(group.key, []).append(r)
+    return [{"key": g.key, "title": g.title, "ids": [r.id for r in found[g.key]],
+             "not_as_expected": sum(not r.as_expected for r in found[g.key])}
+            for g in (*CARD_GROUPS, _OTHER) if g.key in found]
+
+
 def _column(r: ObligationRow) -> str:
     if r.verdict == "proved":
         return {"z3": "proved_z3", "sympy": "proved_sympy", "data": "checked_data",
@@ -230,6 +280,8 @@ def _from_file(path: Path, expected: Sequence[str], keep: set[str] | None = None
 
 
 def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
+    from ..proofs import obligation_summary
+
     if not isinstance(item, dict) or not isinstance(item.get("id"), str):
         raise InputError(f"obligations[{k}]", item, f"in {path} must be an object with an 'id'")
     verdict = str(item.get("verdict", ""))
@@ -247,7 +299,8 @@ def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
         sha256=str(item.get("sha256", "")), change=item.get("change"),
         depth=item.get("depth") if isinstance(item.get("depth"), str) else None,
         solvers=tuple(str(s) for s in item.get("solvers") or ()),
-        label=str(item.get("label") or ""), z3_only=_z3_only(item.get("vcs")))
+        label=str(item.get("label") or ""), z3_only=_z3_only(item.get("vcs")),
+        summary=obligation_summary(item["id"]))
 
 
 def _z3_only(vcs: Any) -> tuple[str, ...]:
@@ -262,7 +315,7 @@ def _z3_only(vcs: Any) -> tuple[str, ...]:
 # --- a fresh run --------------------------------------------------------------------------------
 
 def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
-    from ..proofs import ASSUMPTIONS, discharge
+    from ..proofs import ASSUMPTIONS, discharge, obligation_summary
 
     rows = []
     for ob in obligations:
@@ -273,7 +326,8 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
             seconds=float(p.seconds), counterexample=p.counterexample, reason=p.reason,
             sha256=p.sha256, depth=p.depth, solvers=p.solvers, label=p.label,
             z3_only=tuple(f"{v.name}: {v.note or 'no second solver confirmed it'}"
-                          for v in p.vcs if v.solvers == ("z3",))))
+                          for v in p.vcs if v.solvers == ("z3",)),
+            summary=obligation_summary(ob.id)))
     missing, unexpected = check_ids([r.id for r in rows], expected)
     return ProofData(available=True, source="a fresh run of the prove machinery for this report",
                      note=f"{len(rows)} obligations discharged in this process, "

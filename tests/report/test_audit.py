@@ -37,10 +37,10 @@ from markupsafe import escape
 
 from cfmpa.files import dumps_json
 from cfmpa.errors import InputError
-from cfmpa.proofs import expected_ids, run_prove
+from cfmpa.proofs import ASSUMPTIONS, expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
-from cfmpa.report._audit import _proof_sections, _verdict, contract_rows
+from cfmpa.report._audit import _proof_sections, _verdict, contract_rows, workcell_summary
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
 from cfmpa.gitstate import MAX_PATHS, git_state
@@ -76,12 +76,47 @@ def results_json(tmp_path_factory):
 def report(tiny_file, results_json, tmp_path_factory):
     out = tmp_path_factory.mktemp("audit")
     argv = ["cfmpa", "audit", str(tiny_file), "--out", str(out)]
+    progress = io.StringIO()
     result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
-                         compare_n=4, compare_seed=3, expected_ids=EXPECTED)
+                         compare_n=4, compare_seed=3, expected_ids=EXPECTED, progress=progress)
     write_report(result, out)
     doc = json.loads((out / "report.json").read_text())
     html = (out / "report.html").read_text()
-    return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv}
+    return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv,
+            "progress": progress.getvalue()}
+
+
+def test_the_audit_prints_a_line_per_stage_with_its_time(report):
+    lines = report["progress"].splitlines()
+    assert lines and all(re.fullmatch(r"audit: .+ +\d+\.\d s", line) for line in lines), lines
+    labels = [re.sub(r" +\d+\.\d s$", "", line).removeprefix("audit: ").rstrip()
+              for line in lines]
+    name = report["doc"]["scenarios"][0]["name"]
+    for stage in [*(f"plan {name}, {v}" for v in ("original", "modified", "tight")),
+                  f"figures and tube of {name}", "findings (their plans listed above)",
+                  "mutation self-check", "monitored run", "campaign (4 workcells)",
+                  "proofs (read from the prove run)"]:
+        assert labels.count(stage) == 1, (stage, labels)
+    # A plan's line comes before the stage that asked for it; the proofs are read last.
+    assert labels.index(f"plan {name}, modified") < labels.index(f"figures and tube of {name}")
+    assert labels[-1] == "proofs (read from the prove run)"
+
+
+def test_run_audit_adds_the_writing_and_the_total(report, tmp_path, monkeypatch, capsys):
+    import cfmpa.report._audit as audit
+
+    def built(*args, progress, **kw):
+        with progress.stage("plan x, modified"):
+            pass
+        return report["result"]
+    monkeypatch.setattr(audit, "build_audit", built)
+    stream = io.StringIO()
+    assert run_audit(None, str(tmp_path / "a"), progress=stream) == 0
+    labels = [line.split("  ")[0] for line in stream.getvalue().splitlines()]
+    assert labels == ["audit: plan x, modified", "audit: write report.html and report.json",
+                      "audit: audit, in all"]
+    # The progress goes to the stream given, never to stdout (which has the summary).
+    assert "audit: " not in capsys.readouterr().out
 
 
 def test_report_json_validates_against_the_schema(report):
@@ -129,7 +164,7 @@ def test_html_has_no_external_url(report):
 
 def test_sections_come_in_the_issue_order(report):
     html = report["html"]
-    marks = ['id="provenance"', 'id="summary"', 'id="obligations"', 'id="assumptions"',
+    marks = ['id="workcells"', 'id="provenance"', 'id="summary"', 'id="obligations"', 'id="assumptions"',
              'id="findings"', 'id="selftest"', 'id="scenarios"', 'id="compare"']
     where = [html.index(m) for m in marks]
     assert where == sorted(where)
@@ -200,12 +235,127 @@ def test_summary_counts_match_the_obligations(report):
 def test_scenario_section_reports_each_variant(report):
     (s,) = report["doc"]["scenarios"]
     assert [v["variant"] for v in s["variants"]] == ["original", "modified", "tight"]
+    html = report["html"]
+    table = html[html.index("<h4>Results per variant</h4>"):]
+    table = table[:table.index("</table>")]
+    heads = re.findall(r"<th[^>]*>([^<]*)</th>", table)
+    # The proved bound before the sampled minimum; no two columns under one heading.
+    assert heads.index("proved clearance (certificate's lower bound)") < heads.index(
+        "sampled minimum (upper bound)")
+    assert "certificate verdict" in heads and "certificate time (s)" in heads
+    assert len(heads) == len(set(heads)), heads
     for v in s["variants"]:
         if v["status"] == "found":
             assert v["J1"] is not None and v["clearance"]["clear"] is True
-            assert f'{1000 * v["clearance"]["min_m"]:.2f} mm' in report["html"]
+            row = table[table.index(f"<tr><td>{v['variant']}</td>"):]
+            row = row[:row.index("</tr>")]
+            bound = f'≥ {1000 * v["clearance"]["lower_bound_m"]:.2f} mm'
+            sampled = f'{1000 * v["clearance"]["min_m"]:.2f} mm'
+            assert bound in row and sampled in row
+            assert row.index(bound) < row.rindex(sampled)
     assert {f["id"].rsplit("-", 1)[1] for f in s["figures"]} == {"workcell", "cspace", "variants",
                                                                 "clearance"}
+
+
+def test_section_one_gives_the_verdict_per_workcell_first(report, tiny_file):
+    doc, html = report["doc"], report["html"]
+    (s,) = doc["scenarios"]
+    rows = doc["summary"]
+    assert [(r["scenario"], r["variant"]) for r in rows] == [
+        (s["name"], v["variant"]) for v in s["variants"]]
+    ledger = {e["id"] for e in doc["assumptions"]["entries"]}
+    for r, v in zip(rows, s["variants"]):
+        assert r["status"] == v["status"]
+        if v["status"] == "found":
+            cl, tol = v["clearance"], v["tolerance_rad"]
+            assert r["ok"] is True and r["verdict"] == "safe", r
+            assert r["lower_bound_mm"] == pytest.approx(1000 * cl["lower_bound_m"], rel=1e-12)
+            assert r["min_mm"] == pytest.approx(1000 * cl["min_m"], rel=1e-12)
+            # The proved bound is below the sampled minimum (a bound, and an upper bound on it).
+            assert 0 < r["lower_bound_mm"] <= r["min_mm"]
+            assert (r["tolerance_rad"], r["tolerance_deg"]) == (tol, pytest.approx(
+                tol * 180 / 3.141592653589793, rel=1e-12))
+            lip = s["tube"]["lipschitz_m_per_rad"]
+            assert r["tolerance_tip_mm"] == pytest.approx(1000 * lip * tol, rel=1e-12)
+            # Each arm may stray by L delta, and 2 L delta stays below the proved clearance.
+            assert 2 * r["tolerance_tip_mm"] < r["lower_bound_mm"]
+            assert {"A1.rectangles", "A11.safety_scope"} <= set(r["assumptions"])
+            # The subset of obligations proved for the fixture has no translation check of it.
+            assert "A5.while_model" in r["assumptions"]
+            assert f"{r['lower_bound_mm']:.2f} mm" in html and f"{r['min_mm']:.2f} mm" in html
+        else:
+            assert r["ok"] is None and r["lower_bound_mm"] is None and r["tolerance_rad"] is None
+        assert r["assumptions"] and set(r["assumptions"]) <= ledger
+        for a in r["assumptions"]:
+            assert f'href="#assumption-{a.replace(".", "-").replace("_", "-").lower()}"' in html
+            assert f'id="assumption-{a.replace(".", "-").replace("_", "-").lower()}"' in html
+    first = html[:html.index('id="provenance"')]
+    assert "1. Verdict per workcell" in first and "sampled minimum" in first
+    assert "proved clearance" in first and "mm at the tool tip" in first
+
+
+def test_section_one_fails_a_plan_whose_proof_or_certificate_fails(report):
+    doc = copy.deepcopy(report["result"].doc)
+    (s,) = doc["scenarios"]
+    found = [k for k, v in enumerate(s["variants"]) if v["status"] == "found"]
+    assert len(found) >= 2
+    # A failed obligation of the workcell's theorem fails that variant's row, not the others'.
+    ob = doc["obligations"]
+    ob["items"].append({"id": f"Safety.{s['variants'][found[0]]['variant']}.composition",
+                        "verdict": "failed", "expected": "proved", "as_expected": False})
+    # A plan whose certificate is not clear: its row fails and shows no proved bound.
+    s["variants"][found[1]]["clearance"] = dict(s["variants"][found[1]]["clearance"], clear=False)
+    loaded = [_scenario_of(report)]
+    rows = workcell_summary(loaded, doc)
+    assert rows[found[0]]["ok"] is False and "Safety." in rows[found[0]]["why"]
+    assert rows[found[1]]["ok"] is False and rows[found[1]]["lower_bound_mm"] is None
+    assert "not certified clear" in rows[found[1]]["why"]
+    again = workcell_summary(loaded, report["result"].doc)
+    assert all(r["ok"] is not False for r in again)
+
+
+def _scenario_of(report):
+    from cfmpa.spec import load_scenario
+    return load_scenario(report["doc"]["provenance"]["scenarios"][0]["path"])
+
+
+def test_obligation_cards_are_plain_grouped_and_collapsed(report):
+    doc, html = report["doc"], report["html"]
+    ob = doc["obligations"]
+    grouped = [i for g in ob["cards"] for i in g["ids"]]
+    assert sorted(grouped) == sorted(i["id"] for i in ob["items"]), "each card in one group"
+    for item in ob["items"]:
+        assert item["summary"] == obligation_summary(item["id"]) and item["summary"]
+        assert str(escape(item["summary"])) in html, item["id"]
+        card = html[html.index(f'id="ob-{item["id"].replace(".", "-").replace("_", "-").lower()}"'):]
+        card = card[:card.index('<div class="obligation"', 10) if '<div class="obligation"' in
+                    card[10:] else len(card)]
+        # The summary comes first; the full statement is folded in a <details> below it.
+        assert card.index(str(escape(item["summary"]))) < card.index("<details")
+        assert card.index("<details") < card.index(str(escape(item["statement"][:40])))
+    keys = [g["key"] for g in ob["cards"]]
+    assert keys == sorted(keys, key=["safety", "tolerance", "workcells", "planner", "geometry",
+                                     "findings", "other"].index)
+    assert "findings" in keys and all(i["expected"] == "refuted as expected" for i in ob["items"]
+                                      if i["id"] in ob["cards"][keys.index("findings")]["ids"])
+    # Everything as expected: every group and card collapsed.
+    assert '<details class="group" id="cards-' in html and " open>" not in html
+
+
+def test_a_failed_obligation_opens_its_group_and_card(report, tmp_path):
+    doc = json.loads(_results(report)["text"])
+    doc["obligations"][0]["verdict"] = "failed"
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
+    failed = doc["obligations"][0]["id"]
+    (group,) = [g for g in audit["obligations"]["cards"] if failed in g["ids"]]
+    assert group["not_as_expected"] == 1
+    assert sum(g["not_as_expected"] for g in audit["obligations"]["cards"]) == 1
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert f'<details class="group" id="cards-{group["key"]}" open>' in text
+    assert text.count(" open>") == 2      # the group and the failed card, nothing else
 
 
 def _record(*checks):

@@ -95,6 +95,8 @@ def test_each_found_plan_has_its_tube_in_json_and_html(report):
     tube = s["tube"]
     assert tube["lipschitz_m_per_rad"] == tube_lipschitz(load_scenario(s["path"]))
     assert [pl["variant"] for pl in tube["plans"]] == [v["variant"] for v in found]
+    text = html[html.index(f'id="tube-{s["name"]}"'):]
+    table = text[text.index("<table>"):text.index("</table>")]
     for v, pl in zip(found, tube["plans"]):
         assert pl["tolerance_rad"] == v["tolerance_rad"] > 0
         assert pl["lower_bound_m"] == v["clearance"]["lower_bound_m"]
@@ -102,8 +104,12 @@ def test_each_found_plan_has_its_tube_in_json_and_html(report):
         # The tolerance is the largest on its 1e-6 grid under the lemma's premise c > 2 L delta.
         assert 0 < pl["lower_bound_m"] - pl["margin_m"] < (
             2 * tube["lipschitz_m_per_rad"] * 1e-6 + 1e-9)
-        assert f"{pl['tolerance_rad']:.6f} rad" in html
-        assert f"{1000 * pl['margin_m']:.2f} mm" in html
+        assert f'<td class="n">{pl["tolerance_rad"]:.6f}</td>' in table
+        assert f"{1000 * pl['margin_m']:.2f} mm" in table
+        assert f"{500 * pl['margin_m']:.2f} mm" in table           # L delta, at the tool tip
+    # The table says what the condition is and why c - 2 L delta is small.
+    assert "The condition is c − 2 L δ &gt; 0, and δ is\nchosen as large as it allows" in text
+    assert "c − 2 L δ (must be &gt; 0)" in table
     assert tube["plans"][1]["same_path_as"] == "modified"
     assert f'id="tube-{s["name"]}"' in html and f'id="{tube["figure"]["id"]}"' in html
     assert report["result"].figures[tube["figure"]["id"]].png[:4] == b"\x89PNG"
