@@ -106,9 +106,10 @@ def _clearance_line(c: Certificate) -> str:
         return (f"clearance clear: proved >= {c.lower_bound_m * 1000:.6g} mm at every instant; "
                 f"{sampled}")
     if c.contact_detail is not None:
+        from .spec import contact_links_text
         d = c.contact_detail
-        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, left link {d.links[0]} and "
-                f"right link {d.links[1]}, {d.segment}; {sampled}")
+        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, "
+                f"{contact_links_text(d.links)}, {d.segment}; {sampled}")
     return (f"clearance NOT CLEAR: {len(c.undecided)} interval(s) neither proved clear nor in "
             f"contact, first {c.undecided[0]} s; {sampled}")
 

@@ -27,7 +27,7 @@ import numpy.typing as npt
 from ..errors import MISSING, InputError
 from ..files import dumps_json, write_bytes_atomic
 from ..spec import (TRAJECTORY_COLUMNS, Certificate, Scenario, Trajectory, certify_trajectory,
-                    csv_column_order, load_scenario, load_trajectory, tolerance_rad,
+                    closest_links, contact_links_text, csv_column_order, load_scenario, load_trajectory, tolerance_rad,
                     trajectory_distances, tube_lipschitz)
 
 __all__ = ["BLOCK_ROWS", "Excursion", "MonitorResult", "certify_json", "log_csv", "monitor_json",
@@ -55,7 +55,7 @@ def certify_json(s: Scenario, traj: Trajectory, cert: Certificate,
     if cert.contact is not None and cert.contact_detail is not None:
         d = cert.contact_detail
         k = d.step
-        contact = {"t_s": d.t_s, "links": list(d.links),
+        contact = {"t_s": d.t_s, "links": list(d.links), "links_text": contact_links_text(d.links),
                    "left_angles_rad": list(d.left_angles_rad),
                    "right_angles_rad": list(d.right_angles_rad),
                    "row": None if k is None else k,
@@ -107,8 +107,8 @@ def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
     elif doc["contact"] is not None:
         c = doc["contact"]
         where = "" if c["line"] is None else f" (line {c['line']})"
-        print(f"clearance NOT CLEAR: contact at t={c['t_s']:.9g} s, left link {c['links'][0]} "
-              f"and right link {c['links'][1]}, {c['segment']}{where}; left angles "
+        print(f"clearance NOT CLEAR: contact at t={c['t_s']:.9g} s, {c['links_text']}, "
+              f"{c['segment']}{where}; left angles "
               f"{c['left_angles_rad']}, right angles {c['right_angles_rad']}", file=sys.stderr)
     else:
         print(f"clearance NOT CLEAR: {len(cert.undecided)} interval(s) neither proved clear nor "
@@ -256,14 +256,14 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
             if res.first is None:
                 k = int(out[0])
                 q = int(np.argmax(dev[k]))
-                a, b = np.unravel_index(int(np.argmin(d[0])), (2, 2))
+                links = closest_links(d[0])
                 res.first = {"t_s": float(t[k]), "line": start + k,
                              "joint": TRAJECTORY_COLUMNS[1 + q],
                              "deviation_rad": float(dev[k, q]),
                              "angles_rad": [float(x) for x in arr[k, 1:]],
                              "in_contact": bool(touching[0]),
                              "distance_m": float(d[0].min()),
-                             "links": [int(a), int(b)]}
+                             "links": list(links), "links_text": contact_links_text(links)}
             res.outside += len(out)
     if res.samples == 0:
         raise InputError("log", MISSING, "has no samples (only a header)", source=source,
@@ -289,6 +289,7 @@ def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
         "first_outside_deviation_rad": None if f is None else f["deviation_rad"],
         "contact": None if f is None else {
             "in_contact": f["in_contact"], "distance_m": f["distance_m"], "links": f["links"],
+            "links_text": f["links_text"],
             "angles_rad": f["angles_rad"],
             "meaning": ("the sampled configuration is in contact" if f["in_contact"] else
                         "not in contact, but outside what the certificate covers")},
@@ -329,7 +330,8 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
           f"({rate:,.0f} samples/s)")
     if res.first is not None:
         f = res.first
-        kind = "IN CONTACT" if f["in_contact"] else "not in contact, outside the certified tube"
+        kind = (f"IN CONTACT ({f['links_text']})" if f["in_contact"] else
+                "not in contact, outside the certified tube")
         print(f"first     outside at t={f['t_s']!r} s (line {f['line']}): {f['joint']} off by "
               f"{f['deviation_rad']:.6g} rad; {kind}", file=sys.stderr)
     doc = monitor_json(s, traj, tol, res, source)

@@ -7,13 +7,14 @@ from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
 from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
 from ._grid import (EPS, Grid, Variant, VariantRule, cell_box, exact_n, exact_tf, joint_points,
                     left_angles, left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
-from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
+from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
+                           contact_links_text, require_clear)
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
 from ._trajectory import (Trajectory, certify_trajectory, csv_column_order, executed_trajectory,
                           load_trajectory, parse_trajectory_csv, parse_trajectory_json,
                           tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
 from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
-from ._kinematics import arm_corners, joints, link_corners
+from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name
 from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                      Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
                      is_opt_path, is_path, is_path_paper, opt_path, path_violations)
@@ -39,6 +40,8 @@ __all__ = [
     "cases", "ceil_of", "floor_of", "if_then", "max_of", "min_of",
     # geometry
     "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
+    # links named 1-based with words, as docs/model.md §2 names them
+    "LINK_WORDS", "closest_links", "contact_links_text", "link_name",
     # paths (docs/model.md §5)
     "Cell", "J1", "J2", "MOVES", "PathViolation", "REASON_GOAL_BLOCKED", "REASON_START_BLOCKED",
     "REASON_UNREACHABLE", "SearchResult", "SearchStatus", "check_search_inputs", "is_opt_path",
