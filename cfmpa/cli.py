@@ -275,7 +275,7 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     from .runs import run_monitor
 
     return run_monitor(resolve(args.scenario), args.traj, args.log, json_out=args.json,
-                       allow_speed=args.allow_speed)
+                       allow_speed=args.allow_speed, max_speed=args.max_speed)
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
@@ -451,6 +451,9 @@ def _parser() -> argparse.ArgumentParser:
     mo.add_argument("--log", required=True, metavar="LOG",
                     help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
     mo.add_argument("--json", default=None, metavar="OUT", help="write the result as JSON")
+    mo.add_argument("--max-speed", default=None, metavar="W[,W2,W3,W4]",
+                    help="the robot's joint speed bound in rad/s, one for all joints or one per "
+                         "joint (default: the scenario's omega; docs/model.md §12)")
     mo.set_defaults(func=cmd_monitor)
 
     si = sub.add_parser("simulate", help="write a simulated measured log of a trajectory")

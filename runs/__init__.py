@@ -33,9 +33,11 @@ from ._engine import (CONNECT_TIMEOUT_S, RETRIES, Engine, ProgressBar, TaskLost,
 from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json,
                          optimality_failures, violation_json)
 from ._plan import CERTIFICATE, PlanResult, plan, plan_json, versions, write_plan
-from ._trajectory_runs import (BLOCK_ROWS, Excursion, MonitorResult, certify_json, log_csv,
-                               monitor_json, monitor_log, parse_excursion, run_certify,
-                               run_monitor, run_simulate, simulate_log)
+from ._trajectory_runs import (AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, BLOCK_ROWS, Excursion,
+                               LISTED_UNOBSERVED, MonitorResult, Unobserved, certify_json,
+                               log_csv, monitor_json, monitor_log, parse_excursion,
+                               parse_max_speed, run_certify, run_monitor, run_simulate,
+                               simulate_log)
 from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
                             code_mutation_rows, code_mutation_table, imports_copy, mutated_copy,
                             run_code_selftest)
@@ -57,6 +59,8 @@ __all__ = [
     "MAX_DT", "STORE_NAME", "Store", "VariantOutcome", "load_campaign", "open_store",
     "plan_workcell", "random_workcell", "read_store", "run_campaign", "workcell_task",
     # any planner's trajectory (docs/model.md §12)
+    "AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "LISTED_UNOBSERVED", "Unobserved",
+    "parse_max_speed",
     "BLOCK_ROWS", "Excursion", "MonitorResult", "certify_json", "log_csv", "monitor_json",
     "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",
     "simulate_log",

@@ -10,7 +10,8 @@ from ._grid import (EPS, Grid, Variant, VariantRule, cell_box, exact_n, exact_tf
 from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
                            contact_links_text, require_clear)
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
-from ._trajectory import (Trajectory, certify_trajectory, csv_column_order, executed_trajectory,
+from ._trajectory import (ReferenceSpeeds, Trajectory, between_samples_bound, certify_trajectory,
+                          csv_column_order, executed_trajectory,
                           load_trajectory, parse_trajectory_csv, parse_trajectory_json,
                           tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
 from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
@@ -62,4 +63,6 @@ __all__ = [
     "TRAJECTORY_COLUMNS", "Trajectory", "certify_trajectory", "csv_column_order",
     "executed_trajectory", "load_trajectory", "parse_trajectory_csv", "parse_trajectory_json",
     "tolerance_rad", "trajectory_csv", "trajectory_distances", "tube_lipschitz",
+    # the monitor between samples (docs/model.md §12; proofs/_obl_monitor.py)
+    "ReferenceSpeeds", "between_samples_bound",
 ]

@@ -108,7 +108,8 @@ class Certificate:
     is THE PROVED figure: a lower bound on the distance between the arms over the whole motion
     (else 0.0). ``min_clearance_m`` / ``t_min_s`` are only the least SAMPLED distance and its
     instant: an upper bound on the true minimum, not a guarantee. ``contact`` is
-    (t, (left link, right link)) for a sampled contact, links numbered 1-based (``closest_links``), and ``contact_detail`` the same with the
+    (t, (left link, right link)) for a sampled contact, links numbered 1-based
+    (``closest_links``), and ``contact_detail`` the same with the
     angles and path segment; ``undecided`` lists the merged (t0, t1) intervals left unproved.
     """
 
