@@ -536,8 +536,9 @@ def parse_excursion(text: str) -> Excursion:
 def simulate_log(traj: Trajectory, *, lag: float = 0.0, noise: float = 0.0, seed: int = 0,
                  excursions: Sequence[Excursion] = (), period: float | None = None,
                  samples: int | None = None, tail: float = 0.0) -> tuple[FloatArray, FloatArray]:
-    """(t, angles): samples from t_0 to t_end + tail, every ``period`` s (default 1 ms) or
-    ``samples`` of them evenly; measured = trajectory(t - lag) + uniform noise in
+    """(t, angles): samples from t_0 to t_end + tail (both included), every ``period`` s
+    (default 1 ms; the last gap shorter when the span is not a multiple) or ``samples`` of them
+    evenly; measured = trajectory(t - lag) + uniform noise in
     [-noise, noise] per joint (seeded), plus the excursions."""
     if lag < 0 or noise < 0 or tail < 0:
         raise InputError("--lag/--noise/--tail", (lag, noise, tail), "must be >= 0")
@@ -551,7 +552,16 @@ def simulate_log(traj: Trajectory, *, lag: float = 0.0, noise: float = 0.0, seed
         p = 0.001 if period is None else period
         if not p > 0:
             raise InputError("--period", p, "must be > 0")
-        t = t0 + p * np.arange(int(math.floor((t1 - t0) / p + 1e-9)) + 1)
+        t = np.minimum(t0 + p * np.arange(int(math.floor((t1 - t0) / p + 1e-9)) + 1), t1)
+        # The last sample at t_end + tail exactly (the grid's last point may fall short of it,
+        # by rounding or by a fraction of a period): a log that stops short is unobserved (§12).
+        if t[-1] < t1:
+            if t1 - t[-1] <= 1e-9 * (t1 - t0):
+                t[-1] = t1
+            else:
+                t = np.append(t, t1)
+    if len(t) > 1:
+        t[-1] = t1
     if len(t) > 1 and not np.all(np.diff(t) > 0):
         raise InputError("--samples", samples, "gives times that do not increase")
     rng = np.random.default_rng(seed)
