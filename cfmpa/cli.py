@@ -149,7 +149,7 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     from .runs import run_monitor
 
     return run_monitor(resolve(args.scenario), args.traj, args.log, json_out=args.json,
-                       allow_speed=args.allow_speed)
+                       allow_speed=args.allow_speed, max_speed=args.max_speed)
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
@@ -342,6 +342,9 @@ def _parser() -> argparse.ArgumentParser:
     opt.trajectory_arguments(mo)
     mo.add_argument("--log", required=True, metavar="LOG",
                     help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
+    mo.add_argument("--max-speed", default=None, metavar="W[,W2,W3,W4]",
+                    help="the robot's joint speed bound in rad/s, one for all joints or one per "
+                         "joint (default: the scenario's omega; docs/model.md §12)")
     opt.json_argument(mo)
 
     si = _command(sub, "simulate", "write a simulated measured log of a trajectory",

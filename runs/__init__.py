@@ -41,10 +41,11 @@ from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_js
 from ._plan import (CERTIFICATE, PlanResult, clearance_line, plan, plan_json, run_dr, run_plan,
                     versions, write_plan)
 from ._bundled import run_scenarios
-from ._trajectory_runs import (BLOCK_ROWS, MAX_LOG_SAMPLES, MIN_PERIOD_S, Excursion,
-                               MonitorResult, certify_json, log_csv,
-                               monitor_json, monitor_log, parse_excursion, run_certify,
-                               run_monitor, run_simulate, simulate_log)
+from ._trajectory_runs import (AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, BLOCK_ROWS, MAX_LOG_SAMPLES,
+                               MIN_PERIOD_S, LISTED_UNOBSERVED, Excursion, MonitorResult,
+                               Unobserved, certify_json, log_csv, monitor_json, monitor_log,
+                               parse_excursion, parse_max_speed, run_certify, run_monitor,
+                               run_simulate, simulate_log)
 from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
                             code_mutation_rows, code_mutation_table, imports_copy, mutated_copy,
                             run_code_selftest)
@@ -69,6 +70,8 @@ __all__ = [
     "open_store",
     "plan_workcell", "random_workcell", "read_store", "run_campaign", "workcell_task",
     # any planner's trajectory (docs/model.md §12)
+    "AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "LISTED_UNOBSERVED", "Unobserved",
+    "parse_max_speed",
     "BLOCK_ROWS", "Excursion", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult",
     "certify_json", "log_csv", "monitor_json",
     "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",

@@ -27,7 +27,7 @@ from ..files import dumps_json, npy_bytes, write_bytes_atomic
 from ..errors import ContractViolation
 from ..impl import build_dr_fast, kernel_name, search_opt_path, search_opt_path_fast
 from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
-from ..spec import Certificate, certificate_json, certify, require_clear
+from ..spec import Certificate, certificate_json, certify, contact_links_text, require_clear
 from ..spec import SearchResult, SearchStatus
 from ..spec import executed_trajectory, tolerance_rad, trajectory_csv
 from ..spec import ExactGaps, exact_path_gaps
@@ -386,7 +386,7 @@ def clearance_line(c: Certificate) -> str:
                 f"{sampled}")
     if c.contact_detail is not None:
         d = c.contact_detail
-        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, left link {d.links[0]} and "
-                f"right link {d.links[1]}, {d.segment}; {sampled}")
+        return (f"clearance NOT CLEAR: contact at t={d.t_s:.4f} s, "
+                f"{contact_links_text(d.links)}, {d.segment}; {sampled}")
     return (f"clearance NOT CLEAR: {len(c.undecided)} interval(s) neither proved clear nor in "
             f"contact, first {c.undecided[0]} s; {sampled}")

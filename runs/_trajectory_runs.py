@@ -26,13 +26,15 @@ import numpy.typing as npt
 
 from ..errors import MISSING, InputError
 from ..files import dumps_json, write_bytes_atomic
-from ..spec import (TRAJECTORY_COLUMNS, Certificate, Scenario, Trajectory, certify_trajectory,
+from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
+                    between_samples_bound, certify_trajectory, closest_links, contact_links_text,
                     csv_column_order, load_scenario, load_trajectory, tolerance_rad,
                     trajectory_distances, tube_lipschitz)
 
-__all__ = ["BLOCK_ROWS", "Excursion", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult",
+__all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
+           "LISTED_UNOBSERVED", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult", "Unobserved",
            "certify_json", "log_csv", "monitor_json", "monitor_log", "parse_excursion",
-           "run_certify", "run_monitor", "run_simulate", "simulate_log"]
+           "parse_max_speed", "run_certify", "run_monitor", "run_simulate", "simulate_log"]
 
 #: The most samples `cfmpa simulate` writes: the log is built in memory (about 0.5 KB a sample
 #: at its peak, a 100 MB CSV), so a count beyond is refused before anything is allocated.
@@ -61,7 +63,7 @@ def certify_json(s: Scenario, traj: Trajectory, cert: Certificate,
     if cert.contact is not None and cert.contact_detail is not None:
         d = cert.contact_detail
         k = d.step
-        contact = {"t_s": d.t_s, "links": list(d.links),
+        contact = {"t_s": d.t_s, "links": list(d.links), "links_text": contact_links_text(d.links),
                    "left_angles_rad": list(d.left_angles_rad),
                    "right_angles_rad": list(d.right_angles_rad),
                    "row": None if k is None else k,
@@ -113,8 +115,8 @@ def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
     elif doc["contact"] is not None:
         c = doc["contact"]
         where = "" if c["line"] is None else f" (line {c['line']})"
-        print(f"clearance NOT CLEAR: contact at t={c['t_s']:.9g} s, left link {c['links'][0]} "
-              f"and right link {c['links'][1]}, {c['segment']}{where}; left angles "
+        print(f"clearance NOT CLEAR: contact at t={c['t_s']:.9g} s, {c['links_text']}, "
+              f"{c['segment']}{where}; left angles "
               f"{c['left_angles_rad']}, right angles {c['right_angles_rad']}", file=sys.stderr)
     else:
         print(f"clearance NOT CLEAR: {len(cert.undecided)} interval(s) neither proved clear nor "
@@ -127,10 +129,35 @@ def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
 
 # --- monitor ----------------------------------------------------------------------------------
 
+#: Unobserved intervals the JSON lists (all are counted and summed).
+LISTED_UNOBSERVED = 20
+#: Why an interval is unobserved, by where it lies.
+BEFORE_LOG = "before the log's first sample"
+BETWEEN_SAMPLES = "between samples, the bound exceeds the tolerance"
+AFTER_LOG = "after the log's last sample"
+
+
+@dataclass(frozen=True)
+class Unobserved:
+    """Time no sample vouches for: [t_s, t_s + length_s]. ``line``: the log line of the sample
+    it starts at (None before the first sample); ``why``: BEFORE_LOG, BETWEEN_SAMPLES or
+    AFTER_LOG, the reason at its start."""
+
+    t_s: float
+    length_s: float
+    line: int | None
+    why: str
+
+    def json(self) -> dict[str, Any]:
+        return {"t_s": self.t_s, "length_s": self.length_s, "line": self.line, "why": self.why}
+
 
 @dataclass
 class MonitorResult:
-    """What the monitor saw: counts and the first sample outside the tube."""
+    """What the monitor saw: counts, the first sample outside the tube, and what the samples
+    vouch for between them (docs/model.md §12): the unobserved intervals (merged; counted,
+    summed, the first LISTED_UNOBSERVED kept and the longest), the covered fraction of the
+    trajectory's time and the largest gap between samples."""
 
     samples: int = 0
     outside: int = 0
@@ -139,11 +166,46 @@ class MonitorResult:
     t_first_s: float | None = None
     t_last_s: float | None = None
     max_deviation_rad: float = 0.0
+    max_gap_s: float = 0.0
+    covered_fraction: float = 0.0
+    unobserved_count: int = 0
+    unobserved_s: float = 0.0
+    unobserved_in_span_s: float = 0.0
+    unobserved: list[Unobserved] = field(default_factory=list)
+    longest_unobserved: Unobserved | None = None
+    max_speed_rad_s: tuple[float, ...] = ()
     timings_s: dict[str, float] = field(default_factory=dict)
 
     @property
     def status(self) -> str:
-        return "inside" if self.outside == 0 else "outside"
+        """``outside`` (a sample outside the tube), else ``unobserved`` (some time no sample
+        vouches for), else ``inside`` (the bound within the tube at every instant)."""
+        if self.outside:
+            return "outside"
+        return "unobserved" if self.unobserved_count else "inside"
+
+    def _record(self, u: Unobserved, span: tuple[float, float]) -> None:
+        self.unobserved_count += 1
+        self.unobserved_s += u.length_s
+        self.unobserved_in_span_s += max(0.0, min(u.t_s + u.length_s, span[1]) -
+                                         max(u.t_s, span[0]))
+        if len(self.unobserved) < LISTED_UNOBSERVED:
+            self.unobserved.append(u)
+        if self.longest_unobserved is None or u.length_s > self.longest_unobserved.length_s:
+            self.longest_unobserved = u
+
+
+@dataclass
+class _Open:
+    """The unobserved interval being extended: from ``start`` to ``end`` so far."""
+
+    start: float
+    end: float
+    line: int | None
+    why: str
+
+    def closed(self) -> Unobserved:
+        return Unobserved(self.start, self.end - self.start, self.line, self.why)
 
 
 def _log_lines(stream: IO[str]) -> Iterator[tuple[int, str]]:
@@ -204,15 +266,62 @@ def _parse_rows(lines: Sequence[str], first_line: int, order: list[int],
     return np.asarray(rows, dtype=float).reshape(-1, len(TRAJECTORY_COLUMNS)), blank
 
 
-def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str], *,
-                source: str = "<log>", block_rows: int = BLOCK_ROWS) -> MonitorResult:
-    """Check every sample of the log against the tube of radius ``tol`` around ``traj``.
+def parse_max_speed(text: str | None, s: Scenario, traj: Trajectory) -> FloatArray:
+    """The robot's joint speed bound (4,) in JOINTS order, rad/s: ``--max-speed`` as one value
+    for all joints or four comma-separated ones; without it the scenario's omega, raised to the
+    trajectory's own top speed on a joint where that is faster (a robot tracking it is)."""
+    if text is None:
+        omega = np.array([*s.left.omega, *s.right.omega], dtype=float)
+        return np.maximum(omega, ReferenceSpeeds.of(traj).top())
+    parts = str(text).split(",")
+    try:
+        vals = [float(x) for x in parts]
+    except ValueError:
+        raise InputError("--max-speed", _cut(text), "must be W or W1,W2,W3,W4 (rad/s, one per "
+                         f"joint {','.join(TRAJECTORY_COLUMNS[1:])})") from None
+    if len(vals) not in (1, 4) or not all(math.isfinite(v) and v >= 0 for v in vals):
+        raise InputError("--max-speed", _cut(text), "must be one or four finite speeds >= 0 "
+                         f"(rad/s, joints {','.join(TRAJECTORY_COLUMNS[1:])})")
+    return np.broadcast_to(np.array(vals, dtype=float), (4,)).copy()
 
-    Times must strictly increase; a sample is inside when each joint is within ``tol`` of the
-    trajectory at its time (at rest before its first and after its last row). Reads
-    ``block_rows`` lines at a time (constant memory); blank lines may only end the log.
+
+def _cut(value: Any) -> str:
+    text = str(value)
+    return text if len(text) <= 80 else text[:80] + "..."
+
+
+def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str], *,
+                source: str = "<log>", block_rows: int = BLOCK_ROWS,
+                max_speed: npt.ArrayLike | None = None) -> MonitorResult:
+    """Check the log against the tube of radius ``tol`` around ``traj``, at every instant.
+
+    At a sample: inside when each joint is within ``tol`` of the trajectory at its time (at
+    rest before its first and after its last row). Between consecutive samples (docs/model.md
+    §12): covered when ``between_samples_bound`` (from both ends' deviations, the gap, the
+    robot's speed bound ``max_speed`` (4,), default ``parse_max_speed(None, ...)``, and the
+    trajectory's speed on the gap) is within ``tol`` for every joint; a gap not covered, and
+    the trajectory's time before the log's first or after its last sample, is unobserved.
+    Times must strictly increase. Reads ``block_rows`` lines at a time (constant memory; the
+    last sample is carried into the next block's first gap); blank lines may only end the log.
     """
     res = MonitorResult()
+    w_robot = (parse_max_speed(None, s, traj) if max_speed is None else
+               np.broadcast_to(np.asarray(max_speed, dtype=float), (4,)).copy())
+    res.max_speed_rad_s = tuple(float(x) for x in w_robot)
+    ref = ReferenceSpeeds.of(traj)
+    span0, span1 = float(traj.t[0]), float(traj.t[-1])
+    span_seen = False                                  # the instant span0 (a zero span)
+    run: _Open | None = None
+
+    def extend(a: float, b: float, line: int | None, why: str) -> None:
+        nonlocal run
+        if run is not None and run.end == a:           # contiguous with the open interval
+            run.end = b
+            return
+        if run is not None:
+            res._record(run.closed(), (span0, span1))
+        run = _Open(a, b, line, why)
+
     it = iter(stream)
     header = next(it, None)
     if header is None or not header.strip():
@@ -222,6 +331,8 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
     order = csv_column_order(header, source)
     no = 1                                            # lines read so far
     prev_t = -math.inf
+    prev_dev: FloatArray | None = None                # the last sample's deviation per joint
+    prev_line = 0
     blank: int | None = None
     while True:
         block = list(itertools.islice(it, block_rows))
@@ -246,14 +357,37 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
             raise InputError("t", float(t[k]), f"must be greater than the previous sample's time "
                              f"{before!r} (times strictly increase)", source=source,
                              line=start + k)
-        prev_t = float(t[-1])
         if res.t_first_s is None:
             res.t_first_s = float(t[0])
-        res.t_last_s = prev_t
+            if t[0] > span0:
+                extend(span0, float(t[0]), None, BEFORE_LOG)
+        res.t_last_s = float(t[-1])
         dev = np.abs(arr[:, 1:] - traj.at(t))
         worst = dev.max(axis=1)
         res.max_deviation_rad = max(res.max_deviation_rad, float(worst.max()))
         out = np.flatnonzero(worst > tol)
+        span_seen = span_seen or bool(np.any((t == span0) & (worst <= tol)))
+        # The gaps: from the previous block's last sample (if any) through this block's.
+        if prev_dev is None:
+            gt, gd, gl = t, dev, np.arange(start, start + len(t))
+        else:
+            gt = np.concatenate([[prev_t], t])
+            gd = np.concatenate([prev_dev[None, :], dev])
+            gl = np.concatenate([[prev_line], np.arange(start, start + len(t))])
+        if len(gt) > 1:
+            a, b = gt[:-1], gt[1:]
+            h = b - a
+            res.max_gap_s = max(res.max_gap_s, float(h.max()))
+            bound = between_samples_bound(gd[:-1], gd[1:], h[:, None], w_robot[None, :],
+                                          ref.over(a, b))
+            ok = np.all(bound <= tol, axis=1)
+            span_seen = span_seen or bool(np.any(ok & (a <= span0) & (span0 <= b)))
+            # Runs of uncovered gaps, each one interval (merged with the open one if they meet).
+            nb = ~ok
+            edges = np.diff(np.concatenate([[False], nb, [False]]).astype(np.int8))
+            for r0, r1 in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+                extend(float(a[r0]), float(b[r1 - 1]), int(gl[r0]), BETWEEN_SAMPLES)
+        prev_t, prev_dev, prev_line = float(t[-1]), dev[-1].copy(), start + len(t) - 1
         res.samples += len(t)
         if len(out):
             d = trajectory_distances(s, arr[out, 1:])            # (K, 2, 2)
@@ -262,18 +396,26 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
             if res.first is None:
                 k = int(out[0])
                 q = int(np.argmax(dev[k]))
-                a, b = np.unravel_index(int(np.argmin(d[0])), (2, 2))
+                links = closest_links(d[0])
                 res.first = {"t_s": float(t[k]), "line": start + k,
                              "joint": TRAJECTORY_COLUMNS[1 + q],
                              "deviation_rad": float(dev[k, q]),
                              "angles_rad": [float(x) for x in arr[k, 1:]],
                              "in_contact": bool(touching[0]),
                              "distance_m": float(d[0].min()),
-                             "links": [int(a), int(b)]}
+                             "links": list(links), "links_text": contact_links_text(links)}
             res.outside += len(out)
     if res.samples == 0:
         raise InputError("log", MISSING, "has no samples (only a header)", source=source,
                          line=no)
+    if prev_t < span1:
+        extend(prev_t, span1, prev_line, AFTER_LOG)
+    if run is not None:
+        res._record(run.closed(), (span0, span1))
+    # The trajectory's time not unobserved is covered (by gaps whose bound is within the tube,
+    # and sample instants); computed from the merged intervals, so blocks do not change it.
+    res.covered_fraction = (max(0.0, 1.0 - res.unobserved_in_span_s / (span1 - span0))
+                            if span1 > span0 else float(span_seen))
     return res
 
 
@@ -295,22 +437,33 @@ def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
         "first_outside_deviation_rad": None if f is None else f["deviation_rad"],
         "contact": None if f is None else {
             "in_contact": f["in_contact"], "distance_m": f["distance_m"], "links": f["links"],
+            "links_text": f["links_text"],
             "angles_rad": f["angles_rad"],
             "meaning": ("the sampled configuration is in contact" if f["in_contact"] else
                         "not in contact, but outside what the certificate covers")},
+        "max_gap_s": res.max_gap_s,
+        "covered_fraction": res.covered_fraction,
+        "max_speed_rad_s": list(res.max_speed_rad_s),
+        "unobserved": None if not res.unobserved_count else {
+            "count": res.unobserved_count, "total_s": res.unobserved_s,
+            "first": res.unobserved[0].json(),
+            "longest": None if res.longest_unobserved is None else res.longest_unobserved.json(),
+            "listed": [u.json() for u in res.unobserved]},
         "timings_s": {k: round(v, 6) for k, v in sorted(res.timings_s.items())},
     }
 
 
 def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str | Path, *,
                 json_out: str | Path | None = None, allow_speed: bool = False,
-                stdin: IO[str] | None = None) -> int:
-    """Monitor a measured log (a file, or ``-`` for standard input) against the certified tube:
-    0 every sample inside, 1 some outside (or the trajectory is not certified clear: no JSON
-    then), 2 bad input (InputError)."""
+                stdin: IO[str] | None = None, max_speed: str | None = None) -> int:
+    """Monitor a measured log (a file, or ``-`` for standard input) against the certified tube
+    at every instant: 0 inside, 1 some sample outside or some time unobserved (or the trajectory
+    is not certified clear: no JSON then), 2 bad input (InputError). ``max_speed``: the
+    robot's joint speed bound as ``--max-speed`` gives it (``parse_max_speed``)."""
     s = _scenario(scenario)
     t0 = time.perf_counter()
     traj = load_trajectory(traj_path, s, allow_speed=allow_speed)
+    w_robot = parse_max_speed(max_speed, s, traj)
     cert = certify_trajectory(s, traj)
     t1 = time.perf_counter()
     c1 = time.process_time()
@@ -321,28 +474,37 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
     tol = tolerance_rad(s, cert)
     source = "<stdin>" if str(log) == "-" else str(log)
     if str(log) == "-":
-        res = monitor_log(s, traj, tol, stdin if stdin is not None else sys.stdin, source=source)
+        res = monitor_log(s, traj, tol, stdin if stdin is not None else sys.stdin, source=source,
+                          max_speed=w_robot)
     else:
         with open(log, encoding="utf-8", newline=None) as fh:
-            res = monitor_log(s, traj, tol, fh, source=source)
+            res = monitor_log(s, traj, tol, fh, source=source, max_speed=w_robot)
     t2 = time.perf_counter()
     # monitor: wall-clock seconds of the stream; monitor_cpu: this process's CPU seconds in it.
     res.timings_s = {"certificate": t1 - t0, "monitor": t2 - t1,
                      "monitor_cpu": time.process_time() - c1}
     rate = res.samples / (t2 - t1) if t2 > t1 else float("inf")
     print(f"monitor   {res.samples} samples of {source} against {traj_path} "
-          f"(tolerance {tol:.6f} rad): {res.status}, {res.outside} outside "
-          f"({rate:,.0f} samples/s)")
+          f"(tolerance {tol:.6f} rad): {res.status}, {res.outside} outside; largest gap "
+          f"{res.max_gap_s:.6g} s, {100 * res.covered_fraction:.4g}% of the trajectory's time "
+          f"covered ({rate:,.0f} samples/s)")
     if res.first is not None:
         f = res.first
-        kind = "IN CONTACT" if f["in_contact"] else "not in contact, outside the certified tube"
+        kind = (f"IN CONTACT ({f['links_text']})" if f["in_contact"] else
+                "not in contact, outside the certified tube")
         print(f"first     outside at t={f['t_s']!r} s (line {f['line']}): {f['joint']} off by "
               f"{f['deviation_rad']:.6g} rad; {kind}", file=sys.stderr)
+    if res.unobserved_count:
+        u = res.unobserved[0]
+        at = "" if u.line is None else f" (line {u.line})"
+        print(f"unobserved {res.unobserved_count} interval(s), {res.unobserved_s:.6g} s in all; "
+              f"first from t={u.t_s!r} s for {u.length_s:.6g} s{at}: {u.why} (no sample vouches "
+              "for the robot then)", file=sys.stderr)
     doc = monitor_json(s, traj, tol, res, source)
     if json_out is not None:
         write_bytes_atomic(json_out, dumps_json(doc).encode())
         print(f"wrote     {json_out}")
-    return 0 if res.outside == 0 else 1
+    return 0 if res.status == "inside" else 1
 
 
 # --- simulate ---------------------------------------------------------------------------------
@@ -380,8 +542,9 @@ def parse_excursion(text: str) -> Excursion:
 def simulate_log(traj: Trajectory, *, lag: float = 0.0, noise: float = 0.0, seed: int = 0,
                  excursions: Sequence[Excursion] = (), period: float | None = None,
                  samples: int | None = None, tail: float = 0.0) -> tuple[FloatArray, FloatArray]:
-    """(t, angles): samples from t_0 to t_end + tail, every ``period`` s (default 1 ms) or
-    ``samples`` of them evenly; measured = trajectory(t - lag) + uniform noise in
+    """(t, angles): samples from t_0 to t_end + tail (both included), every ``period`` s
+    (default 1 ms; the last gap shorter when the span is not a multiple) or ``samples`` of them
+    evenly; measured = trajectory(t - lag) + uniform noise in
     [-noise, noise] per joint (seeded), plus the excursions."""
     if lag < 0 or noise < 0 or tail < 0:
         raise InputError("--lag/--noise/--tail", (lag, noise, tail), "must be >= 0")
@@ -403,7 +566,16 @@ def simulate_log(traj: Trajectory, *, lag: float = 0.0, noise: float = 0.0, seed
         if count > MAX_LOG_SAMPLES:
             raise InputError("--period", p, f"gives {count:.4g} samples over {t1 - t0:g} s, more "
                              f"than the simulated log's budget of {MAX_LOG_SAMPLES}")
-        t = t0 + p * np.arange(int(math.floor((t1 - t0) / p + 1e-9)) + 1)
+        t = np.minimum(t0 + p * np.arange(int(math.floor((t1 - t0) / p + 1e-9)) + 1), t1)
+        # The last sample at t_end + tail exactly (the grid's last point may fall short of it,
+        # by rounding or by a fraction of a period): a log that stops short is unobserved (§12).
+        if t[-1] < t1:
+            if t1 - t[-1] <= 1e-9 * (t1 - t0):
+                t[-1] = t1
+            else:
+                t = np.append(t, t1)
+    if len(t) > 1:
+        t[-1] = t1
     if len(t) > 1 and not np.all(np.diff(t) > 0):
         raise InputError("--samples", samples, "gives times that do not increase")
     rng = np.random.default_rng(seed)

@@ -8,13 +8,15 @@ from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
 from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
                     VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
                     left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
-from ._certificate import Certificate, ContactDetail, certificate_json, certify, require_clear
+from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
+                           contact_links_text, require_clear)
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
-from ._trajectory import (Trajectory, certify_trajectory, csv_column_order, executed_trajectory,
+from ._trajectory import (ReferenceSpeeds, Trajectory, between_samples_bound, certify_trajectory,
+                          csv_column_order, executed_trajectory,
                           load_trajectory, parse_trajectory_csv, parse_trajectory_json,
                           tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
 from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
-from ._kinematics import arm_corners, joints, link_corners
+from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name
 from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                      Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
                      is_opt_path, is_path, is_path_paper, opt_path, path_violations)
@@ -41,6 +43,8 @@ __all__ = [
     "cases", "ceil_of", "floor_of", "if_then", "max_of", "min_of",
     # geometry
     "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
+    # links named 1-based with words, as docs/model.md §2 names them
+    "LINK_WORDS", "closest_links", "contact_links_text", "link_name",
     # paths (docs/model.md §5)
     "Cell", "J1", "J2", "MOVES", "PathViolation", "REASON_GOAL_BLOCKED", "REASON_START_BLOCKED",
     "REASON_UNREACHABLE", "SearchResult", "SearchStatus", "check_search_inputs", "is_opt_path",
@@ -61,4 +65,6 @@ __all__ = [
     "TRAJECTORY_COLUMNS", "Trajectory", "certify_trajectory", "csv_column_order",
     "executed_trajectory", "load_trajectory", "parse_trajectory_csv", "parse_trajectory_json",
     "tolerance_rad", "trajectory_csv", "trajectory_distances", "tube_lipschitz",
+    # the monitor between samples (docs/model.md §12; proofs/_obl_monitor.py)
+    "ReferenceSpeeds", "between_samples_bound",
 ]

@@ -46,7 +46,7 @@ import numpy.typing as npt
 
 from ..errors import CertificateViolation, InputError
 from ._grid import EPS, Grid, exact_tf, left_angles
-from ._kinematics import corners, reach
+from ._kinematics import corners, link_name, reach
 from ._polygon import polygon_distances
 from ._scenario import Arm, Scenario
 
@@ -55,6 +55,8 @@ __all__ = [
     "ContactDetail",
     "certify",
     "certificate_json",
+    "closest_links",
+    "contact_links_text",
     "prove_motion",
     "require_clear",
     "link_speeds",
@@ -79,7 +81,8 @@ Contact = tuple[float, tuple[int, int]]
 
 @dataclass(frozen=True)
 class ContactDetail:
-    """Where a sampled contact is: the instant, the links, both arms' joint angles then, and the
+    """Where a sampled contact is: the instant, the links (left, right), numbered 1-based as in
+    docs/model.md §2 (1 the upper arm, 2 the forearm), both arms' joint angles then, and the
     path segment the subordinate was on (``step`` k: moving from cells[0] to cells[1] during
     [k dt, (k+1) dt]; ``step`` None: resting at its last cell, cells[0] == cells[1])."""
 
@@ -105,7 +108,8 @@ class Certificate:
     is THE PROVED figure: a lower bound on the distance between the arms over the whole motion
     (else 0.0). ``min_clearance_m`` / ``t_min_s`` are only the least SAMPLED distance and its
     instant: an upper bound on the true minimum, not a guarantee. ``contact`` is
-    (t, (left link, right link)) for a sampled contact, and ``contact_detail`` the same with the
+    (t, (left link, right link)) for a sampled contact, links numbered 1-based
+    (``closest_links``), and ``contact_detail`` the same with the
     angles and path segment; ``undecided`` lists the merged (t0, t1) intervals left unproved.
     """
 
@@ -226,7 +230,8 @@ def certificate_json(cert: Certificate) -> dict[str, Any]:
     the PROVED lower bound over every instant (> 1e-9 when ``clear``, else 0.0)."""
     contact = None
     if cert.contact is not None:
-        contact = {"t_s": cert.contact[0], "links": list(cert.contact[1])}
+        contact = {"t_s": cert.contact[0], "links": list(cert.contact[1]),
+                   "links_text": contact_links_text(cert.contact[1])}
         c = cert.contact_detail
         if c is not None:
             contact.update(left_angles_rad=list(c.left_angles_rad),
@@ -245,13 +250,27 @@ def certificate_json(cert: Certificate) -> dict[str, Any]:
     }
 
 
+def closest_links(d: FloatArray) -> tuple[int, int]:
+    """(left link, right link) of the least of ``d[a, b]`` (2, 2), the distances between left link
+    index a and right link index b: as link NUMBERS, 1-based (docs/model.md §2), the one place
+    an array index becomes a link number."""
+    a, b = np.unravel_index(int(np.argmin(d)), (2, 2))
+    return int(a) + 1, int(b) + 1
+
+
+def contact_links_text(links: Sequence[int]) -> str:
+    """``left link 2 (forearm) and right link 2 (forearm)`` for 1-based link numbers."""
+    return f"{link_name('left', int(links[0]))} and {link_name('right', int(links[1]))}"
+
+
 def require_clear(cert: Certificate, *, name: str = "continuous-time certificate") -> None:
     """Raise CertificateViolation unless the certificate proved the motion clear."""
     if cert.clear:
         return
     if cert.contact is not None:
         t, (a, b) = cert.contact
-        values: dict[str, Any] = {"t_s": t, "left link": a, "right link": b, "distance_m": 0.0}
+        values: dict[str, Any] = {"t_s": t, "links": contact_links_text((a, b)),
+                                  "distance_m": 0.0}
         c = cert.contact_detail
         if c is not None:
             values.update({"left angles_rad": list(c.left_angles_rad),
@@ -312,14 +331,12 @@ class _Best:
         touching = np.flatnonzero(arm == 0.0)
         if best.contact is None and len(touching):
             first = touching[np.argmin(t[touching])]
-            a, b = np.unravel_index(int(np.argmin(d[first])), (2, 2))
-            contact = (float(t[first]), (int(a), int(b)))
+            contact = (float(t[first]), closest_links(d[first]))
             best = _Best(0.0, contact[0], contact, int(seg[first]))
         elif earliest and best.contact is not None and len(touching):
             first = touching[np.argmin(t[touching])]
             if float(t[first]) < best.contact[0]:
-                a, b = np.unravel_index(int(np.argmin(d[first])), (2, 2))
-                contact = (float(t[first]), (int(a), int(b)))
+                contact = (float(t[first]), closest_links(d[first]))
                 best = _Best(0.0, contact[0], contact, int(seg[first]))
         return best
 

@@ -13,9 +13,20 @@ import numpy.typing as npt
 
 from ._scenario import Arm
 
-__all__ = ["joints", "link_corners", "arm_corners", "corners", "reach"]
+__all__ = ["LINK_WORDS", "joints", "link_corners", "arm_corners", "corners", "link_name", "reach"]
 
 Point = tuple[float, float]
+
+#: Link numbers as docs/model.md §2 names them: 1-based, link 1 the upper arm, link 2 the forearm.
+LINK_WORDS = {1: "upper arm", 2: "forearm"}
+
+
+def link_name(arm: str, number: int) -> str:
+    """``left link 2 (forearm)``: the words every message, JSON text and table uses for link
+    ``number`` (1-based: 1 upper arm, 2 forearm; docs/model.md §2) of the ``arm`` side."""
+    if arm not in ("left", "right") or number not in LINK_WORDS:
+        raise ValueError(f"no link {number!r} of arm {arm!r} (arms left/right, links 1 and 2)")
+    return f"{arm} link {number} ({LINK_WORDS[number]})"
 
 
 def joints(arm: Arm, theta: tuple[float, float]) -> tuple[Point, Point, Point]:

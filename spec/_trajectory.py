@@ -15,6 +15,14 @@ between the two configurations; docs/model.md §12), so each arm's rectangles li
 the planned ones in Hausdorff distance and the distance between the arms drops by at most
 2 L delta. The obligation ``Tolerance.tube`` proves the lemma; ``tolerance_rad`` is the largest
 delta on a 1e-6 rad grid with 2 L delta <= c - EPS.
+
+Between samples (docs/model.md §12). A measured log shows the robot at sampled instants only. If
+a joint moves at most w_x rad/s (the robot's speed bound) and the trajectory's joint at most w_r
+on [t_k, t_k+1] (its speed there), the deviation d(t) = |x(t) - r(t)| at any instant of the gap
+is at most ``between_samples_bound(d_k, d_k+1, h, w_x, w_r)`` = max(d_k, d_k+1) + (w_x + w_r) h / 2
+with h = t_k+1 - t_k: by the triangle inequality d(t) <= d_k + (w_x + w_r)(t - t_k) and
+d(t) <= d_k+1 + (w_x + w_r)(t_k+1 - t), and one of t - t_k, t_k+1 - t is at most h / 2. The
+obligation ``Monitor.between_samples`` proves it with Z3 on this very function's terms.
 """
 
 from __future__ import annotations
@@ -29,6 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
+from ._arith import max_of
 from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
                            Certificate, ContactDetail, link_rects, link_speeds, prove_motion)
 from ._grid import EPS, Grid, exact_tf, left_angles
@@ -39,7 +48,8 @@ from ._scenario import ANGLE_TOLERANCE, Scenario
 __all__ = ["COLUMNS", "JOINTS", "Trajectory", "csv_column_order", "load_trajectory",
            "parse_trajectory_csv", "parse_trajectory_json", "certify_trajectory",
            "executed_trajectory", "trajectory_csv", "tube_lipschitz", "tolerance_rad",
-           "TOLERANCE_STEP_RAD", "SPEED_TOLERANCE", "trajectory_distances", "validate"]
+           "TOLERANCE_STEP_RAD", "SPEED_TOLERANCE", "trajectory_distances", "validate",
+           "between_samples_bound", "ReferenceSpeeds"]
 
 #: The file columns, in the order of ``Trajectory.angles`` after t.
 COLUMNS = ("t", "left1", "left2", "right1", "right2")
@@ -279,6 +289,47 @@ def tolerance_rad(s: Scenario, cert: Certificate) -> float:
     while k > 0 and two_l * (k / per) > cert.lower_bound_m - EPS:
         k -= 1
     return k / per
+
+
+def between_samples_bound(d0: Any, d1: Any, h: Any, w_robot: Any, w_ref: Any) -> Any:
+    """The largest deviation |x(t) - r(t)| of one joint at any instant t of a gap of length h
+    between two samples with deviations d0, d1, when the robot's joint moves at most w_robot
+    rad/s and the trajectory's at most w_ref on the gap (module docstring; the obligation
+    Monitor.between_samples). Floats, numpy arrays (elementwise) or Z3 terms."""
+    return max_of(d0, d1) + (w_robot + w_ref) * h / 2
+
+
+@dataclass(frozen=True)
+class ReferenceSpeeds:
+    """The trajectory's joint speeds per piece of time: ``per_piece[j]`` (R + 1, 4) is the speed
+    on the j-th piece, j = 0 before the first row (at rest, 0), j = k + 1 between rows k and
+    k + 1 (|a_k+1 - a_k| / (t_k+1 - t_k)), j = R after the last row (at rest, 0)."""
+
+    t: FloatArray
+    per_piece: FloatArray
+
+    @staticmethod
+    def of(traj: Trajectory) -> ReferenceSpeeds:
+        zero = np.zeros((1, 4))
+        inner = (np.abs(np.diff(traj.angles, axis=0)) / np.diff(traj.t)[:, None]
+                 if traj.rows > 1 else np.zeros((0, 4)))
+        return ReferenceSpeeds(traj.t, np.concatenate([zero, inner, zero]))
+
+    def top(self) -> FloatArray:
+        """(4,): the largest speed of each joint over the whole trajectory."""
+        return self.per_piece.max(axis=0)
+
+    def over(self, a: FloatArray, b: FloatArray) -> FloatArray:
+        """(G, 4): each joint's largest speed on [a_g, b_g] (a_g < b_g): over the pieces the
+        interval meets. A gap within one or two pieces (the usual case) is one numpy step; a
+        longer one is a slice each (gaps are disjoint, so the slices add up to R + 2 G)."""
+        lo = np.searchsorted(self.t, a, side="right")         # the piece of a
+        hi = np.searchsorted(self.t, b, side="left")          # the piece of the instant before b
+        hi = np.maximum(hi, lo)
+        out = np.maximum(self.per_piece[lo], self.per_piece[hi])
+        for g in np.flatnonzero(hi - lo > 1):
+            out[g] = self.per_piece[lo[g]:hi[g] + 1].max(axis=0)
+        return out
 
 
 def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
