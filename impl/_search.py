@@ -18,7 +18,7 @@ from ..errors import InputError
 from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                            Cell, SearchResult, Witness, check_search_inputs)
 
-__all__ = ["WitnessLabels", "hold_waits", "search_opt_path"]
+__all__ = ["BackPointers", "WitnessLabels", "hold_waits", "search_opt_path"]
 
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
@@ -40,7 +40,7 @@ def _prepare(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness:
     blocked-end reason and the witness labels; or the early answer when an end is blocked (the
     goal's only without a witness: with one, the search still settles the reachable states)."""
     N, m, n, start, goal = check_search_inputs(dr, start, goal)
-    free = np.ascontiguousarray(np.asarray(dr) == 0)
+    free = FreeLayers(dr)
     reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
               REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
     if reason is not None and not with_witness:
@@ -101,6 +101,56 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
     return replace(result, witness=labels.witness(found=found is not None))
 
 
+class FreeLayers:
+    """D_R's free masks, one layer at a time: ``free[s]`` is ``dr[s] == 0`` (C-contiguous bool),
+    made when asked for, so that the search holds no second D_R-sized array."""
+
+    def __init__(self, dr: npt.NDArray[np.integer]) -> None:
+        self.dr = dr
+        self.shape = tuple(dr.shape)
+
+    def __getitem__(self, key: Any) -> Any:
+        return np.ascontiguousarray(np.asarray(self.dr[key]) == 0)
+
+
+class BackPointers:
+    """The DAG steps' back-pointers, compact: for step s = 1..N, the previous move (index into
+    MOVES, int8) of each state's optimal predecessor, kept only on the box of cells within s
+    moves of the start, rows r0:r1 and columns c0:c1 of ``box(s)``. A state at step s outside
+    that box has no label (a move changes each coordinate by at most 1), so nothing is lost: the
+    pointers take 9 (2 s + 1)^2 bytes at step s at most, instead of 9 m n."""
+
+    def __init__(self, start: Cell, m: int, n: int) -> None:
+        self.start, self.m, self.n = start, m, n
+        self.layers: list[npt.NDArray[np.int8]] = []
+
+    @property
+    def N(self) -> int:
+        return len(self.layers)
+
+    def box(self, s: int) -> tuple[int, int, int, int]:
+        """(r0, r1, c0, c1): the rows and columns within s moves of the start."""
+        i, j = self.start
+        return max(0, i - s), min(self.m, i + s + 1), max(0, j - s), min(self.n, j + s + 1)
+
+    def new(self, s: int) -> npt.NDArray[np.int8]:
+        """Step s's pointers (9, r1 - r0, c1 - c0), -1 (no predecessor) until written; steps are
+        made in order 1, 2, ..."""
+        if s != self.N + 1:
+            raise AssertionError(f"BackPointers.new({s}) after step {self.N}")
+        r0, r1, c0, c1 = self.box(s)
+        self.layers.append(np.full((9, r1 - r0, c1 - c0), -1, dtype=np.int8))
+        return self.layers[-1]
+
+    def at(self, s: int, d: int, i: int, j: int) -> int:
+        """The previous move of state (s, (i, j), d)'s optimal predecessor."""
+        r0, r1, c0, c1 = self.box(s)
+        if not (r0 <= i < r1 and c0 <= j < c1):
+            raise AssertionError(f"BackPointers.at: cell {(i, j)} is not within {s} moves of "
+                                 f"the start {self.start}")
+        return int(self.layers[s - 1][d, i - r0, j - c0])
+
+
 class WitnessLabels:
     """A search's labels, step by step, as the witness's arrays j1, j2 (N + 1, 9, m, n).
 
@@ -152,21 +202,23 @@ def _check_size(N: int, m: int, n: int) -> None:
         raise InputError("dr", (N + 1, m, n), "is too large for the search's int64 cost keys")
 
 
-def _dag_phase(free: BoolArray, start: Cell, labels: WitnessLabels | None = None
-               ) -> tuple[IntArray, list[npt.NDArray[np.int8]]]:
+def _dag_phase(free: FreeLayers, start: Cell, labels: WitnessLabels | None = None
+               ) -> tuple[IntArray, BackPointers]:
     """Keys of the states at step N (shape (3, 3, m, n), move index (di+1, dj+1)), and per step
-    s = 1..N the previous move (index into MOVES) of each state's optimal predecessor. The keys
-    of steps 0..N-1 go to ``labels`` when given."""
+    s = 1..N the previous move (index into MOVES) of each state's optimal predecessor, on the
+    box of s moves (``BackPointers``). Only one step's keys are held at a time; the keys of steps
+    0..N-1 go to ``labels`` when given."""
     N = free.shape[0] - 1
     m, n = free.shape[1:]
     keys = np.full((3, 3, m, n), INF, dtype=np.int64)
     keys[1, 1, start[0], start[1]] = 0  # step 0: at start, "arrived" by the rest move (0, 0)
-    preds: list[npt.NDArray[np.int8]] = []
+    preds = BackPointers(start, m, n)
     for s in range(1, N + 1):
         if labels is not None:
             labels.put(s - 1, keys.reshape(9, m, n))
         keys, pred = _step(keys, np.where(free[s], np.int64(0), INF))
-        preds.append(pred)
+        r0, r1, c0, c1 = preds.box(s)
+        preds.new(s)[:] = pred.reshape(9, m, n)[:, r0:r1, c0:c1]
     return keys, preds
 
 
@@ -269,11 +321,11 @@ def _push(buckets: dict[int, list[IntArray]], states: IntArray, keys: IntArray) 
 
 
 def _unwind(goal: Cell, last: int, start: Cell, static_pred: npt.NDArray[np.int8],
-            from_static: BoolArray, dag_pred: list[npt.NDArray[np.int8]]) -> list[Cell]:
+            from_static: BoolArray, dag_pred: BackPointers) -> list[Cell]:
     """The cells of the optimal path, from the predecessor moves, without trailing waits."""
-    m, n = dag_pred[0].shape[2:]
-    M = m * n
-    N = len(dag_pred)
+    n = dag_pred.n
+    M = dag_pred.m * n
+    N = dag_pred.N
     cells = [goal]
     i, j, d = goal[0], goal[1], last
     while from_static[d * M + i * n + j]:  # back through the capped step N
@@ -282,7 +334,7 @@ def _unwind(goal: Cell, last: int, start: Cell, static_pred: npt.NDArray[np.int8
         d = p
         cells.append((i, j))
     for s in range(N, 0, -1):  # back through the DAG steps N .. 1
-        p = int(dag_pred[s - 1][d // 3, d % 3, i, j])
+        p = dag_pred.at(s, d, i, j)
         i, j = i - MOVES[d][0], j - MOVES[d][1]
         d = p
         cells.append((i, j))
