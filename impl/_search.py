@@ -16,7 +16,7 @@ import numpy.typing as npt
 
 from ..errors import InputError
 from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                           Cell, SearchResult, Witness, check_search_inputs)
+                   Cell, LayerSpill, SearchResult, Witness, check_search_inputs, spill_wanted)
 
 __all__ = ["BackPointers", "WitnessLabels", "hold_waits", "search_opt_path"]
 
@@ -157,32 +157,73 @@ class WitnessLabels:
     The type is uint16 when every label of the DAG steps fits (J1 <= 2 s, J2 <= 4 s at step s,
     so when 4 N + 4 < 65535), else uint32; the capped step's labels widen it when they do not
     fit. The type's largest value marks a state without a label.
+
+    Arrays larger than ``spec.SPILL_BYTES`` together (or with ``spill=True``) are not held: each
+    step's labels are appended to a ``spec.LayerSpill`` (a temporary file) as they are made, in
+    step order, and the witness reads them back one layer at a time (``spec.Layers``).
     """
 
-    def __init__(self, N: int, m: int, n: int) -> None:
+    def __init__(self, N: int, m: int, n: int, spill: bool | None = None) -> None:
         dtype = np.uint16 if 4 * N + 4 < np.iinfo(np.uint16).max else np.uint32
-        self.j1 = np.full((N + 1, 9, m, n), np.iinfo(dtype).max, dtype=dtype)
-        self.j2 = np.full((N + 1, 9, m, n), np.iinfo(dtype).max, dtype=dtype)
+        self.N = N
+        self.shape = (N + 1, 9, m, n)
+        if spill is None:
+            spill = spill_wanted(2 * (N + 1) * 9 * m * n * np.dtype(dtype).itemsize)
+        self.spills: tuple[LayerSpill, LayerSpill] | None = None
+        if spill:
+            self.spills = (LayerSpill(self.shape, dtype), LayerSpill(self.shape, dtype))
+        else:
+            self.j1 = np.full(self.shape, np.iinfo(dtype).max, dtype=dtype)
+            self.j2 = np.full(self.shape, np.iinfo(dtype).max, dtype=dtype)
+
+    @property
+    def dtype(self) -> np.dtype[Any]:
+        return self.spills[0].dtype if self.spills is not None else self.j1.dtype
 
     def put(self, s: int, keys: IntArray, box: tuple[int, int, int, int] | None = None) -> None:
         """Step s's keys (9, m, n), INF for no label; only rows r0:r1, columns c0:c1 of
-        ``box`` = (r0, r1, c0, c1) when given (no label elsewhere)."""
+        ``box`` = (r0, r1, c0, c1) when given (no label elsewhere). Spilled, steps are put in
+        order 0, 1, ..., N."""
         r0, r1, c0, c1 = box or (0, keys.shape[1], 0, keys.shape[2])
         k = keys[:, r0:r1, c0:c1]
         reached = k < INF
-        none = np.iinfo(self.j1.dtype).max
+        none = np.iinfo(self.dtype).max
         finite = k[reached]
         if finite.size and max(int(finite.max() >> SHIFT), int((finite & J2_MASK).max())) >= none:
-            self.j1, self.j2 = self.j1.astype(np.uint32), self.j2.astype(np.uint32)
+            # Widened, "no label" stays "no label" in the steps already put (the old type's
+            # largest value is a label value in uint32).
+            if self.spills is not None:
+                self.spills = (self.spills[0].widened(np.uint32),
+                               self.spills[1].widened(np.uint32))
+            else:
+                self.j1, self.j2 = (np.where(a == none, np.iinfo(np.uint32).max,
+                                             a.astype(np.uint32)) for a in (self.j1, self.j2))
             none = np.iinfo(np.uint32).max
-        self.j1[s, :, r0:r1, c0:c1] = np.where(reached, k >> SHIFT, none)
-        self.j2[s, :, r0:r1, c0:c1] = np.where(reached, k & J2_MASK, none)
+        if self.spills is None:
+            self.j1[s, :, r0:r1, c0:c1] = np.where(reached, k >> SHIFT, none)
+            self.j2[s, :, r0:r1, c0:c1] = np.where(reached, k & J2_MASK, none)
+            return
+        if s != self.spills[0].written:
+            raise AssertionError(f"WitnessLabels.put: step {s} after {self.spills[0].written}")
+        for spill, part in zip(self.spills, (k >> SHIFT, k & J2_MASK)):
+            layer = np.full(self.shape[1:], none, dtype=self.dtype)
+            layer[:, r0:r1, c0:c1] = np.where(reached, part, none)
+            spill.append(layer)
 
     def witness(self, *, found: bool) -> Witness:
         """The labels, or (no path) the set of labelled states: those reachable from the start."""
+        none = np.iinfo(self.dtype).max
+        if self.spills is not None:
+            while self.spills[0].written < self.shape[0]:    # steps never reached: no labels
+                for spill in self.spills:
+                    spill.append(np.full(self.shape[1:], none, dtype=self.dtype))
+            j1, j2 = self.spills[0].layers(), self.spills[1].layers()
+            if found:
+                return Witness.of_labels(j1, j2)
+            return Witness.of_reachable(j1.map(lambda a: a != none, np.bool_))
         if found:
             return Witness.of_labels(self.j1, self.j2)
-        return Witness.of_reachable(self.j1 != np.iinfo(self.j1.dtype).max)
+        return Witness.of_reachable(self.j1 != none)
 
 
 def hold_waits(keys: IntArray) -> IntArray:
@@ -285,8 +326,7 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell,
                             np.concatenate(cand_k), np.concatenate(cand_p))
         _push(buckets, improved, keys)
     if labels is not None:
-        N = labels.j1.shape[0] - 1
-        labels.put(N, hold_waits(keys.reshape(9, m, n)))
+        labels.put(labels.N, hold_waits(keys.reshape(9, m, n)))
     return answer
 
 
