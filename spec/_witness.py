@@ -224,7 +224,8 @@ def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
                   result: SearchResult, witness: Witness | None) -> list[Failure]:
     """The first failing condition of the module docstring, or [] when the witness proves the
     answer: a found path optimal, or no path valid. ``dr`` is a 0/1 array (N + 1, m, n)."""
-    free = np.asarray(dr) == 0
+    dr = np.asarray(dr)
+    free = Layers(dr.shape, np.bool_, lambda s: dr[s] == 0)   # one layer at a time (§11)
     N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
     start, goal = (int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))
     found = result.status is SearchStatus.FOUND
@@ -277,7 +278,8 @@ def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
     if edge:
         return edge
     path = list(result.path)
-    bad = path_violations(path, free.astype(np.uint8) ^ 1, start, goal)
+    blocked = free.map(lambda a: (~a).astype(np.uint8), np.uint8)
+    bad = path_violations(path, blocked, start, goal)
     if bad:
         return [_fail("path", f"the returned path is not valid: {bad[0].message}",
                       ("clause", bad[0].clause), ("failed clauses", len(bad)))]
