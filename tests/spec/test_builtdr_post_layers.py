@@ -66,3 +66,17 @@ def test_a_value_other_than_0_or_1_is_a_mismatch(built):
     full = dr_postcondition(s, "modified", g, bad)
     assert full == dr_postcondition(s, "modified", g, bad, cells=every_cell(g))
     assert not full.ok and full.mismatches[0].got == 2
+
+
+def test_values_other_than_0_or_1_are_counted_layer_by_layer(built):
+    from cfmpa.spec._triples import dr_shape_failures
+
+    s, g, dr = built
+    bad = dr.copy()
+    rng = np.random.default_rng(5)
+    bad.reshape(-1)[rng.choice(bad.size, size=17, replace=False)] = 7
+    (f,) = dr_shape_failures(g, bad)
+    first = tuple(int(x) for x in np.argwhere(bad > 1)[0])
+    assert f.count == 17 and dict(f.values)["layer"] == first[0]
+    assert dict(f.values)["cell"] == list(first[1:]) and dict(f.values)["value"] == 7
+    assert dr_shape_failures(g, dr) == []
