@@ -206,9 +206,7 @@ class WitnessLabels:
         if s != self.spills[0].written:
             raise AssertionError(f"WitnessLabels.put: step {s} after {self.spills[0].written}")
         for spill, part in zip(self.spills, (k >> SHIFT, k & J2_MASK)):
-            layer = np.full(self.shape[1:], none, dtype=self.dtype)
-            layer[:, r0:r1, c0:c1] = np.where(reached, part, none)
-            spill.append(layer)
+            spill.append(np.where(reached, part, none).astype(self.dtype), (r0, r1, c0, c1))
 
     def witness(self, *, found: bool) -> Witness:
         """The labels, or (no path) the set of labelled states: those reachable from the start."""
@@ -216,7 +214,7 @@ class WitnessLabels:
         if self.spills is not None:
             while self.spills[0].written < self.shape[0]:    # steps never reached: no labels
                 for spill in self.spills:
-                    spill.append(np.full(self.shape[1:], none, dtype=self.dtype))
+                    spill.append(np.zeros((9, 0, 0), dtype=self.dtype), (0, 0, 0, 0))
             j1, j2 = self.spills[0].layers(), self.spills[1].layers()
             if found:
                 return Witness.of_labels(j1, j2)

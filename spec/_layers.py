@@ -119,39 +119,76 @@ def _pread(fd: int, nbytes: int, offset: int) -> bytes:
 
 
 class LayerSpill:
-    """Layers of one shape and type appended in order to an unnamed temporary file."""
+    """Layers of one shape and type appended in order to an unnamed temporary file.
 
-    def __init__(self, shape: tuple[int, ...], dtype: npt.DTypeLike) -> None:
+    A layer is stored as the part inside the bounding box, over its last two axes, of the
+    entries that differ from ``fill`` (by default the type's largest value, "no label"); the
+    rest reads back as ``fill``. The labels of the search's step s lie within s moves of the
+    start, so its early steps take little room."""
+
+    def __init__(self, shape: tuple[int, ...], dtype: npt.DTypeLike,
+                 fill: Any = None) -> None:
         self.shape = tuple(int(x) for x in shape)
         self.dtype = np.dtype(dtype)
+        self.fill = (np.iinfo(self.dtype).max if fill is None and self.dtype.kind in "ui"
+                     else (fill or 0))
         self._file: IO[bytes] = tempfile.TemporaryFile(prefix="cfmpa-layers-")
-        self.written = 0
+        self._parts: list[tuple[int, tuple[int, int, int, int]]] = []   # (offset, box)
+        self._end = 0
 
     @property
-    def layer_bytes(self) -> int:
-        return int(np.prod(self.shape[1:], dtype=np.int64)) * self.dtype.itemsize
+    def written(self) -> int:
+        return len(self._parts)
 
-    def append(self, layer: Array) -> None:
-        """Write the next layer (converted to this type; its shape must be the layer shape)."""
+    def append(self, layer: Array, box: tuple[int, int, int, int] | None = None) -> None:
+        """Write the next layer (converted to this type): the whole layer, or with ``box`` =
+        (r0, r1, c0, c1) its part at rows r0:r1, columns c0:c1 of the last two axes (``fill``
+        elsewhere)."""
         a = np.asarray(layer)
-        if self.written >= self.shape[0] or a.shape != self.shape[1:]:
-            raise ValueError(f"LayerSpill.append: layer {self.written} of shape {a.shape}, "
-                             f"expected {self.shape[1:]} and at most {self.shape[0]} layers")
-        self._file.write(np.ascontiguousarray(a, dtype=self.dtype).data)
-        self.written += 1
+        R, C = self.shape[-2:]
+        r0, r1, c0, c1 = box or (0, R, 0, C)
+        want = (*self.shape[1:-2], r1 - r0, c1 - c0)
+        if (self.written >= self.shape[0] or a.shape != want
+                or not (0 <= r0 <= r1 <= R and 0 <= c0 <= c1 <= C)):
+            raise ValueError(f"LayerSpill.append: layer {self.written} of shape {a.shape} at "
+                             f"{(r0, r1, c0, c1)}, expected {want} inside {(R, C)} and at "
+                             f"most {self.shape[0]} layers")
+        a = a.astype(self.dtype, copy=False)
+        lead = int(np.prod(a.shape[:-2], dtype=np.int64))
+        used = (a != self.fill).reshape(lead, *a.shape[-2:]).any(axis=0)
+        rows, cols = np.flatnonzero(used.any(axis=1)), np.flatnonzero(used.any(axis=0))
+        if rows.size == 0:
+            self._parts.append((self._end, (0, 0, 0, 0)))
+            return
+        a = np.ascontiguousarray(a[..., rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1])
+        self._parts.append((self._end, (r0 + int(rows[0]), r0 + int(rows[-1]) + 1,
+                                        c0 + int(cols[0]), c0 + int(cols[-1]) + 1)))
+        self._file.write(a.data)
+        self._end += a.nbytes
+
+    def _part(self, s: int) -> tuple[Array, tuple[int, int, int, int]]:
+        offset, (r0, r1, c0, c1) = self._parts[s]
+        shape = (*self.shape[1:-2], r1 - r0, c1 - c0)
+        size = int(np.prod(shape, dtype=np.int64)) * self.dtype.itemsize
+        data = _pread(self._file.fileno(), size, offset) if size else b""
+        return np.frombuffer(data, self.dtype).reshape(shape), (r0, r1, c0, c1)
+
+    def _layer(self, s: int) -> Array:
+        out = np.full(self.shape[1:], self.fill, dtype=self.dtype)
+        part, (r0, r1, c0, c1) = self._part(s)
+        out[..., r0:r1, c0:c1] = part
+        return out
 
     def widened(self, dtype: npt.DTypeLike) -> LayerSpill:
         """A new spill holding the layers written so far converted to ``dtype`` (values kept,
-        except this type's largest value, which becomes the new type's)."""
+        ``fill`` becoming the new type's largest value)."""
         out = LayerSpill(self.shape, dtype)
-        old_none, new_none = np.iinfo(self.dtype).max, np.iinfo(out.dtype).max
         self._file.flush()
-        fd = self._file.fileno()
         for s in range(self.written):
-            a = np.frombuffer(_pread(fd, self.layer_bytes, s * self.layer_bytes), self.dtype)
-            wide = a.astype(out.dtype)
-            wide[a == old_none] = new_none
-            out.append(wide.reshape(self.shape[1:]))
+            part, box = self._part(s)
+            wide = part.astype(out.dtype)
+            wide[part == self.fill] = out.fill
+            out.append(wide, box)
         return out
 
     def layers(self) -> Layers:
@@ -159,9 +196,7 @@ class LayerSpill:
         if self.written != self.shape[0]:
             raise ValueError(f"LayerSpill.layers: {self.written} of {self.shape[0]} written")
         self._file.flush()
-        f, size, dtype = self._file, self.layer_bytes, self.dtype
-        return Layers(self.shape, dtype,
-                      lambda s: np.frombuffer(_pread(f.fileno(), size, s * size), dtype))
+        return Layers(self.shape, self.dtype, self._layer)
 
 
 def npz_layers(path: str | Path, name: str) -> Layers | None:

@@ -64,19 +64,41 @@ def test_the_view_reads_again_what_its_cache_let_go():
 
 
 def test_a_spill_refuses_a_wrong_layer_and_an_unfinished_read():
-    spill = LayerSpill((2, 3), np.uint16)
+    spill = LayerSpill((2, 1, 3), np.uint16)
     with pytest.raises(ValueError):
         spill.append(np.zeros(4))
-    spill.append(np.array([1, 65535, 3]))
+    with pytest.raises(ValueError):
+        spill.append(np.zeros((1, 2)), (0, 1, 2, 4))          # the box leaves the layer
+    spill.append(np.array([[1, 65535, 3]]))
     with pytest.raises(ValueError):
         spill.layers()
     wide = spill.widened(np.uint32)
-    wide.append(np.array([70000, 4, 4294967295]))
+    wide.append(np.array([[70000, 4, 4294967295]]))
     assert np.array_equal(np.asarray(wide.layers()),
-                          [[1, 4294967295, 3], [70000, 4, 4294967295]])
-    spill.append(np.zeros(3))
+                          [[[1, 4294967295, 3]], [[70000, 4, 4294967295]]])
+    spill.append(np.zeros((1, 3)))
     with pytest.raises(ValueError):
-        spill.append(np.zeros(3))
+        spill.append(np.zeros((1, 3)))
+
+
+def test_a_spill_stores_the_box_of_what_is_not_fill_and_reads_the_rest_as_fill():
+    a = np.full((4, 9, 6, 7), 65535, dtype=np.uint16)
+    a[1, 3, 2, 4] = 5
+    a[2, :, 1:3, 0:6] = 9
+    a[3] = 1                                       # a full layer; layer 0 is all fill
+    spill = LayerSpill(a.shape, a.dtype)
+    spill.append(a[0])
+    spill.append(a[1, :, 1:5, 2:7], (1, 5, 2, 7))  # a part, fill around what is given
+    spill.append(a[2])
+    spill.append(a[3])
+    assert [box for _, box in spill._parts] == [(0, 0, 0, 0), (2, 3, 4, 5), (1, 3, 0, 6),
+                                               (0, 6, 0, 7)]
+    assert spill._end == 2 * (9 * 1 + 9 * 2 * 6 + 9 * 6 * 7)
+    assert np.array_equal(np.asarray(spill.layers()), a)
+    reach = LayerSpill((2, 9, 3, 3), np.bool_)
+    reach.append(np.zeros((9, 3, 3), dtype=bool))
+    reach.append(np.eye(3, dtype=bool)[None].repeat(9, axis=0))
+    assert np.asarray(reach.layers()).sum() == 27 and reach.fill == 0
 
 
 # --- npz --------------------------------------------------------------------------------------
