@@ -32,7 +32,7 @@ from numba import njit
 from ..spec import (MOVES, REASON_UNREACHABLE,
                            Cell, SearchResult)
 from ._progress import progress_bar
-from ._search import INF, J2_MASK, SHIFT, WAIT, _prepare, _unwind, hold_waits
+from ._search import INF, J2_MASK, SHIFT, WAIT, BackPointers, _prepare, _unwind, hold_waits
 
 __all__ = ["search_opt_path_fast"]
 
@@ -51,16 +51,16 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
     if early is not None:
         return early
     N, m, n, start, goal, free, reason, labels = setup
-    dag_pred = np.zeros((N, 9, m, n), dtype=np.int8)   # read only at reachable states
+    dag_pred = BackPointers(start, m, n)               # on the box of s moves, per step
     keys = np.full((9, m, n), INF, dtype=np.int64)
     spare = np.full((9, m, n), INF, dtype=np.int64)
     keys[WAIT, start[0], start[1]] = 0                 # step 0: at start, "arrived" by waiting
-    with progress_bar("search", N + 1, int(free.size), progress) as bar:
+    with progress_bar("search", N + 1, (N + 1) * m * n, progress) as bar:
         for s in range(1, N + 1):
             if labels is not None:                     # labels only within s - 1 moves
                 labels.put(s - 1, keys, (max(0, start[0] - s + 1), min(m, start[0] + s),
                                          max(0, start[1] - s + 1), min(n, start[1] + s)))
-            _dag_step(free[s], keys, spare, dag_pred[s - 1], start[0], start[1], s,
+            _dag_step(free[s], keys, spare, dag_pred.new(s), start[0], start[1], s,
                       _DI, _DJ, _NORM, _GAP, SHIFT, INF)
             keys, spare = spare, keys
             bar.advance()
@@ -75,7 +75,7 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
     if key < 0:
         result = SearchResult.no_path(reason or REASON_UNREACHABLE)
     else:
-        path = _unwind(goal, int(last), start, pred, from_static, dag_pred.reshape(N, 3, 3, m, n))
+        path = _unwind(goal, int(last), start, pred, from_static, dag_pred)
         result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
     if labels is None:
         return result
@@ -89,7 +89,8 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
 def _dag_step(free, keys, out, pred, si, sj, s, DI, DJ, NORM, GAP, shift, inf
               ):  # pragma: no cover - compiled; its results are tested against search_opt_path
     """Step s: out[d, c] = min over p of keys[p, c - d] + |d - p|_1 + (|d|_1 << shift), the least
-    p on ties into pred[d, c]; inf where c is blocked or no finite label reaches it."""
+    p on ties into pred[d, c - (i0, j0)] (pred holds the box of s moves only, BackPointers);
+    inf where c is blocked or no finite label reaches it."""
     m, n = free.shape
     i0, i1 = max(0, si - s), min(m - 1, si + s)   # cells within s moves of the start
     j0, j1 = max(0, sj - s), min(n - 1, sj + s)
@@ -111,7 +112,7 @@ def _dag_step(free, keys, out, pred, si, sj, s, DI, DJ, NORM, GAP, shift, inf
                                 best, arg = v, p
                 if arg >= 0:
                     out[d, i, j] = best + (NORM[d] << shift)
-                    pred[d, i, j] = arg
+                    pred[d, i - i0, j - j0] = arg
                 else:
                     out[d, i, j] = inf
 

@@ -16,9 +16,9 @@ import numpy.typing as npt
 
 from ..errors import InputError
 from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                           Cell, SearchResult, Witness, check_search_inputs)
+                   Cell, LayerSpill, SearchResult, Witness, check_search_inputs, spill_wanted)
 
-__all__ = ["WitnessLabels", "hold_waits", "search_opt_path"]
+__all__ = ["BackPointers", "WitnessLabels", "hold_waits", "search_opt_path"]
 
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
@@ -40,7 +40,7 @@ def _prepare(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness:
     blocked-end reason and the witness labels; or the early answer when an end is blocked (the
     goal's only without a witness: with one, the search still settles the reachable states)."""
     N, m, n, start, goal = check_search_inputs(dr, start, goal)
-    free = np.ascontiguousarray(np.asarray(dr) == 0)
+    free = FreeLayers(dr)
     reason = (REASON_START_BLOCKED if not free[0, start[0], start[1]] else
               REASON_GOAL_BLOCKED if not free[N, goal[0], goal[1]] else None)
     if reason is not None and not with_witness:
@@ -101,38 +101,127 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
     return replace(result, witness=labels.witness(found=found is not None))
 
 
+class FreeLayers:
+    """D_R's free masks, one layer at a time: ``free[s]`` is ``dr[s] == 0`` (C-contiguous bool),
+    made when asked for, so that the search holds no second D_R-sized array."""
+
+    def __init__(self, dr: npt.NDArray[np.integer]) -> None:
+        self.dr = dr
+        self.shape = tuple(dr.shape)
+
+    def __getitem__(self, key: Any) -> Any:
+        return np.ascontiguousarray(np.asarray(self.dr[key]) == 0)
+
+
+class BackPointers:
+    """The DAG steps' back-pointers, compact: for step s = 1..N, the previous move (index into
+    MOVES, int8) of each state's optimal predecessor, kept only on the box of cells within s
+    moves of the start, rows r0:r1 and columns c0:c1 of ``box(s)``. A state at step s outside
+    that box has no label (a move changes each coordinate by at most 1), so nothing is lost: the
+    pointers take 9 (2 s + 1)^2 bytes at step s at most, instead of 9 m n."""
+
+    def __init__(self, start: Cell, m: int, n: int) -> None:
+        self.start, self.m, self.n = start, m, n
+        self.layers: list[npt.NDArray[np.int8]] = []
+
+    @property
+    def N(self) -> int:
+        return len(self.layers)
+
+    def box(self, s: int) -> tuple[int, int, int, int]:
+        """(r0, r1, c0, c1): the rows and columns within s moves of the start."""
+        i, j = self.start
+        return max(0, i - s), min(self.m, i + s + 1), max(0, j - s), min(self.n, j + s + 1)
+
+    def new(self, s: int) -> npt.NDArray[np.int8]:
+        """Step s's pointers (9, r1 - r0, c1 - c0), -1 (no predecessor) until written; steps are
+        made in order 1, 2, ..."""
+        if s != self.N + 1:
+            raise AssertionError(f"BackPointers.new({s}) after step {self.N}")
+        r0, r1, c0, c1 = self.box(s)
+        self.layers.append(np.full((9, r1 - r0, c1 - c0), -1, dtype=np.int8))
+        return self.layers[-1]
+
+    def at(self, s: int, d: int, i: int, j: int) -> int:
+        """The previous move of state (s, (i, j), d)'s optimal predecessor."""
+        r0, r1, c0, c1 = self.box(s)
+        if not (r0 <= i < r1 and c0 <= j < c1):
+            raise AssertionError(f"BackPointers.at: cell {(i, j)} is not within {s} moves of "
+                                 f"the start {self.start}")
+        return int(self.layers[s - 1][d, i - r0, j - c0])
+
+
 class WitnessLabels:
     """A search's labels, step by step, as the witness's arrays j1, j2 (N + 1, 9, m, n).
 
     The type is uint16 when every label of the DAG steps fits (J1 <= 2 s, J2 <= 4 s at step s,
     so when 4 N + 4 < 65535), else uint32; the capped step's labels widen it when they do not
     fit. The type's largest value marks a state without a label.
+
+    Arrays larger than ``spec.SPILL_BYTES`` together (or with ``spill=True``) are not held: each
+    step's labels are appended to a ``spec.LayerSpill`` (a temporary file) as they are made, in
+    step order, and the witness reads them back one layer at a time (``spec.Layers``).
     """
 
-    def __init__(self, N: int, m: int, n: int) -> None:
+    def __init__(self, N: int, m: int, n: int, spill: bool | None = None) -> None:
         dtype = np.uint16 if 4 * N + 4 < np.iinfo(np.uint16).max else np.uint32
-        self.j1 = np.full((N + 1, 9, m, n), np.iinfo(dtype).max, dtype=dtype)
-        self.j2 = np.full((N + 1, 9, m, n), np.iinfo(dtype).max, dtype=dtype)
+        self.N = N
+        self.shape = (N + 1, 9, m, n)
+        if spill is None:
+            spill = spill_wanted(2 * (N + 1) * 9 * m * n * np.dtype(dtype).itemsize)
+        self.spills: tuple[LayerSpill, LayerSpill] | None = None
+        if spill:
+            self.spills = (LayerSpill(self.shape, dtype), LayerSpill(self.shape, dtype))
+        else:
+            self.j1 = np.full(self.shape, np.iinfo(dtype).max, dtype=dtype)
+            self.j2 = np.full(self.shape, np.iinfo(dtype).max, dtype=dtype)
+
+    @property
+    def dtype(self) -> np.dtype[Any]:
+        return self.spills[0].dtype if self.spills is not None else self.j1.dtype
 
     def put(self, s: int, keys: IntArray, box: tuple[int, int, int, int] | None = None) -> None:
         """Step s's keys (9, m, n), INF for no label; only rows r0:r1, columns c0:c1 of
-        ``box`` = (r0, r1, c0, c1) when given (no label elsewhere)."""
+        ``box`` = (r0, r1, c0, c1) when given (no label elsewhere). Spilled, steps are put in
+        order 0, 1, ..., N."""
         r0, r1, c0, c1 = box or (0, keys.shape[1], 0, keys.shape[2])
         k = keys[:, r0:r1, c0:c1]
         reached = k < INF
-        none = np.iinfo(self.j1.dtype).max
+        none = np.iinfo(self.dtype).max
         finite = k[reached]
         if finite.size and max(int(finite.max() >> SHIFT), int((finite & J2_MASK).max())) >= none:
-            self.j1, self.j2 = self.j1.astype(np.uint32), self.j2.astype(np.uint32)
+            # Widened, "no label" stays "no label" in the steps already put (the old type's
+            # largest value is a label value in uint32).
+            if self.spills is not None:
+                self.spills = (self.spills[0].widened(np.uint32),
+                               self.spills[1].widened(np.uint32))
+            else:
+                self.j1, self.j2 = (np.where(a == none, np.iinfo(np.uint32).max,
+                                             a.astype(np.uint32)) for a in (self.j1, self.j2))
             none = np.iinfo(np.uint32).max
-        self.j1[s, :, r0:r1, c0:c1] = np.where(reached, k >> SHIFT, none)
-        self.j2[s, :, r0:r1, c0:c1] = np.where(reached, k & J2_MASK, none)
+        if self.spills is None:
+            self.j1[s, :, r0:r1, c0:c1] = np.where(reached, k >> SHIFT, none)
+            self.j2[s, :, r0:r1, c0:c1] = np.where(reached, k & J2_MASK, none)
+            return
+        if s != self.spills[0].written:
+            raise AssertionError(f"WitnessLabels.put: step {s} after {self.spills[0].written}")
+        for spill, part in zip(self.spills, (k >> SHIFT, k & J2_MASK)):
+            spill.append(np.where(reached, part, none).astype(self.dtype), (r0, r1, c0, c1))
 
     def witness(self, *, found: bool) -> Witness:
         """The labels, or (no path) the set of labelled states: those reachable from the start."""
+        none = np.iinfo(self.dtype).max
+        if self.spills is not None:
+            while self.spills[0].written < self.shape[0]:    # steps never reached: no labels
+                for spill in self.spills:
+                    spill.append(np.zeros((9, 0, 0), dtype=self.dtype), (0, 0, 0, 0))
+            j1, j2 = self.spills[0].layers(), self.spills[1].layers()
+            if found:
+                return Witness.of_labels(j1, j2)
+            return Witness.of_reachable(j1.map(lambda a: a != none, np.bool_))
         if found:
             return Witness.of_labels(self.j1, self.j2)
-        return Witness.of_reachable(self.j1 != np.iinfo(self.j1.dtype).max)
+        return Witness.of_reachable(self.j1 != none)
 
 
 def hold_waits(keys: IntArray) -> IntArray:
@@ -152,21 +241,23 @@ def _check_size(N: int, m: int, n: int) -> None:
         raise InputError("dr", (N + 1, m, n), "is too large for the search's int64 cost keys")
 
 
-def _dag_phase(free: BoolArray, start: Cell, labels: WitnessLabels | None = None
-               ) -> tuple[IntArray, list[npt.NDArray[np.int8]]]:
+def _dag_phase(free: FreeLayers, start: Cell, labels: WitnessLabels | None = None
+               ) -> tuple[IntArray, BackPointers]:
     """Keys of the states at step N (shape (3, 3, m, n), move index (di+1, dj+1)), and per step
-    s = 1..N the previous move (index into MOVES) of each state's optimal predecessor. The keys
-    of steps 0..N-1 go to ``labels`` when given."""
+    s = 1..N the previous move (index into MOVES) of each state's optimal predecessor, on the
+    box of s moves (``BackPointers``). Only one step's keys are held at a time; the keys of steps
+    0..N-1 go to ``labels`` when given."""
     N = free.shape[0] - 1
     m, n = free.shape[1:]
     keys = np.full((3, 3, m, n), INF, dtype=np.int64)
     keys[1, 1, start[0], start[1]] = 0  # step 0: at start, "arrived" by the rest move (0, 0)
-    preds: list[npt.NDArray[np.int8]] = []
+    preds = BackPointers(start, m, n)
     for s in range(1, N + 1):
         if labels is not None:
             labels.put(s - 1, keys.reshape(9, m, n))
         keys, pred = _step(keys, np.where(free[s], np.int64(0), INF))
-        preds.append(pred)
+        r0, r1, c0, c1 = preds.box(s)
+        preds.new(s)[:] = pred.reshape(9, m, n)[:, r0:r1, c0:c1]
     return keys, preds
 
 
@@ -233,8 +324,7 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell,
                             np.concatenate(cand_k), np.concatenate(cand_p))
         _push(buckets, improved, keys)
     if labels is not None:
-        N = labels.j1.shape[0] - 1
-        labels.put(N, hold_waits(keys.reshape(9, m, n)))
+        labels.put(labels.N, hold_waits(keys.reshape(9, m, n)))
     return answer
 
 
@@ -269,11 +359,11 @@ def _push(buckets: dict[int, list[IntArray]], states: IntArray, keys: IntArray) 
 
 
 def _unwind(goal: Cell, last: int, start: Cell, static_pred: npt.NDArray[np.int8],
-            from_static: BoolArray, dag_pred: list[npt.NDArray[np.int8]]) -> list[Cell]:
+            from_static: BoolArray, dag_pred: BackPointers) -> list[Cell]:
     """The cells of the optimal path, from the predecessor moves, without trailing waits."""
-    m, n = dag_pred[0].shape[2:]
-    M = m * n
-    N = len(dag_pred)
+    n = dag_pred.n
+    M = dag_pred.m * n
+    N = dag_pred.N
     cells = [goal]
     i, j, d = goal[0], goal[1], last
     while from_static[d * M + i * n + j]:  # back through the capped step N
@@ -282,7 +372,7 @@ def _unwind(goal: Cell, last: int, start: Cell, static_pred: npt.NDArray[np.int8
         d = p
         cells.append((i, j))
     for s in range(N, 0, -1):  # back through the DAG steps N .. 1
-        p = int(dag_pred[s - 1][d // 3, d % 3, i, j])
+        p = dag_pred.at(s, d, i, j)
         i, j = i - MOVES[d][0], j - MOVES[d][1]
         d = p
         cells.append((i, j))

@@ -62,9 +62,9 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                  "                    for (lo, hi), a in zip(left_box(s, v, k), anchor))\n"),)),
     CodeMutant("search_skips_rest_layer", "both searches take the rest layer as free",
                "impl/_search.py",
-               (("    free = np.ascontiguousarray(np.asarray(dr) == 0)\n",
-                 "    free = np.ascontiguousarray(np.asarray(dr) == 0)\n"
-                 "    free[N] = True  # mutant\n"),)),
+               (("    free = FreeLayers(dr)\n",
+                 "    free = FreeLayers(np.concatenate([np.asarray(dr)[:N],  # mutant\n"
+                 "                                      np.zeros_like(np.asarray(dr)[N:])]))\n"),)),
     CodeMutant("right_regions_turned_backwards", "the fast right regions turned by -t_i "
                "instead of t_i", "impl/_fast_regions.py",
                (("        ci, si, nsi = c[i], s[i], -s[i]\n",

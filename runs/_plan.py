@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import os
 import platform
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -30,7 +32,7 @@ from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
 from ..spec import Certificate, certificate_json, certify, contact_links_text, require_clear
 from ..spec import SearchResult, SearchStatus
 from ..spec import executed_trajectory, tolerance_rad, trajectory_csv
-from ..spec import ExactGaps, exact_path_gaps
+from ..spec import ExactGaps, exact_path_gaps, save_npz
 from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
                          checked_search, contracts_json, violation_json)
 
@@ -225,17 +227,24 @@ def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[...,
 
 
 def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
-              witness_bytes: bytes | None = None) -> dict[str, Any]:
+              witness_bytes: bytes | None = None, *, dr_sha256: str | None = None,
+              witness_sha256: str | None = None) -> dict[str, Any]:
     """The plan.json document of docs/model.md §9 (keys are stable: add, never rename).
 
-    ``witness_sha256`` (only when ``witness_bytes``, the witness file's, are given) is their
-    sha256, so that `cfmpa check --witness` can tell a witness file of another run.
+    ``witness_sha256`` (only when ``witness_bytes``, the witness file's, or the hash itself is
+    given) is their sha256, so that `cfmpa check --witness` can tell a witness file of another
+    run.
 
     ``dr_sha256`` is the sha256 of dr.npy's bytes (``dr_bytes``, by default ``npy_bytes(p.dr)``,
-    what write_plan writes), so that a dr.npy from another run is detectable. In ``clearance``,
+    what write_plan writes; or the hash itself, as write_plan gives it), so that a dr.npy from
+    another run is detectable. In ``clearance``,
     ``min_m`` / ``t_s`` are the least SAMPLED distance and its instant (an upper bound on the
     true minimum); ``lower_bound_m`` is the PROVED lower bound over every instant.
     """
+    if dr_sha256 is None:
+        dr_sha256 = hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest()
+    if witness_sha256 is None and witness_bytes is not None:
+        witness_sha256 = hashlib.sha256(witness_bytes).hexdigest()
     r = p.search
     found = r.status is SearchStatus.FOUND
     g = p.grid
@@ -253,7 +262,7 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
         "J2": r.J2 if found else None,
         "path_length": len(r.path),
         "free_fraction": p.free_fraction,
-        "dr_sha256": hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest(),
+        "dr_sha256": dr_sha256,
         "kernel": p.kernel,
         "clearance": certificate_json(p.certificate) if p.certificate is not None else None,
         "tolerance_rad": (tolerance_rad(p.scenario, p.certificate)
@@ -262,8 +271,7 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
         "contracts": p.contracts,
         "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
         "versions": versions(),
-    } | ({} if witness_bytes is None else
-         {"witness_sha256": hashlib.sha256(witness_bytes).hexdigest()})
+    } | ({} if witness_sha256 is None else {"witness_sha256": witness_sha256})
 
 
 #: The executed motion of a found path, beside plan.json (docs/model.md §9, §12).
@@ -277,23 +285,26 @@ def write_plan(p: PlanResult, out: str | Path, *,
     also DIR/traj.csv, its executed motion (one row per step, `cfmpa certify` reads it); with
     no path a traj.csv left by an earlier run is deleted. ``witness``: also write the search's
     witness there (npz, ``spec.Witness``; plan() with witness=True makes it), its hash in
-    plan.json as ``witness_sha256``."""
+    plan.json as ``witness_sha256``.
+
+    dr.npy and the witness are streamed to their files (the witness layer by layer,
+    ``spec.save_npz``) and hashed by reading the files back, so neither is held as bytes."""
     out = Path(out)
-    data = npy_bytes(p.dr)
-    proof = None
+    witness_sha = None
     if witness is not None:
         if p.search.witness is None:
             raise ValueError("write_plan(witness=...) needs a plan made with witness=True")
-        proof = p.search.witness.npz_bytes()
-        write_bytes_atomic(witness, proof)
-    dr_path = write_bytes_atomic(out / "dr.npy", data)
+        members = p.search.witness.npz_members()
+        _, witness_sha = _write_streamed(witness, lambda fh: save_npz(fh, members))
+    dr_path, dr_sha = _write_streamed(out / "dr.npy",
+                                      lambda fh: np.save(fh, p.dr, allow_pickle=False))
     if p.search.status is SearchStatus.FOUND:
         traj = executed_trajectory(p.scenario, p.grid, p.search.path)
         write_bytes_atomic(out / TRAJ_CSV, trajectory_csv(traj).encode())
     else:
         (out / TRAJ_CSV).unlink(missing_ok=True)
-    plan_path = write_bytes_atomic(out / "plan.json",
-                                   dumps_json(plan_json(p, data, proof)).encode())
+    doc = plan_json(p, dr_sha256=dr_sha, witness_sha256=witness_sha)
+    plan_path = write_bytes_atomic(out / "plan.json", dumps_json(doc).encode())
     return dr_path, plan_path
 
 
@@ -390,3 +401,27 @@ def clearance_line(c: Certificate) -> str:
                 f"{contact_links_text(d.links)}, {d.segment}; {sampled}")
     return (f"clearance NOT CLEAR: {len(c.undecided)} interval(s) neither proved clear nor in "
             f"contact, first {c.undecided[0]} s; {sampled}")
+
+
+def _write_streamed(path: str | Path, write: Callable[[Any], None]) -> tuple[Path, str]:
+    """``write(fh)`` into a temporary file beside ``path``, then renamed over it (as
+    cfmpa.files.write_bytes_atomic does for bytes); returns the path and the sha256 of the file
+    written, read back in chunks."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        os.chmod(tmp, 0o644)
+        with os.fdopen(fd, "w+b") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+            fh.seek(0)
+            digest = hashlib.sha256()
+            for chunk in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(chunk)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return target, digest.hexdigest()

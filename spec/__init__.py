@@ -26,6 +26,8 @@ from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightA
 from ._triples import (TRIPLES, Failure, Triple, builtdr_triple, cells_failures, cost_failures,
                        dr_cell_failures, dr_shape_failures, grid_failures, path_cells,
                        search_failures, search_triple)
+from ._layers import (SPILL_BYTES, LayerSpill, Layers, npz_layers, npz_member, save_npz,
+                      spill_wanted)
 from ._witness import (KEY_BASE, LABEL_LIMITS, WITNESS_FORMAT, Witness, check_witness,
                        closure_breaks, edge_bound, edge_holds, exclusion_breaks, goal_holds,
                        label_in_range, label_key, load_witness, start_breaks, step_cost,
@@ -59,6 +61,9 @@ __all__ = [
     # its conditions, on numpy arrays and on Z3 terms (proofs/_obl_witness.py)
     "KEY_BASE", "closure_breaks", "edge_bound", "edge_holds", "exclusion_breaks", "goal_holds",
     "label_in_range", "label_key", "start_breaks", "step_cost", "stop_key",
+    # arrays read one layer at a time (the witness on large grids)
+    "SPILL_BYTES", "LayerSpill", "Layers", "npz_layers", "npz_member", "save_npz",
+    "spill_wanted",
     # the path's cells re-decided in ball arithmetic (docs/model.md §7)
     "ExactCell", "ExactGaps", "exact_path_gaps",
     # trajectories and the tolerance tube (docs/model.md §12)

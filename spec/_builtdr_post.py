@@ -12,6 +12,7 @@ regions, leaving to ``expected_cells`` the cells no bound decides (tests check t
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,27 +80,71 @@ def dr_postcondition(s: Scenario, variant: Variant | str, grid: Grid, dr: npt.ND
     mismatches, each with the definition's distance (the count of checked cells is exact).
     """
     if cells is None:
-        expected, near = (a.ravel() for a in full_verdicts(s, variant, grid, eps=eps, band=band))
-        got = np.asarray(dr).reshape(-1).astype(np.int8)
-        checked = got.size
-    else:
-        k, i, j = cells[:, 0], cells[:, 1], cells[:, 2]
-        dist = expected_cells(s, variant, grid, k, i, j)
-        expected = (dist <= eps).astype(np.int8)
-        near = np.abs(dist - eps) <= band
-        got = dr[k, i, j].astype(np.int8)
-        checked = len(k)
+        return _all_cells(s, variant, grid, dr, eps, band, limit)
+    k, i, j = cells[:, 0], cells[:, 1], cells[:, 2]
+    dist = expected_cells(s, variant, grid, k, i, j)
+    expected = (dist <= eps).astype(np.int8)
+    near = np.abs(dist - eps) <= band
+    got = dr[k, i, j].astype(np.int8)
     bad = np.flatnonzero((got != expected) & ~near)
     shown = bad[:limit]
-    at = np.unravel_index(shown, grid.shape) if cells is None else (k[shown], i[shown], j[shown])
+    return _report(s, variant, grid, len(bad) == 0, len(k), int(((got != expected) & near).sum()),
+                   (k[shown], i[shown], j[shown]), got[shown], expected[shown])
+
+
+def _all_cells(s: Scenario, variant: Variant | str, grid: Grid, dr: npt.NDArray[np.uint8],
+               eps: float, band: float, limit: int) -> PostReport:
+    """dr_postcondition at every cell, a layer at a time: the bounds' verdicts of one layer
+    (``_layer_bounds``) against dr[k], so that no D_R-sized temporary is made. The cells no
+    bound decides are gathered and decided by the definition at the end, in one call, as
+    ``full_verdicts`` does; the mismatches shown are the first ``limit`` in (k, i, j) order,
+    the same as over the whole array."""
+    N, m, n = grid.N, grid.m, grid.n
+    bad_count = 0
+    shown: list[tuple[int, int]] = []       # (flat index, expected) of the first bad cells
+    open_k, open_c = [], []
+    for k, meets, undecided in _layer_bounds(s, variant, grid, eps, band):
+        got = np.asarray(dr[k]).reshape(m * n).astype(np.int8)
+        wrong = np.flatnonzero((got != meets) & ~undecided)
+        bad_count += wrong.size
+        if len(shown) < limit:
+            c = wrong[:limit - len(shown)]
+            shown.extend(zip((k * m * n + c).tolist(), meets[c].astype(int).tolist()))
+        c = np.flatnonzero(undecided)
+        open_k.append(np.full(c.size, k, dtype=np.int64))
+        open_c.append(c)
+    kk, cc = np.concatenate(open_k), np.concatenate(open_c)
+    indeterminate = 0
+    if kk.size:
+        dist = expected_cells(s, variant, grid, kk, cc // n, cc % n)
+        want = (dist <= eps).astype(np.int8)
+        near = np.abs(dist - eps) <= band
+        got = np.asarray(dr)[kk, cc // n, cc % n].astype(np.int8)
+        wrong = (got != want) & ~near
+        bad_count += int(wrong.sum())
+        indeterminate = int(((got != want) & near).sum())
+        shown.extend(zip((kk * m * n + cc)[wrong].tolist(), want[wrong].astype(int).tolist()))
+    shown = sorted(shown)[:limit]
+    flat = np.asarray([f for f, _ in shown], dtype=np.int64)
+    at = np.unravel_index(flat, (N + 1, m, n))
+    got = np.asarray(dr)[at].astype(np.int8)
+    expected = np.asarray([e for _, e in shown], dtype=np.int8)
+    return _report(s, variant, grid, bad_count == 0, (N + 1) * m * n, indeterminate, at, got,
+                   expected)
+
+
+def _report(s: Scenario, variant: Variant | str, grid: Grid, ok: bool, checked: int,
+            indeterminate: int, at: tuple[npt.NDArray[np.int64], ...],
+            got: npt.NDArray[np.int8], expected: npt.NDArray[np.int8]) -> PostReport:
+    """The report, its mismatches at the cells ``at`` (k, i, j) with the definition's distance."""
     dist_shown = expected_cells(s, variant, grid, *at)
     mismatches = tuple(
         CellMismatch(layer=int(kk), cell=(int(ii), int(jj)),
-                     angles=grid.angles((int(ii), int(jj))), got=int(got[c]),
-                     expected=int(expected[c]), distance_m=float(d))
-        for c, kk, ii, jj, d in zip(shown, *at, dist_shown))
-    return PostReport(ok=len(bad) == 0, checked=checked,
-                      indeterminate=int(((got != expected) & near).sum()), mismatches=mismatches)
+                     angles=grid.angles((int(ii), int(jj))), got=int(g), expected=int(e),
+                     distance_m=float(d))
+        for kk, ii, jj, g, e, d in zip(*at, got, expected, dist_shown))
+    return PostReport(ok=ok, checked=checked, indeterminate=indeterminate,
+                      mismatches=mismatches)
 
 
 # --- every cell, vectorised ------------------------------------------------------------------
@@ -133,14 +178,31 @@ def full_verdicts(s: Scenario, variant: Variant | str, grid: Grid, *, eps: float
     """For every cell (N + 1, m, n): the expected D_R value (dist <= eps -> 1 | 0) and whether it
     is indeterminate (|dist - eps| <= band), as ``expected_cells`` decides them."""
     N, m, n = grid.N, grid.m, grid.n
+    expected = np.zeros((N + 1, m * n), dtype=np.int8)
+    undecided = np.zeros((N + 1, m * n), dtype=bool)
+    for k, meets, unsure in _layer_bounds(s, variant, grid, eps, band):
+        expected[k] = meets
+        undecided[k] = unsure
+    near = np.zeros((N + 1, m * n), dtype=bool)
+    kk, cc = np.nonzero(undecided)
+    if kk.size:
+        dist = expected_cells(s, variant, grid, kk, cc // n, cc % n)
+        expected[kk, cc] = dist <= eps
+        near[kk, cc] = np.abs(dist - eps) <= band
+    return expected.reshape(N + 1, m, n), near.reshape(N + 1, m, n)
+
+
+def _layer_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, band: float
+                  ) -> Iterator[tuple[int, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]]:
+    """Per layer k: (k, blocked by the bounds (m n,), left undecided by them (m n,)); a cell
+    undecided is not blocked. The decisions of ``full_verdicts``, one layer at a time."""
+    m, n = grid.m, grid.n
     left = left_region_polygons(s, variant, grid)
     rows = np.arange(m)
     r1, _ = right_region_polygons(s, grid, rows, np.zeros_like(rows))
     b1 = shapely.bounds(r1)
     free_at = eps + band + SLACK
     link2 = _Link2(s, grid)
-    expected = np.zeros((N + 1, m * n), dtype=np.int8)
-    undecided = np.zeros((N + 1, m * n), dtype=bool)
     for k, links in enumerate(left):
         d1 = np.full(m, np.inf)        # inf: more than free_at (the boxes' gap shows it)
         for a in links:
@@ -152,15 +214,7 @@ def full_verdicts(s: Scenario, variant: Variant | str, grid: Grid, *, eps: float
             hit, open_ = link2.decide(a, free_at, meets)
             meets |= hit
             unsure |= open_
-        expected[k] = meets
-        undecided[k] = unsure & ~meets
-    near = np.zeros((N + 1, m * n), dtype=bool)
-    kk, cc = np.nonzero(undecided)
-    if kk.size:
-        dist = expected_cells(s, variant, grid, kk, cc // n, cc % n)
-        expected[kk, cc] = dist <= eps
-        near[kk, cc] = np.abs(dist - eps) <= band
-    return expected.reshape(N + 1, m, n), near.reshape(N + 1, m, n)
+        yield k, meets, unsure & ~meets
 
 
 def _box_gap(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

@@ -298,12 +298,18 @@ def dr_shape_failures(grid: Grid, dr: Any, condition: str = "post.shape") -> lis
         return [Failure(condition, "D_R has the wrong shape or element type",
                         (("shape", list(shape)), ("expected shape", list(grid.shape)),
                          ("dtype", str(dtype)), ("expected dtype", "uint8")))]
-    bad = np.flatnonzero(np.asarray(dr).ravel() > 1)
-    if len(bad):
-        k, i, j = np.unravel_index(int(bad[0]), grid.shape)
+    a = np.asarray(dr)
+    count, first = 0, None
+    for layer in range(a.shape[0]):          # a layer at a time: no D_R-sized temporary
+        bad = np.flatnonzero(a[layer].ravel() > 1)
+        count += bad.size
+        if bad.size and first is None:
+            first = (layer, *np.unravel_index(int(bad[0]), a.shape[1:]))
+    if first is not None:
+        k, i, j = (int(x) for x in first)
         return [Failure(condition, "D_R holds values other than 0 and 1",
-                        (("layer", int(k)), ("cell", [int(i), int(j)]),
-                         ("value", int(dr[k, i, j]))), count=len(bad))]
+                        (("layer", k), ("cell", [i, j]), ("value", int(dr[k, i, j]))),
+                        count=count)]
     return []
 
 

@@ -69,6 +69,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
+from ._layers import Layers, npz_member
 from ._paths import J1, J2, MOVES, SearchResult, SearchStatus, path_violations
 from ._triples import Failure
 
@@ -177,11 +178,15 @@ class Witness:
             return {"j1": self.j1, "j2": self.j2}
         return {"reachable": self.reachable}
 
+    def npz_members(self) -> dict[str, Any]:
+        """The witness file's members: ``format``, ``kind`` and the arrays (``npz_bytes`` writes
+        them whole, ``spec.save_npz`` layer by layer)."""
+        return {"format": np.array(WITNESS_FORMAT), "kind": np.array(self.kind), **self.arrays}
+
     def npz_bytes(self) -> bytes:
         """The witness file: an uncompressed npz with ``format``, ``kind`` and the arrays."""
         buf = io.BytesIO()
-        np.savez(buf, format=np.array(WITNESS_FORMAT), kind=np.array(self.kind),
-                 **self.arrays)
+        np.savez(buf, **self.npz_members())
         return buf.getvalue()
 
 
@@ -197,7 +202,8 @@ def load_witness(path: str | Path) -> Witness:
         if not isinstance(z, np.lib.npyio.NpzFile):
             raise bad("witness", MISSING, "is not an .npz witness file (a single array)")
         with z:
-            members = {k: z[k] for k in z.files}
+            # Large members are read in place, a layer at a time (spec._layers).
+            members = {k: npz_member(path, z, k) for k in z.files}
     except OSError as exc:
         raise bad("witness", MISSING, f"cannot be read ({exc.strerror or exc})") from None
     except (ValueError, zipfile.BadZipFile, EOFError) as exc:
@@ -218,7 +224,8 @@ def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
                   result: SearchResult, witness: Witness | None) -> list[Failure]:
     """The first failing condition of the module docstring, or [] when the witness proves the
     answer: a found path optimal, or no path valid. ``dr`` is a 0/1 array (N + 1, m, n)."""
-    free = np.asarray(dr) == 0
+    dr = np.asarray(dr)
+    free = Layers(dr.shape, np.bool_, lambda s: dr[s] == 0)   # one layer at a time (§11)
     N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
     start, goal = (int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))
     found = result.status is SearchStatus.FOUND
@@ -228,7 +235,7 @@ def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
                       f"'{want}' witness", ("witness", None if witness is None else witness.kind))]
     shape = (N + 1, 9, m, n)
     bad = [(k, a) for k, a in witness.arrays.items()
-           if not isinstance(a, np.ndarray) or a.shape != shape
+           if not isinstance(a, (np.ndarray, Layers)) or a.shape != shape
            or (a.dtype != np.bool_ if k == "reachable" else a.dtype.kind != "u")
            or (k == "j2" and a.dtype != witness.j1.dtype)]
     if bad:
@@ -271,7 +278,8 @@ def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
     if edge:
         return edge
     path = list(result.path)
-    bad = path_violations(path, free.astype(np.uint8) ^ 1, start, goal)
+    blocked = free.map(lambda a: (~a).astype(np.uint8), np.uint8)
+    bad = path_violations(path, blocked, start, goal)
     if bad:
         return [_fail("path", f"the returned path is not valid: {bad[0].message}",
                       ("clause", bad[0].clause), ("failed clauses", len(bad)))]
