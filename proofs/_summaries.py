@@ -151,6 +151,9 @@ SUMMARIES: dict[str, str] = {
     "Tolerance.tube": "A robot that tracks a plan proved clear by c to within delta in every "
                       "joint cannot collide while c > 2 L delta, L the largest reach of a link "
                       "about its two joints (metres per radian).",
+    "Monitor.between_samples": "Between two measured samples, a robot and a plan that each "
+                               "move at most their speed limit stay within the larger sampled "
+                               "deviation plus their speeds times half the gap.",
     # End-to-end safety
     "Safety.original.principal_in_layer_box": _IN_BOX.format(variant="original"),
     "Safety.modified.principal_in_layer_box": _IN_BOX.format(variant="modified"),
@@ -163,7 +166,9 @@ SUMMARIES: dict[str, str] = {
                                "inside the swept region the planner builds for that box: the "
                                "margin it adds covers the motion between the grid's sample "
                                "angles.",
-    "Safety.separation": "Two links lying in regions more than 1e-9 m apart share no point.",
+    "Safety.separation": "A pair of regions the planner frees, its rounded distance above "
+                         "1e-9 m, is truly apart, since rounding errs by under 3e-11 m; links "
+                         "in regions apart share no point.",
     "Safety.original.composition": _COMPOSED.format(variant="original"),
     "Safety.modified.composition": _COMPOSED.format(variant="modified"),
     "Safety.tight.composition": _COMPOSED.format(variant="tight"),
