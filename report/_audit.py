@@ -110,8 +110,10 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
               scenarios_dir: str | None = None,
               contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
               compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
-              campaign: str | Path | None = None, progress: TextIO | None = None) -> int:
-    """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary.
+              campaign: str | Path | None = None, progress: TextIO | None = None,
+              stdout: TextIO | None = None) -> int:
+    """Write ``out_dir``/report.json and ``out_dir``/report.html (each atomically); print a summary
+    on ``stdout`` (default sys.stdout), and a line per stage with its time on ``progress``.
 
     ``scenarios``: scenario files (None: every scenarios/*.toml). ``proofs_json``: a results.json
     of ``make prove`` to report (None: run the obligations afresh). Exit code 0 when everything
@@ -129,11 +131,14 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
     with stages.stage("write report.html and report.json"):
         html_path, json_path = write_report(result, out_dir)
     stages.total()
+    import sys
+
+    so = sys.stdout if stdout is None else stdout
     v = result.doc["verdict"]
     for item in v["items"]:
         state = {True: "ok", False: "FAILED", None: "not available"}[item["ok"]]
-        print(f"{item['check']:<38} {state}: {item['detail']}")
-    print(f"wrote     {html_path} ({html_path.stat().st_size} bytes), {json_path}")
+        print(f"{item['check']:<38} {state}: {item['detail']}", file=so)
+    print(f"wrote     {html_path} ({html_path.stat().st_size} bytes), {json_path}", file=so)
     return 0 if v["ok"] else 1
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 
@@ -145,24 +145,27 @@ def format_campaign(doc: dict[str, Any]) -> str:
 def run_compare(n: int = 100, seed: int = 0, out: str | None = None, *, dt: float = COMPARE_DT,
                 workers: int = 0, scheduler: str | None = None,
                 connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool | None = None,
-                _faults: Mapping[int, str] | None = None,
+                stdout: TextIO | None = None, _faults: Mapping[int, str] | None = None,
                 _after_record: Callable[[int], None] | None = None) -> int:
-    """Run a campaign (see ``run_campaign``), print its table; write ``out``/compare.json
-    (atomically) when ``out`` is given, with the store ``out``/compare.jsonl beside it.
+    """Run a campaign (see ``run_campaign``), print its table on ``stdout`` (default
+    sys.stdout); write ``out``/compare.json (atomically) when ``out`` is given, with the store
+    ``out``/compare.jsonl beside it.
 
     Exit code 0 when every check of ``campaign_json`` counts 0 and no workcell raised, else 1.
     """
+    so = sys.stdout if stdout is None else stdout
     c = run_campaign(n, seed, dt, workers=workers, scheduler=scheduler, out=out,
-                     connect_timeout=connect_timeout, progress=progress, stream=sys.stdout,
+                     connect_timeout=connect_timeout, progress=progress, stream=so,
                      _faults=_faults, _after_record=_after_record)
     doc = campaign_json(c)
-    print(format_campaign(doc))
+    print(format_campaign(doc), file=so)
     if out is not None:
         path = write_bytes_atomic(Path(out) / "compare.json", dumps_json(doc).encode())
-        print(f"wrote     {path}")
+        print(f"wrote     {path}", file=so)
     t = c.timings_s
     print(f"time      {t.get('run', 0.0):.1f} s: {c.n - c.reused} workcell(s) planned in "
-          f"{t.get('tasks', 0.0):.1f} s after {t.get('engine_start', 0.0):.1f} s of engine start")
+          f"{t.get('tasks', 0.0):.1f} s after {t.get('engine_start', 0.0):.1f} s of engine start",
+          file=so)
     return 0 if doc["checks_ok"] and not doc["errors"] else 1
 
 

@@ -20,7 +20,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from ..errors import CfmpaError, InputError
 
@@ -331,18 +331,19 @@ def code_mutation_table(rows: Sequence[CodeRow]) -> str:
 
 def run_code_selftest(names: Sequence[str] | None = None, *,
                       checks: Sequence[str] = CODE_CHECKS, prove_only: Sequence[str] = (),
-                      json_out: str | None = None) -> int:
-    """`cfmpa selftest --code`: the table, and JSON if asked; 0 iff cfmpa prove caught every
-    mutant run (1 otherwise)."""
+                      json_out: str | None = None, stdout: TextIO | None = None) -> int:
+    """`cfmpa selftest --code`: the table on ``stdout`` (default sys.stdout), and JSON if asked;
+    0 iff cfmpa prove caught every mutant run (1 otherwise)."""
     from ..files import write_bytes_atomic
 
+    so = sys.stdout if stdout is None else stdout
     _chosen(names, checks)
     print(f"seeded source mutations of a copy of the packages; checks: {', '.join(checks)}",
-          flush=True)
+          file=so, flush=True)
     if prove_only:
-        print(f"cfmpa prove on {', '.join(prove_only)} only (not the whole run)")
-    rows = code_mutation_rows(names, checks=checks, prove_only=prove_only, stream=sys.stdout)
-    print(code_mutation_table(rows))
+        print(f"cfmpa prove on {', '.join(prove_only)} only (not the whole run)", file=so)
+    rows = code_mutation_rows(names, checks=checks, prove_only=prove_only, stream=so)
+    print(code_mutation_table(rows), file=so)
     if json_out is not None:
         doc = {"checks": list(checks), "prove_only": list(prove_only),
                "mutants": [{"mutant": r.mutant, "what": r.what, "caught": r.caught,
@@ -353,6 +354,6 @@ def run_code_selftest(names: Sequence[str] | None = None, *,
         return 0
     missed = [r.mutant for r in rows if not r.caught.get("prove")]
     if missed:
-        print(f"NOT CAUGHT by cfmpa prove: {', '.join(missed)}")
+        print(f"NOT CAUGHT by cfmpa prove: {', '.join(missed)}", file=so)
         return 1
     return 0

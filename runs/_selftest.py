@@ -22,7 +22,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from fractions import Fraction
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 import numpy.typing as npt
@@ -338,14 +338,18 @@ def selftest_table(rows: tuple[SelftestRow, ...], *, sample: int = SAMPLE, seed:
     return "\n".join(out)
 
 
-def run_selftest() -> int:
-    """`cfmpa selftest`: seed every fault, print the table; 0 iff full mode caught every one."""
+def run_selftest(*, stdout: TextIO | None = None) -> int:
+    """`cfmpa selftest`: seed every fault, print the table on ``stdout`` (default sys.stdout);
+    0 iff full mode caught every one."""
+    import sys
+
+    so = sys.stdout if stdout is None else stdout
     rows = selftest_rows()
-    print(selftest_table(rows))
+    print(selftest_table(rows), file=so)
     missed = [r.fault for r in rows if not r.caught_full]
     if missed:
-        print(f"NOT CAUGHT in full mode: {', '.join(missed)}")
+        print(f"NOT CAUGHT in full mode: {', '.join(missed)}", file=so)
         return 1
     print(f"all {len(rows)} faults caught in full mode; "
-          f"{sum(r.caught_sampled for r in rows)} of {len(rows)} in sampled mode")
+          f"{sum(r.caught_sampled for r in rows)} of {len(rows)} in sampled mode", file=so)
     return 0

@@ -595,4 +595,8 @@ def test_the_commands_runs_print_on_the_streams_they_are_given(tiny_file, tmp_pa
                      stdout=out) == 0
     assert "result: all checks hold" in out.getvalue()
     assert run_scenarios(stdout=out) == 0 and "bundled scenarios in" in out.getvalue()
+    from cfmpa.report import run_compare
+
+    assert run_compare(n=1, dt=0.5, workers=0, progress=False, stdout=out) == 0
+    assert "workcell(s) planned in" in out.getvalue()
     assert capsys.readouterr() == ("", "")        # nothing went to the process's own streams
