@@ -203,7 +203,7 @@ def cmd_prove(args: argparse.Namespace) -> int:
             if stopped.is_set():
                 os._exit(1)
 
-            def again() -> int:
+            def again(exc: BaseException = exc) -> int:  # bound now: `except ... as` unbinds it
                 raise exc
             code = _handled(again)
         sys.stdout.flush()

@@ -48,6 +48,7 @@ def _prepare(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness:
     _check_size(N, m, n)
     labels = WitnessLabels(N, m, n) if with_witness else None
     if reason == REASON_START_BLOCKED:
+        assert labels is not None                  # without a witness it returned above
         return (), replace(SearchResult.no_path(reason), witness=labels.witness(found=False))
     return (N, m, n, start, goal, free, reason, labels), None
 
@@ -66,11 +67,12 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
 
     Ties (deterministic), on the returned list L: it never waits at a step >= N before its end,
     L_{k+1} != L_k for N <= k < len - 1 (dropping such a wait keeps a path valid and costs no
-    more), and among the optimal lists that do not, it is the least by this order. Pad L with the goal to N + 1 cells if shorter (the arm
-    holds it until the principal stops): cells L_0 .. L_T, T = max(len - 1, N), moves
-    d_k = L_{k+1} - L_k. Rank the last move d_{T-1} by its index in MOVES; rank each earlier
-    d_k by its index if it arrives before step N (k + 1 < N), by 9 + its index if it arrives at
-    step N or later. The ranks read backwards, d_{T-1} first, are lexicographically least.
+    more), and among the optimal lists that do not, it is the least by this order. Pad L with the
+    goal to N + 1 cells if shorter (the arm holds it until the principal stops): cells L_0 .. L_T,
+    T = max(len - 1, N), moves d_k = L_{k+1} - L_k. Rank the last move d_{T-1} by its index in
+    MOVES; rank each earlier d_k by its index if it arrives before step N (k + 1 < N), by 9 + its
+    index if it arrives at step N or later. The ranks read backwards, d_{T-1} first, are
+    lexicographically least.
     (Internally: the least last move over the goal states; then, for each state, its optimal
     predecessor with the state at step N itself before one at a later step, then the one with
     the least previous move.)
@@ -269,7 +271,8 @@ def _push(buckets: dict[int, list[IntArray]], states: IntArray, keys: IntArray) 
 
 
 def _unwind(goal: Cell, last: int, start: Cell, static_pred: npt.NDArray[np.int8],
-            from_static: BoolArray, dag_pred: list[npt.NDArray[np.int8]]) -> list[Cell]:
+            from_static: BoolArray,
+            dag_pred: list[npt.NDArray[np.int8]] | npt.NDArray[np.int8]) -> list[Cell]:
     """The cells of the optimal path, from the predecessor moves, without trailing waits."""
     m, n = dag_pred[0].shape[2:]
     M = m * n

@@ -172,7 +172,7 @@ class Witness:
         return cls("reachable", reachable=reachable)
 
     @property
-    def arrays(self) -> dict[str, Array]:
+    def arrays(self) -> dict[str, Array | None]:
         if self.kind == "labels":
             return {"j1": self.j1, "j2": self.j2}
         return {"reachable": self.reachable}
@@ -180,8 +180,8 @@ class Witness:
     def npz_bytes(self) -> bytes:
         """The witness file: an uncompressed npz with ``format``, ``kind`` and the arrays."""
         buf = io.BytesIO()
-        np.savez(buf, format=np.array(WITNESS_FORMAT), kind=np.array(self.kind),
-                 **self.arrays)
+        arrays: dict[str, Any] = self.arrays   # not matched against savez's allow_pickle: bool
+        np.savez(buf, format=np.array(WITNESS_FORMAT), kind=np.array(self.kind), **arrays)
         return buf.getvalue()
 
 
@@ -205,8 +205,8 @@ def load_witness(path: str | Path) -> Witness:
     tag = members.get("format")
     if tag is None or tag.shape != () or str(tag) != WITNESS_FORMAT:
         raise bad("format", None if tag is None else str(tag), f"must be {WITNESS_FORMAT!r}")
-    kind = members.get("kind")
-    kind = None if kind is None or kind.shape != () else str(kind)
+    kind_array = members.get("kind")
+    kind = None if kind_array is None or kind_array.shape != () else str(kind_array)
     if kind == "labels" and {"j1", "j2"} <= set(members):
         return Witness.of_labels(members["j1"], members["j2"])
     if kind == "reachable" and "reachable" in members:
@@ -334,6 +334,7 @@ def _check_edges(free: Array, j1: Array, j2: Array) -> list[Failure]:
     to = (i + int(_DI[d]), j + int(_DJ[d]))
     cost = [int(_NORM[d]), int(_TURN[p, d])]
     have = _label(j1, j2, (s, p, i, j))
+    assert have is not None                        # s is a labelled state (``src`` above)
     return [_fail("edge", "a free edge breaks label[s'] <= label[s] + cost(s, s')",
                   ("state", _state(s, (i, j), p)), ("label", have), ("move", list(MOVES[d])),
                   ("edge cost", cost), ("to state", _state(t, to, d)),
