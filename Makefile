@@ -4,12 +4,12 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: prove test test-slow bench mutants clean
+.PHONY: prove test test-slow lint bench mutants clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet -e '.[test,lint]'
 	touch $(STAMP)
 
 prove: $(STAMP)
@@ -20,6 +20,16 @@ test: $(STAMP)
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -m slow
+
+# ruff and mypy as configured in pyproject.toml. mypy reads the installed package names
+# (spec/ is cfmpa.spec, ...): build/typecheck/cfmpa links the folders into that tree.
+TYPECHECK := build/typecheck/cfmpa
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	rm -rf $(TYPECHECK) && mkdir -p $(TYPECHECK)
+	for f in cfmpa/*; do ln -s ../../../$$f $(TYPECHECK)/; done
+	for d in spec impl proofs runs report scenarios; do ln -s ../../../$$d $(TYPECHECK)/$$d; done
+	$(VENV)/bin/mypy
 
 bench: $(STAMP)
 	$(PY) bench/run.py --prove

@@ -16,7 +16,8 @@ import tempfile
 import time
 import tomllib
 from pathlib import Path
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 

@@ -15,8 +15,9 @@ from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin
 
 __all__ = [
     "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "RightRegions", "build_dr",
-    "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly", "containment_slack", "convex_hull",
-    "kernel_name", "kernel_threads", "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
-    "naive_hull", "progress_default", "progress_silenced", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
+    "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly",
+    "containment_slack", "convex_hull", "kernel_name", "kernel_threads", "kernels", "lattice_range",
+    "left_regions", "left_spacing", "link_reach", "link_rectangles", "naive_hull", "progress_default",
+    "progress_silenced", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
     "set_kernel_threads", "swept_region",
 ]

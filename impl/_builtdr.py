@@ -19,7 +19,7 @@ from ..spec import (EPS, Grid, Scenario, Variant, left_angles, left_box, make_gr
                     rest_box)
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._kinematics import link_rectangles
-from ._regions import Box, Polygon, convex_hull, swept_lattice, swept_points
+from ._regions import Angles, Box, Polygon, convex_hull, swept_lattice, swept_points
 
 __all__ = [
     "LeftRegions",
@@ -78,7 +78,7 @@ def left_regions_by(hull: Callable[[npt.NDArray[np.float64]], Polygon], s: Scena
     g = grid or make_grid(s)
     spacing = left_spacing(s)
 
-    def region(link: int, box: Box, anchor: Sequence[float]) -> Polygon:
+    def region(link: int, box: Box, anchor: Angles) -> Polygon:
         return hull(swept_points(s.left, link, box, anchor, spacing, margin_scale=margin_scale))
     out = []
     for k in range(g.N):

@@ -14,7 +14,8 @@ uses) and decision (``blocked_against``); the tests check it bit-identical to ``
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 

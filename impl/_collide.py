@@ -46,7 +46,7 @@ class PolygonSet:
     hi: npt.NDArray[np.float64]
 
     @classmethod
-    def of(cls, verts: npt.ArrayLike) -> "PolygonSet":
+    def of(cls, verts: npt.ArrayLike) -> PolygonSet:
         v = np.asarray(verts, dtype=float)
         edges = np.roll(v, -1, axis=-2) - v
         length = np.hypot(edges[..., 0], edges[..., 1])
@@ -59,7 +59,7 @@ class PolygonSet:
     def __len__(self) -> int:
         return len(self.verts)
 
-    def take(self, idx: npt.NDArray[np.int64]) -> "PolygonSet":
+    def take(self, idx: npt.NDArray[np.int64]) -> PolygonSet:
         return PolygonSet(self.verts[idx], self.normals[idx], self.offsets[idx], self.ok[idx],
                           self.lo[idx], self.hi[idx])
 

@@ -56,6 +56,7 @@ __all__ = [
 
 Polygon = npt.NDArray[np.float64]  # (V, 2), counter-clockwise, no repeated vertex
 Box = tuple[tuple[float, float], tuple[float, float]]
+Angles = Sequence[float] | npt.NDArray[np.float64]  # (theta1, theta2), e.g. spec.left_angles's
 
 #: Relative tolerance for snapping a box end onto a lattice point; its cost (SNAP * g * R) is
 #: added to the margin so that snapping never loses soundness.
@@ -126,14 +127,14 @@ def sweep_margin(arm: Arm, link: int, g: Sequence[float], moving: Sequence[bool]
     return delta
 
 
-def swept_region(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequence[float], *,
+def swept_region(arm: Arm, link: int, box: Box, anchor: Angles, g: Sequence[float], *,
                  margin_scale: float = 1.0) -> Polygon:
     """A convex polygon containing link ``link`` at every configuration in ``box`` (sound for
     ``margin_scale`` >= 1; a smaller scale exists to seed faults that the checks must catch)."""
     return convex_hull(swept_points(arm, link, box, anchor, g, margin_scale=margin_scale))
 
 
-def swept_points(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequence[float], *,
+def swept_points(arm: Arm, link: int, box: Box, anchor: Angles, g: Sequence[float], *,
                  margin_scale: float = 1.0) -> npt.NDArray[np.float64]:
     """The points (P, 2) whose convex hull is ``swept_region``: the grown rectangles' corners
     at the box's lattice points."""
@@ -141,7 +142,7 @@ def swept_points(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequ
     return link_rectangles(arm, t1, t2, link, grow=grow).reshape(-1, 2)
 
 
-def swept_lattice(arm: Arm, link: int, box: Box, anchor: Sequence[float], g: Sequence[float], *,
+def swept_lattice(arm: Arm, link: int, box: Box, anchor: Angles, g: Sequence[float], *,
                   margin_scale: float = 1.0
                   ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float]:
     """The lattice configurations (theta1, theta2 grids) sampled for ``swept_region`` and the

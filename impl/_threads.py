@@ -17,8 +17,9 @@ import numba
 
 __all__ = ["kernel_threads", "parallel", "set_kernel_threads"]
 
-if numba.config.THREADING_LAYER == "default":
-    numba.config.THREADING_LAYER = "forksafe"
+# numba.config's settings are set from the environment at import time: no static attributes.
+if numba.config.THREADING_LAYER == "default":  # type: ignore[attr-defined]
+    numba.config.THREADING_LAYER = "forksafe"  # type: ignore[attr-defined]
 _LOCK = threading.Lock()
 
 #: Two where the machine has two cores or more; one in processes that run side by side (the
@@ -43,7 +44,8 @@ def parallel(kernel: Callable[..., Any], *args: Any) -> Any:
     """``kernel(*args)`` on kernel_threads() threads (numba's setting is per calling thread)."""
     with _LOCK:
         before = numba.get_num_threads()
-        numba.set_num_threads(min(_THREADS[0], numba.config.NUMBA_NUM_THREADS))
+        numba.set_num_threads(min(_THREADS[0],
+                                  numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]
         try:
             return kernel(*args)
         finally:

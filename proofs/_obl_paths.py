@@ -272,8 +272,8 @@ def _def4_off_grid() -> Z3Query:
         cells = [(int(str(ev(L.xs[q]))), int(str(ev(L.ys[q])))) for q in range(3)]
         return (f"N = m = n = 3, every cell of every layer blocked (P = 1), start (0, 0), goal "
                 f"(2, 2): L = {cells} passes the printed is_path, since a step is constrained only "
-                "when both its cells are grid cells; it leaves the grid (under the fixed is_path nothing passes: the start is "
-                "blocked at step 0)")
+                "when both its cells are grid cells; it leaves the grid (under the fixed is_path "
+                "nothing passes: the start is blocked at step 0)")
     return Z3Query((VC("off_grid", hyps, goal),), render=render)
 
 

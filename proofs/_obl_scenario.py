@@ -228,7 +228,8 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "delta plus the snap slack SNAP g R per joint (ledger A10), exactly up "
                        "to 2^-48 relative float rounding (ledger A2).",
                        D, P, lambda f=f: _query(f, _margin_side, "margin_side")),
-            Obligation(scenario_check_id(f.stem, "containment"), group, "docs/model.md §4 (containment chain)",
+            Obligation(scenario_check_id(f.stem, "containment"), group,
+                       "docs/model.md §4 (containment chain)",
                        f"{f.name}: region_tight ⊆ region_modified ⊆ region_original on the computed "
                        "polygons, every layer and the rest layer, both links: every vertex of the "
                        "inner polygon on the inner side of every edge of the outer one, decided "

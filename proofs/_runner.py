@@ -5,7 +5,8 @@ The run passes only if every verdict is the one pinned in EXPECTED_VERDICTS (and
 repeats: the fixed ids below plus one per check (CHECKS) and scenario, by name for the bundled
 folder's scenarios (so a deleted file is a missing id) and per file found for any other folder
 (said in the report). Nothing can be dropped silently. Every obligation's query is saved under
-the output directory with its sha256, and results.json says which obligations are new, changed or the same since last time.
+the output directory with its sha256, and results.json says which obligations are new, changed or
+the same since last time.
 """
 
 from __future__ import annotations
@@ -238,7 +239,7 @@ def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
     """What these results are of: the date, the checkout's commit and cleanliness, and the
     sha256 of every scenario file read, so a report can tell results of another tree."""
     git = git_state(repo_root())
-    return {"date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+    return {"date_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
             "git": {"commit": git["commit"], "clean": git["clean"]},
             "scenarios": {f.name: hashlib.sha256(f.read_bytes()).hexdigest()
                           for f in scenario_files(scenarios_dir)}}

@@ -45,6 +45,6 @@ def provenance(argv: Sequence[str] | None, scenarios: Sequence[Any]) -> dict[str
         "versions": dict(sorted(v.items())),
         "git": git_state(repo),
         "command_line": shlex.join(args),
-        "date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "date_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "scenarios": [{"name": s.name, "path": s.source, "sha256": s.sha256} for s in scenarios],
     }

@@ -289,8 +289,8 @@ def _close(a: Any, b: float) -> bool:
 
 
 def _grid_line(g: Grid, claimed: dict[str, Any]) -> CheckLine:
-    want = g.as_json()
-    wrong = []
+    want: dict[str, Any] = g.as_json()
+    wrong: list[tuple[str, Any]] = []
     for key in ("N", "m", "n"):
         if key in claimed and claimed[key] != want[key]:
             wrong.append((key, claimed[key]))

@@ -159,7 +159,7 @@ def _probe_scheduler(address: str, timeout: float) -> None:
     import asyncio
     from concurrent.futures import ThreadPoolExecutor
 
-    from distributed.comm import connect
+    from distributed.comm.core import connect     # what distributed.comm re-exports
     from distributed.security import Security
 
     args = Security().get_connection_args("client")   # as Client's (TLS from dask's config)

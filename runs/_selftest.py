@@ -184,11 +184,14 @@ def _forged_witness(s: Scenario, v: Variant, g: Grid) -> Mutant:
     """The non-optimal path with a forged witness: the optimum's labels, with every goal state's
     label raised so that the least goal label (plus the stop term) is the path's cost."""
     worse_search = _non_optimal(s, v, g).search
+    assert worse_search is not None                # _non_optimal replaces the search
 
     def search(dr: DR, start: Cell, goal: Cell) -> SearchResult:
         worse = worse_search(dr, start, goal)
         best = search_opt_path(dr, start, goal, with_witness=True)
-        j1, j2 = best.witness.j1.copy(), best.witness.j2.copy()
+        labels = best.witness                      # with_witness: a found path's labels
+        assert labels is not None and labels.j1 is not None and labels.j2 is not None
+        j1, j2 = labels.j1.copy(), labels.j2.copy()
         N, (gi, gj) = dr.shape[0] - 1, goal
         stop = np.abs(np.asarray(MOVES)).sum(axis=1)
         j1[N, :, gi, gj] = worse.J1
@@ -286,8 +289,8 @@ def run_fault(fault: Fault, mode: Mode | str, *, scenario: Scenario | None = Non
     s = scenario or workcell(fault.workcell)
     g = make_grid(s)
     m = fault.make(s, fault.variant, g)
-    kwargs = {k: v for k, v in (("grid", m.grid), ("build", m.build), ("search", m.search))
-              if v is not None}
+    kwargs: dict[str, Any] = {k: v for k, v in (("grid", m.grid), ("build", m.build),
+                                                ("search", m.search)) if v is not None}
     try:
         p = plan(s, fault.variant, contracts=mode, seed=seed, sample=sample, stop=False, **kwargs)
     except ContractViolation as exc:        # a failed precondition always stops the run

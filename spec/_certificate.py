@@ -18,7 +18,8 @@ before Tf and 0 after; right joint speeds on segment k are |angle(L_{k+1}) - ang
 and 0 after the path ends. So each rectangle moves by at most v |t - s| in Hausdorff distance,
 and d_ab is Lipschitz with constant L_ab = v_a + v_b. On [t0, t1], from the samples at both ends,
 
-    d_ab(t) >= max(d_ab(t0) - L_ab (t - t0), d_ab(t1) - L_ab (t1 - t)) >= (d_ab(t0) + d_ab(t1) - L_ab (t1 - t0)) / 2.
+    d_ab(t) >= max(d_ab(t0) - L_ab (t - t0), d_ab(t1) - L_ab (t1 - t))
+            >= (d_ab(t0) + d_ab(t1) - L_ab (t1 - t0)) / 2.
 
 (This is never weaker than the midpoint test d(mid) > L (t1 - t0) / 2 applied to the same
 interval split at its midpoint.) An interval is proved clear when the least such bound over the
@@ -39,7 +40,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -377,7 +378,8 @@ class _Motion:
             t0, t1, seg = np.zeros(1), np.zeros(1), np.full(1, -1, dtype=np.int64)
         order = np.argsort(t0, kind="stable")
         t0, t1, seg = t0[order], t1[order], seg[order]
-        return t0, t1, seg, t0 < tf
+        # cast: numpy's stubs type an int array times a float as floating[Any]
+        return cast(FloatArray, t0), cast(FloatArray, t1), seg, t0 < tf
 
     def lipschitz(self, seg: IntArray, moving: npt.NDArray[np.bool_]) -> FloatArray:
         """L_ab = v_a (left link a) + v_b (right link b) per piece, shape (K, 2, 2)."""

@@ -24,8 +24,8 @@ from collections.abc import Sequence
 from fractions import Fraction
 
 __all__ = ["READINGS", "SPAN_TOLERANCE", "MAX_EXTRA_POINTS", "GridRefused", "ceil_fraction",
-           "decimal", "joint_grid", "joint_points", "min_points", "spacing_ok", "spacing_readings", "time_readings",
-           "travel_time", "time_steps"]
+           "decimal", "joint_grid", "joint_points", "min_points", "spacing_ok", "spacing_readings",
+           "time_readings", "travel_time", "time_steps"]
 
 #: The two readings of a number in a scenario file (see the module docstring).
 READINGS = ("binary", "decimal")

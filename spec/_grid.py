@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import Enum
 from fractions import Fraction
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -231,7 +231,8 @@ class Grid:
 
     def angle(self, q: int, index: int | npt.NDArray[np.int64]) -> float | FloatArray:
         """theta = lo_q + index * h_q for joint q (0 or 1)."""
-        return self.lo[q] + index * self.h[q]
+        # cast: numpy's stubs type an int array times a float as floating[Any]
+        return cast("float | FloatArray", self.lo[q] + index * self.h[q])
 
     def angles(self, cell: tuple[int, int]) -> tuple[float, float]:
         return (float(self.angle(0, cell[0])), float(self.angle(1, cell[1])))

@@ -77,7 +77,7 @@ def _side(p: FloatArray, q: FloatArray) -> FloatArray:
     return _cross(e[..., :, None, 0], e[..., :, None, 1], rel[..., 0], rel[..., 1])
 
 
-def _inside(side: FloatArray, orient: FloatArray) -> FloatArray:
+def _inside(side: FloatArray, orient: FloatArray) -> npt.NDArray[np.bool_]:
     """Whether any vertex of q lies in the closed polygon p, given _side(p, q) and p's orientation.
 
     A degenerate p (zero area) contains nothing here: a vertex on a segment is found by the
@@ -87,7 +87,7 @@ def _inside(side: FloatArray, orient: FloatArray) -> FloatArray:
     return (orient != 0) & np.any(np.all(on_inner_side, axis=-2), axis=-1)
 
 
-def _crossing(side_pq: FloatArray, side_qp: FloatArray) -> FloatArray:
+def _crossing(side_pq: FloatArray, side_qp: FloatArray) -> npt.NDArray[np.bool_]:
     """Whether some edge of p properly crosses some edge of q (endpoints strictly on both sides).
 
     Touching and collinear overlaps are not crossings; they put a vertex on an edge, where the

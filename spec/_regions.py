@@ -9,6 +9,7 @@ SNAP * g_q * R_q for rounding box ends onto the lattice (R_1 = R_base, R_2 = R_e
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 import numpy.typing as npt
@@ -28,7 +29,8 @@ def lattice(lo: float, hi: float, anchor: float, g: float) -> npt.NDArray[np.flo
     a = math.floor((lo - anchor) / g + SNAP)
     b = math.ceil((hi - anchor) / g - SNAP)
     a, b = min(a, b), max(a, b)
-    return anchor + np.arange(a, b + 1) * g
+    # cast: numpy's stubs type an int array times a float as floating[Any]
+    return cast(npt.NDArray[np.float64], anchor + np.arange(a, b + 1) * g)
 
 
 def margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int]) -> float:

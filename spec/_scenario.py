@@ -232,7 +232,7 @@ def _short(x: Any) -> Any:
 
 
 def _arm_common(r: _Reader, doc: dict[str, Any], side: str, dt: float) -> dict[str, Any]:
-    out = {
+    out: dict[str, Any] = {
         "base": r.pair(doc["base"], f"{side}.base", bound=MAX_BASE_M, unit=" m"),
         "links": r.pair(doc["links"], f"{side}.links", positive=True, bound=MAX_LENGTH_M,
                         unit=" m"),
@@ -350,7 +350,7 @@ def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str 
     dt = r.number(doc["dt"], "dt", positive=True)
 
     ld = r.table(doc, "left", _LEFT_KEYS, _LEFT_KEYS)
-    angle = {"bound": MAX_ANGLE_RAD, "unit": " rad"}
+    angle: dict[str, Any] = {"bound": MAX_ANGLE_RAD, "unit": " rad"}
     left = LeftArm(**_arm_common(r, ld, "left", dt), start=r.pair(ld["start"], "left.start", **angle),
                    goal=r.pair(ld["goal"], "left.goal", **angle))
 

@@ -31,7 +31,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -246,7 +246,8 @@ def executed_trajectory(s: Scenario, g: Grid, path: Any) -> Trajectory:
     dt, tf = g.dt, float(exact_tf(s))
     last = len(cells) - 1
     steps = max(last, math.ceil(tf / dt))
-    times = np.arange(steps + 1, dtype=np.int64) * dt
+    # cast: numpy's stubs type an int array times a float as floating[Any]
+    times = cast(FloatArray, np.arange(steps + 1, dtype=np.int64) * dt)
     if tf > 0 and not np.any(times == tf) and tf < times[-1]:
         times = np.sort(np.append(times, tf))
     right = np.stack([g.lo[0] + cells[:, 0] * g.h[0], g.lo[1] + cells[:, 1] * g.h[1]], axis=1)

@@ -52,7 +52,7 @@ def random_workcells(draw: st.DrawFn, *, dts: tuple[float, ...]) -> Scenario:
     left["goal"] = [start[q] + draw(f(-1.5, 1.5)) for q in range(2)]
     right = arm([draw(f(0.0, 0.9)), draw(f(-0.4, 0.4))])
     limits = []
-    for q in range(2):
+    for _q in range(2):
         lo = draw(f(-math.pi, 0.0))
         limits.append([lo, lo + draw(f(0.5, 2 * math.pi))])
     right["limits"] = limits

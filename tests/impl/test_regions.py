@@ -89,7 +89,7 @@ def test_naive_hull_search_finds_a_protrusion_that_grows_with_the_box():
     assert worst[1] > 5e-3  # millimetres at a 0.3 rad sweep
 
 
-# The README's second figure, kept as a regression example: at a 0.6 rad sweep of both joints
+# docs/model.md §4.2's second figure, kept as a regression example: at a 0.6 rad sweep of both joints
 # the naive hull misses link 2 of the default left arm by ~28.5 mm (at theta1 mid-sweep).
 WIDE_BOX = ((0.3, 0.9), (0.8, 1.4))
 WIDE_THETA = (0.6, 0.8)

@@ -185,7 +185,8 @@ def test_the_box_rules_are_spec_left_box_and_right_box(path):
     # The subordinate's box is spec.right_box's.
     g = make_grid(s)
     R = S.Subordinate.named()
-    rpins = [(R.lo[q], exact_real(g.lo[q])) for q in range(2)] + [(R.h[q], exact_real(g.h[q])) for q in range(2)]
+    rpins = ([(R.lo[q], exact_real(g.lo[q])) for q in range(2)]
+             + [(R.h[q], exact_real(g.h[q])) for q in range(2)])
     for cell in ((0, 0), (g.m - 1, g.n - 1), (g.m // 2, 1)):
         box = R.box((z3.IntVal(cell[0]), z3.IntVal(cell[1])))
         want = right_box(g, cell)

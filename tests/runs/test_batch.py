@@ -85,7 +85,10 @@ def test_a_batch_of_good_plans_passes_on_a_local_cluster(plans, tmp_path, capsys
     assert doc["ok"] and doc["passed"] == 3 and all(r["status"] == "ok" for r in doc["rows"])
     serial = tmp_path / "serial.json"
     assert run_batch(root, plans / "small.toml", json_out=serial) == 0
-    strip = (lambda d: {k: v for k, v in d.items() if k != "timings_s"})
+
+    def strip(d: dict) -> dict:
+        return {k: v for k, v in d.items() if k != "timings_s"}
+
     assert strip(json.loads(serial.read_text())) == strip(doc)
 
 
