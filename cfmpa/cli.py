@@ -314,7 +314,7 @@ def _parser() -> argparse.ArgumentParser:
                     help="show the campaign `cfmpa compare --out DIR` recorded there (read "
                          "from its records, not run again) instead of running one")
 
-    sc = _command(sub, "scenarios", "list the bundled scenarios and their purposes",
+    _command(sub, "scenarios", "list the bundled scenarios and their purposes",
                   "cfmpa scenarios", cmd_scenarios)
 
     co = _command(sub, "compare", "original vs modified vs tight on random workcells",

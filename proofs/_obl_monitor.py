@@ -12,9 +12,9 @@ terms (``max_of`` is an If there), so a changed bound changes the proved stateme
 deviations are reals d_k >= |x_k - r_k| and each |a| <= b is the case split -b <= a <= b. The
 argument Z3 finds is the triangle inequality at either end, |x(t) - r(t)| <= |x(t) - x_k| +
 |x_k - r_k| + |r_k - r(t)| <= d_k + (w_x + w_r)(t - t_k), and the same from t_k+1; one of
-t - t_k, t_k+1 - t is at most h / 2. Linear in the products w (t - t_k) that Z3 treats as atoms, with no If but the
-bound's max, so Z3 decides it at once (with the absolute values as If terms it answered unknown
-after 20 s). Prose, not checked: that a speed bound |x'| <= w_x gives
+t - t_k, t_k+1 - t is at most h / 2. Linear in the products w (t - t_k) that Z3 treats as
+atoms, with no If but the bound's max, so Z3 decides it at once (with the absolute values as
+If terms it answered unknown after 20 s). Prose, not checked: that a speed bound |x'| <= w_x gives
 |x(t) - x_k| <= w_x (t - t_k) (the mean value theorem), and that the trajectory's largest speed
 over the pieces the gap meets (``spec.ReferenceSpeeds.over``) bounds r' on the gap; the four
 joints are independent, so the max norm is within the tube when every joint is.

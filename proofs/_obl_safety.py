@@ -45,7 +45,6 @@ from ..spec import DISTANCE_ERROR_M, EPS, Arm, Variant, cell_box, ptp_angles
 from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
                             is_path_fixed, member, position, z3_path)
 from ._obl_margin import margin_obligations
-from ._obl_paths import path_obligations
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 
 __all__ = ["VARIANTS", "safety_obligations"]
@@ -1585,11 +1584,12 @@ def safety_obligations() -> list[Obligation]:
         "theta of a box [lo1, hi1] x [lo2, hi2] lies in the region impl.swept_region builds for "
         "the box: the lattice A_q + i g_q (0 < g_q <= 3.14) with the indices of "
         "impl.lattice_range, read by running lattice_range itself on the symbols "
-        "(floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP)), the link's rectangle at every lattice configuration grown by Delta = "
-        "impl.sweep_margin, and their convex hull. The point is exhibited as a convex "
-        "combination of points of the grown rectangles at the corners of the lattice cell that "
-        "holds theta clamped onto the lattice's span (four corners for link 2, two for link 1, "
-        "which does not depend on theta2). The margin is derived, not assumed: clamping theta_q "
+        "(floor((lo - A)/g + SNAP), ceil((hi - A)/g - SNAP)), the link's rectangle at every "
+        "lattice configuration grown by Delta = impl.sweep_margin, and their convex hull. The "
+        "point is exhibited as a convex combination of points of the grown rectangles at the "
+        "corners of the lattice cell that holds theta clamped onto the lattice's span (four "
+        "corners for link 2, two for link 1, which does not depend on theta2). The margin is "
+        "derived, not assumed: clamping theta_q "
         "by at most SNAP g_q moves the point by at most SNAP g_q R_q (chord, from cos x >= 1 - "
         "x^2/2), and Margin.arc_chord, re-proved here as the first VC, is instantiated by "
         "substitution at every arc (about the base, and about the elbow at both ends), at (r, "

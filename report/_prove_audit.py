@@ -62,7 +62,7 @@ def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
             if stopped.is_set():
                 os._exit(1)
 
-            def again() -> int:
+            def again(exc: BaseException = exc) -> int:
                 raise exc
             code = handled(again, sys.stderr)
         sys.stdout.flush()

@@ -191,7 +191,7 @@ def _forged_witness(s: Scenario, v: Variant, g: Grid) -> Mutant:
         best = search_opt_path(dr, start, goal, with_witness=True)
         labels = best.witness                      # with_witness: a found path's labels
         assert labels is not None and labels.j1 is not None and labels.j2 is not None
-        j1, j2 = labels.j1.copy(), labels.j2.copy()
+        j1, j2 = np.array(labels.j1), np.array(labels.j2)     # copies, held whole
         N, (gi, gj) = dr.shape[0] - 1, goal
         stop = np.abs(np.asarray(MOVES)).sum(axis=1)
         j1[N, :, gi, gj] = worse.J1

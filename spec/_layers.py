@@ -96,7 +96,7 @@ class Layers:
         for s in range(self.shape[0]):
             yield self.layer(s)
 
-    def __array__(self, dtype: npt.DTypeLike = None, copy: bool | None = None) -> Array:
+    def __array__(self, dtype: npt.DTypeLike | None = None, copy: bool | None = None) -> Array:
         out = np.empty(self.shape, dtype=self.dtype)
         for s in range(self.shape[0]):
             out[s] = np.asarray(self._read(s), dtype=self.dtype).reshape(self.shape[1:])

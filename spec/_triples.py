@@ -299,7 +299,8 @@ def dr_shape_failures(grid: Grid, dr: Any, condition: str = "post.shape") -> lis
                         (("shape", list(shape)), ("expected shape", list(grid.shape)),
                          ("dtype", str(dtype)), ("expected dtype", "uint8")))]
     a = np.asarray(dr)
-    count, first = 0, None
+    count = 0
+    first: tuple[int, ...] | None = None
     for layer in range(a.shape[0]):          # a layer at a time: no D_R-sized temporary
         bad = np.flatnonzero(a[layer].ravel() > 1)
         count += bad.size

@@ -160,20 +160,20 @@ class Witness:
     each of shape ``(N + 1, 9, m, n)`` indexed (step, previous move, i, j); see the module."""
 
     kind: str                       # "labels" | "reachable"
-    j1: Array | None = None
-    j2: Array | None = None
-    reachable: Array | None = None
+    j1: Array | Layers | None = None
+    j2: Array | Layers | None = None
+    reachable: Array | Layers | None = None
 
     @classmethod
-    def of_labels(cls, j1: Array, j2: Array) -> Witness:
+    def of_labels(cls, j1: Array | Layers, j2: Array | Layers) -> Witness:
         return cls("labels", j1=j1, j2=j2)
 
     @classmethod
-    def of_reachable(cls, reachable: Array) -> Witness:
+    def of_reachable(cls, reachable: Array | Layers) -> Witness:
         return cls("reachable", reachable=reachable)
 
     @property
-    def arrays(self) -> dict[str, Array]:
+    def arrays(self) -> dict[str, Any]:
         if self.kind == "labels":
             return {"j1": self.j1, "j2": self.j2}
         return {"reachable": self.reachable}
@@ -211,8 +211,8 @@ def load_witness(path: str | Path) -> Witness:
     tag = members.get("format")
     if tag is None or tag.shape != () or str(tag) != WITNESS_FORMAT:
         raise bad("format", None if tag is None else str(tag), f"must be {WITNESS_FORMAT!r}")
-    kind = members.get("kind")
-    kind = None if kind is None or kind.shape != () else str(kind)
+    tag_kind = members.get("kind")
+    kind = None if tag_kind is None or tag_kind.shape != () else str(tag_kind)
     if kind == "labels" and {"j1", "j2"} <= set(members):
         return Witness.of_labels(members["j1"], members["j2"])
     if kind == "reachable" and "reachable" in members:
@@ -253,7 +253,7 @@ def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
 # --- labels -------------------------------------------------------------------------------------
 
 
-def _check_labels(free: Array, start: tuple[int, int], goal: tuple[int, int],
+def _check_labels(free: Layers, start: tuple[int, int], goal: tuple[int, int],
                   result: SearchResult, j1: Array, j2: Array) -> list[Failure]:
     N = free.shape[0] - 1
     none = np.iinfo(j1.dtype).max
@@ -342,6 +342,7 @@ def _check_edges(free: Array, j1: Array, j2: Array) -> list[Failure]:
     to = (i + int(_DI[d]), j + int(_DJ[d]))
     cost = [int(_NORM[d]), int(_TURN[p, d])]
     have = _label(j1, j2, (s, p, i, j))
+    assert have is not None         # the edge's source holds a label: it broke the bound
     return [_fail("edge", "a free edge breaks label[s'] <= label[s] + cost(s, s')",
                   ("state", _state(s, (i, j), p)), ("label", have), ("move", list(MOVES[d])),
                   ("edge cost", cost), ("to state", _state(t, to, d)),

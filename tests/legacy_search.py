@@ -69,7 +69,8 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
 
     Ties (deterministic), on the returned list L: it never waits at a step >= N before its end,
     L_{k+1} != L_k for N <= k < len - 1 (dropping such a wait keeps a path valid and costs no
-    more), and among the optimal lists that do not, it is the least by this order. Pad L with the goal to N + 1 cells if shorter (the arm
+    more), and among the optimal lists that do not, it is the least by this order. Pad L with
+    the goal to N + 1 cells if shorter (the arm
     holds it until the principal stops): cells L_0 .. L_T, T = max(len - 1, N), moves
     d_k = L_{k+1} - L_k. Rank the last move d_{T-1} by its index in MOVES; rank each earlier
     d_k by its index if it arrives before step N (k + 1 < N), by 9 + its index if it arrives at

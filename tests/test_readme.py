@@ -137,9 +137,9 @@ def test_an_option_new_in_the_parser_is_reported():
     p = _parser()
     for action in p._actions:
         if isinstance(action, argparse._SubParsersAction):
-            action.choices["monitor"].add_argument("--max-speed", type=float)
+            action.choices["monitor"].add_argument("--planted-option", type=float)
     assert _new_problems(_block(), p) == [
-        "cfmpa monitor: the parser has --max-speed, missing from the synopsis"]
+        "cfmpa monitor: the parser has --planted-option, missing from the synopsis"]
 
 
 def test_a_missing_subcommand_is_reported():

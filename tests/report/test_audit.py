@@ -37,7 +37,7 @@ from markupsafe import escape
 
 from cfmpa.files import dumps_json
 from cfmpa.errors import InputError
-from cfmpa.proofs import ASSUMPTIONS, expected_ids, obligation_summary, run_prove
+from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
 from cfmpa.report._audit import _proof_sections, _verdict, contract_rows, workcell_summary

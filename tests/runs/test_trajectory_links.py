@@ -13,7 +13,7 @@ import factory
 from cfmpa.cli import main
 from cfmpa.errors import CertificateViolation
 from cfmpa.spec import (LINK_WORDS, Trajectory, certificate_json, certify_trajectory,
-                        closest_links, contact_links_text, link_name, load_trajectory,
+                        closest_links, link_name, load_trajectory,
                         require_clear, tolerance_rad, trajectory_csv)
 
 HEADER = "t,left1,left2,right1,right2\n"
