@@ -812,9 +812,13 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     # Off mode still writes a record (checked = 0); only records that checked something count.
     recorded = [(n, v) for n, v in plans if v["contracts"] and v["contracts"].get("checked", 0) > 0]
     violated = [f"{n}/{v['variant']}" for n, v in recorded if v["contracts"].get("violations")]
-    items.append(_item("contracts hold", (not violated) if recorded else None,
+    # A plan stopped by a violated precondition recorded no count, yet it failed a contract.
+    stopped = [f"{n}/{v['variant']}" for n, v in plans if v["status"] == "contract_violation"]
+    items.append(_item("contracts hold", (not violated and not stopped)
+                       if recorded or stopped else None,
                        f"{len(recorded)} of {len(plans)} plans recorded contracts"
-                       + (f"; violated: {', '.join(violated)}" if violated else "")))
+                       + (f"; violated: {', '.join(violated)}" if violated else "")
+                       + (f"; stopped by a violation: {', '.join(stopped)}" if stopped else "")))
     st = doc["selftest"]
     if st["available"]:
         missed = [r["fault"] for r in st["rows"] if r.get("caught_full") is False]

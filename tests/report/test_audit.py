@@ -314,6 +314,21 @@ def test_section_one_fails_a_plan_whose_proof_or_certificate_fails(report):
     assert all(r["ok"] is not False for r in again)
 
 
+def test_a_plan_stopped_by_a_contract_fails_its_row_and_the_report(report):
+    # A plan that raised (a violated precondition) records no counts: it must still fail.
+    doc = copy.deepcopy(report["result"].doc)
+    (s,) = doc["scenarios"]
+    assert _verdict(doc)["ok"] is True
+    s["variants"][1].update(status="contract_violation", reason="pre.grid.h violated",
+                            clearance=None, contracts={"violations": ["pre.grid.h violated"]})
+    verdict = _verdict(doc)
+    item = next(i for i in verdict["items"] if i["check"] == "contracts hold")
+    assert verdict["ok"] is False and item["ok"] is False
+    assert f"stopped by a violation: {s['name']}/{s['variants'][1]['variant']}" in item["detail"]
+    row = workcell_summary([_scenario_of(report)], doc)[1]
+    assert row["ok"] is False and row["verdict"] == "FAILED" and "stopped" in row["why"]
+
+
 def _scenario_of(report):
     from cfmpa.spec import load_scenario
     return load_scenario(report["doc"]["provenance"]["scenarios"][0]["path"])
