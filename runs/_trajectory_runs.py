@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import io
-import itertools
 import math
 import sys
 import time
@@ -36,8 +35,11 @@ __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursio
            "monitor_json", "monitor_log", "parse_excursion", "parse_max_speed", "run_certify",
            "run_monitor", "run_simulate", "simulate_log"]
 
-#: Log rows parsed per numpy block by the monitor.
+#: Log rows parsed per numpy block by the monitor ...
 BLOCK_ROWS = 16_384
+#: ... and at most this many characters of them (lines of up to 64 KiB each would otherwise
+#: make a block of 1 GiB).
+BLOCK_CHARS = 8 * 1024 * 1024
 FloatArray = npt.NDArray[np.float64]
 
 
@@ -261,6 +263,20 @@ def _parse_rows(lines: Sequence[str], first_line: int, order: list[int],
     return np.asarray(rows, dtype=float).reshape(-1, len(TRAJECTORY_COLUMNS)), blank
 
 
+def _blocks(lines: Iterator[str], rows: int) -> Iterator[list[str]]:
+    """``lines`` in lists of ``rows`` lines, fewer where they reach BLOCK_CHARS characters."""
+    block: list[str] = []
+    size = 0
+    for line in lines:
+        block.append(line)
+        size += len(line)
+        if len(block) >= rows or size >= BLOCK_CHARS:
+            yield block
+            block, size = [], 0
+    if block:
+        yield block
+
+
 def parse_max_speed(text: str | None, s: Scenario, traj: Trajectory) -> FloatArray:
     """The robot's joint speed bound (4,) in JOINTS order, rad/s: ``--max-speed`` as one value
     for all joints or four comma-separated ones; without it the scenario's omega, raised to the
@@ -324,10 +340,7 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
     prev_dev: FloatArray | None = None                # the last sample's deviation per joint
     prev_line = 0
     blank: int | None = None
-    while True:
-        block = list(itertools.islice(it, block_rows))
-        if not block:
-            break
+    for block in _blocks(it, block_rows):
         start = no + 1
         no += len(block)
         arr, trailing = _parse_rows(block, start, order, source)
