@@ -1,7 +1,8 @@
 """`cfmpa certify`, `cfmpa monitor` and `cfmpa simulate`: any planner's trajectory (docs/model.md §12).
 
 certify: the continuous-time certificate of a trajectory file and its tolerance tube.
-monitor: a measured joint log streamed (in blocks, constant memory) against the certified tube.
+monitor: a measured joint log streamed (in blocks, constant memory) against the certified tube,
+at its samples and, by ``spec.between_samples_bound``, at every instant between them.
 simulate: a measured log from a tracking model (lag, bounded noise, seeded; injected excursions).
 
 JSON outputs are byte-identical for the same inputs apart from ``timings_s``.
