@@ -1,4 +1,7 @@
-"""Atomic file output: write to a temporary name in the same folder, then rename over the target."""
+"""Files in and out: atomic output (a temporary name in the same folder, then a rename over the
+target) and bounded input (docs/model.md §3, §12): a line reader with a per-line limit and an
+optional total, a whole-file reader with a size limit, the limits overridable by environment
+variables, and echoed values cut to ECHO_CHARS characters."""
 
 from __future__ import annotations
 
@@ -6,13 +9,170 @@ import io
 import json
 import math
 import os
+import stat
 import tempfile
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["dumps_json", "jsonable", "npy_bytes", "save_npy_atomic", "write_bytes_atomic"]
+from .errors import MISSING, InputError
+
+__all__ = ["ECHO_CHARS", "LIMITS", "Limit", "bounded_lines", "check_file_size", "dumps_json",
+           "echo", "jsonable", "npy_bytes", "read_bounded", "save_npy_atomic",
+           "write_bytes_atomic"]
+
+#: An echoed value (a row, a field) longer than this in a message is cut to it.
+ECHO_CHARS = 80
+
+
+@dataclass(frozen=True)
+class Limit:
+    """A size limit on input, in bytes: ``default`` unless the environment variable ``env`` sets
+    it (a positive integer)."""
+
+    env: str
+    default: int
+    what: str
+
+    def value(self) -> int:
+        raw = os.environ.get(self.env)
+        if raw is None:
+            return self.default
+        try:
+            v = int(raw)
+        except ValueError:
+            v = 0
+        if v < 1:
+            raise InputError(self.env, echo(raw), "must be a positive integer (bytes)")
+        return v
+
+    def words(self, v: int) -> str:
+        return f"the limit of {v:,} bytes for {self.what} (environment variable {self.env})"
+
+
+#: The input limits (docs/model.md §3, §12).
+LIMITS = {
+    "line": Limit("CFMPA_MAX_LINE_BYTES", 64 * 1024,
+                  "a line of a scenario, trajectory CSV or log, its newline included"),
+    "scenario": Limit("CFMPA_MAX_SCENARIO_BYTES", 1024 * 1024, "a scenario file"),
+    "trajectory": Limit("CFMPA_MAX_TRAJECTORY_BYTES", 32 * 1024 * 1024, "a trajectory file"),
+    # Read a layer at a time in place (spec._layers), so the limit is no memory bound: 36 bytes
+    # a cell at the 400 M cell budget is 14.4 GB (docs/model.md §3, §11).
+    "witness": Limit("CFMPA_MAX_WITNESS_BYTES", 32 * 1024 * 1024 * 1024,
+                     "a witness file and its arrays unpacked"),
+}
+
+
+class _Cut:
+    """A value whose repr is cut to ECHO_CHARS characters (what a message echoes)."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    def __repr__(self) -> str:
+        return self.text
+
+
+def echo(value: Any) -> Any:
+    """``value`` itself if its repr has at most ECHO_CHARS characters, else a stand-in whose
+    repr is the first ECHO_CHARS of it, then ``...``: a 100 MB row is not echoed whole."""
+    text = repr(value)
+    return value if len(text) <= ECHO_CHARS else _Cut(text[:ECHO_CHARS] + "...")
+
+
+def _too_long(source: str | None, line: int) -> InputError:
+    lim = LIMITS["line"]
+    return InputError("line", MISSING, f"is longer than {lim.words(lim.value())}",
+                      source=source, line=line)
+
+
+def _too_large(limit: Limit, cap: int, source: str | None, line: int | None) -> InputError:
+    return InputError("file", MISSING, f"is larger than {limit.words(cap)}", source=source,
+                      line=line)
+
+
+def bounded_lines(stream: IO[bytes] | IO[str], source: str | None, *,
+                  total: Limit | None = None) -> Iterator[str]:
+    """The lines of ``stream`` as text ending in ``\n`` (``\r\n`` read as ``\n``; the last
+    may have none), reading at most the line limit + 1 bytes at a time: a line longer than
+    LIMITS["line"], more than ``total`` bytes in all, or bytes that are not UTF-8 raise
+    InputError naming the line and the limit, with no more than a line's worth in memory.
+    A text stream (standard input) is read through its buffer when it has one."""
+    cap_line = LIMITS["line"].value()
+    cap = None if total is None else total.value()
+    raw_stream: Any = getattr(stream, "buffer", stream)
+    read = 0
+    no = 0
+    while True:
+        raw = raw_stream.readline(cap_line + 1)
+        if not raw:
+            return
+        no += 1
+        size = len(raw.encode("utf-8")) if isinstance(raw, str) else len(raw)
+        if size > cap_line:
+            raise _too_long(source, no)
+        read += size
+        if cap is not None and total is not None and read > cap:
+            raise _too_large(total, cap, source, no)
+        if isinstance(raw, bytes):
+            try:
+                text = raw.decode("utf-8")
+            except UnicodeDecodeError:
+                raise InputError("line", MISSING, "is not UTF-8 text", source=source,
+                                 line=no) from None
+        else:
+            text = raw
+        if text.endswith("\r\n"):
+            text = text[:-2] + "\n"
+        yield text
+
+
+def check_file_size(path: str | os.PathLike[str], limit: Limit, source: str | None, *,
+                    field: str = "file") -> None:
+    """Refuse a regular file larger than ``limit`` (by its size, nothing read), and anything but
+    a regular file (a device, a pipe: its size says nothing), with InputError."""
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise InputError(field, MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=source) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(field, MISSING, "must be a regular file", source=source)
+    cap = limit.value()
+    if st.st_size > cap:
+        raise _too_large(limit, cap, source, None)
+
+
+def read_bounded(path: str | os.PathLike[str], limit: Limit, source: str | None, *,
+                 lines: bool = True, field: str = "file") -> bytes:
+    """The whole file, read with at most ``limit`` + 1 bytes in memory: larger (a device such
+    as /dev/zero, a file cut short of nothing) raises InputError naming the limit; with
+    ``lines``, so does a line longer than LIMITS["line"] (the first, by its number), and a
+    too-large file names the line the limit fell in."""
+    cap = limit.value()
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(cap + 1)
+    except OSError as exc:
+        raise InputError(field, MISSING, f"cannot be read ({exc.strerror or exc})",
+                         source=source) from None
+    if lines:
+        cap_line = LIMITS["line"].value()
+        start, no = 0, 1
+        while True:
+            end = data.find(b"\n", start)
+            stop = len(data) if end < 0 else end + 1
+            if stop - start > cap_line:
+                raise _too_long(source, no)
+            if end < 0:
+                break
+            start, no = end + 1, no + 1
+    if len(data) > cap:
+        raise _too_large(limit, cap, source, data.count(b"\n") + 1 if lines else None)
+    return data
 
 
 def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:

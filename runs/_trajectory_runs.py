@@ -1,7 +1,8 @@
 """`cfmpa certify`, `cfmpa monitor` and `cfmpa simulate`: any planner's trajectory (docs/model.md §12).
 
 certify: the continuous-time certificate of a trajectory file and its tolerance tube.
-monitor: a measured joint log streamed (in blocks, constant memory) against the certified tube.
+monitor: a measured joint log streamed (in blocks, constant memory) against the certified tube,
+at its samples and, by ``spec.between_samples_bound``, at every instant between them.
 simulate: a measured log from a tracking model (lag, bounded noise, seeded; injected excursions).
 
 JSON outputs are byte-identical for the same inputs apart from ``timings_s``.
@@ -11,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import io
-import itertools
 import math
 import sys
 import time
@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
-from ..files import dumps_json, write_bytes_atomic
+from ..files import bounded_lines, dumps_json, echo, write_bytes_atomic
 from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
                     between_samples_bound, certify_trajectory, closest_links, contact_links_text,
                     csv_column_order, load_scenario, load_trajectory, tolerance_rad,
@@ -42,8 +42,11 @@ MAX_LOG_SAMPLES = 1_000_000
 #: The shortest --period (s): a 1 MHz log; finer is no measured robot's.
 MIN_PERIOD_S = 1e-6
 
-#: Log rows parsed per numpy block by the monitor.
+#: Log rows parsed per numpy block by the monitor ...
 BLOCK_ROWS = 16_384
+#: ... and at most this many characters of them (lines of up to 64 KiB each would otherwise
+#: make a block of 1 GiB).
+BLOCK_CHARS = 8 * 1024 * 1024
 FloatArray = npt.NDArray[np.float64]
 
 
@@ -250,20 +253,35 @@ def _parse_rows(lines: Sequence[str], first_line: int, order: list[int],
                              source=source, line=blank)
         fields = line.strip().split(",")
         if len(fields) != len(TRAJECTORY_COLUMNS):
-            raise InputError("row", line.strip(), f"must have {len(TRAJECTORY_COLUMNS)} values, "
-                             f"has {len(fields)}", source=source, line=no)
+            raise InputError("row", echo(line.strip()),
+                             f"must have {len(TRAJECTORY_COLUMNS)} values, has {len(fields)}",
+                             source=source, line=no)
         vals = []
         for name, i in zip(TRAJECTORY_COLUMNS, order):
             try:
                 v = float(fields[i])
             except ValueError:
-                raise InputError(name, fields[i].strip(), "must be a number", source=source,
-                                 line=no) from None
+                raise InputError(name, echo(fields[i].strip()), "must be a number",
+                                 source=source, line=no) from None
             if not math.isfinite(v):
                 raise InputError(name, v, "must be finite", source=source, line=no)
             vals.append(v)
         rows.append(vals)
     return np.asarray(rows, dtype=float).reshape(-1, len(TRAJECTORY_COLUMNS)), blank
+
+
+def _blocks(lines: Iterator[str], rows: int) -> Iterator[list[str]]:
+    """``lines`` in lists of ``rows`` lines, fewer where they reach BLOCK_CHARS characters."""
+    block: list[str] = []
+    size = 0
+    for line in lines:
+        block.append(line)
+        size += len(line)
+        if len(block) >= rows or size >= BLOCK_CHARS:
+            yield block
+            block, size = [], 0
+    if block:
+        yield block
 
 
 def parse_max_speed(text: str | None, s: Scenario, traj: Trajectory) -> FloatArray:
@@ -277,17 +295,12 @@ def parse_max_speed(text: str | None, s: Scenario, traj: Trajectory) -> FloatArr
     try:
         vals = [float(x) for x in parts]
     except ValueError:
-        raise InputError("--max-speed", _cut(text), "must be W or W1,W2,W3,W4 (rad/s, one per "
+        raise InputError("--max-speed", echo(text), "must be W or W1,W2,W3,W4 (rad/s, one per "
                          f"joint {','.join(TRAJECTORY_COLUMNS[1:])})") from None
     if len(vals) not in (1, 4) or not all(math.isfinite(v) and v >= 0 for v in vals):
-        raise InputError("--max-speed", _cut(text), "must be one or four finite speeds >= 0 "
+        raise InputError("--max-speed", echo(text), "must be one or four finite speeds >= 0 "
                          f"(rad/s, joints {','.join(TRAJECTORY_COLUMNS[1:])})")
     return np.broadcast_to(np.array(vals, dtype=float), (4,)).copy()
-
-
-def _cut(value: Any) -> str:
-    text = str(value)
-    return text if len(text) <= 80 else text[:80] + "..."
 
 
 def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str], *,
@@ -334,10 +347,7 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
     prev_dev: FloatArray | None = None                # the last sample's deviation per joint
     prev_line = 0
     blank: int | None = None
-    while True:
-        block = list(itertools.islice(it, block_rows))
-        if not block:
-            break
+    for block in _blocks(it, block_rows):
         start = no + 1
         no += len(block)
         arr, trailing = _parse_rows(block, start, order, source)
@@ -473,12 +483,19 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
         return 1
     tol = tolerance_rad(s, cert)
     source = "<stdin>" if str(log) == "-" else str(log)
+    # Lines within LIMITS["line"] (docs/model.md §12): /dev/zero ends at its first line's limit.
     if str(log) == "-":
-        res = monitor_log(s, traj, tol, stdin if stdin is not None else sys.stdin, source=source,
-                          max_speed=w_robot)
+        res = monitor_log(s, traj, tol, bounded_lines(stdin if stdin is not None else sys.stdin,
+                                                      source), source=source, max_speed=w_robot)
     else:
-        with open(log, encoding="utf-8", newline=None) as fh:
-            res = monitor_log(s, traj, tol, fh, source=source, max_speed=w_robot)
+        try:
+            fh = open(log, "rb")
+        except OSError as exc:
+            raise InputError("log", MISSING, f"cannot be read ({exc.strerror or exc})",
+                             source=source) from None
+        with fh:
+            res = monitor_log(s, traj, tol, bounded_lines(fh, source), source=source,
+                              max_speed=w_robot)
     t2 = time.perf_counter()
     # monitor: wall-clock seconds of the stream; monitor_cpu: this process's CPU seconds in it.
     res.timings_s = {"certificate": t1 - t0, "monitor": t2 - t1,

@@ -22,10 +22,10 @@ import re
 import tomllib
 from dataclasses import dataclass
 from fractions import Fraction
-from pathlib import Path
 from typing import Any
 
 from ..errors import MISSING, InputError
+from ..files import LIMITS, echo, read_bounded
 from ._counts import GridRefused, joint_grid, min_points, time_steps
 
 __all__ = [
@@ -160,7 +160,8 @@ class _Reader:
         return None
 
     def fail(self, field: str, value: Any, message: str) -> InputError:
-        return InputError(field, value, message, source=self.source, line=self.line_of(field))
+        return InputError(field, echo(value), message, source=self.source,
+                          line=self.line_of(field))
 
     def table(self, doc: dict[str, Any], key: str, allowed: set[str], required: set[str],
               prefix: str = "") -> dict[str, Any]:
@@ -386,13 +387,9 @@ def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     """Read and validate a scenario TOML file; InputError (exit 2) names what is wrong."""
-    p = Path(path)
     source = str(path)
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise InputError("scenario", MISSING, f"cannot be read ({exc.strerror or exc})",
-                         source=source) from None
+    # Bounded (docs/model.md §3): /dev/zero or a huge file ends at the limit, not in memory.
+    data = read_bounded(path, LIMITS["scenario"], source, field="scenario")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
@@ -401,7 +398,7 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+)", str(exc))
-        raise InputError("toml", str(exc), "is not valid TOML", source=source,
+        raise InputError("toml", echo(str(exc)), "is not valid TOML", source=source,
                          line=int(m.group(1)) if m else None) from None
     return parse_scenario(doc, source=source, text=text, sha256=hashlib.sha256(data).hexdigest())
 

@@ -27,8 +27,11 @@ obligation ``Monitor.between_samples`` proves it with Z3 on this very function's
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
+from array import array
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
@@ -37,6 +40,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
+from ..files import LIMITS, bounded_lines, echo, read_bounded
 from ._arith import max_of
 from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
                            Certificate, ContactDetail, link_rects, link_speeds, prove_motion)
@@ -106,46 +110,49 @@ def csv_column_order(header: str, source: str | None = None) -> list[int]:
     names = [x.strip() for x in header.strip().split(",")]
     for name in COLUMNS:
         if name not in names:
-            raise _fail("header", header.strip(), f"is missing the column {name!r} (need "
+            raise _fail("header", echo(header.strip()), f"is missing the column {name!r} (need "
                         f"{','.join(COLUMNS)})", source, 1)
     if len(names) != len(COLUMNS) or len(set(names)) != len(names):
-        raise _fail("header", header.strip(), f"must have exactly the columns "
+        raise _fail("header", echo(header.strip()), f"must have exactly the columns "
                     f"{','.join(COLUMNS)}", source, 1)
     return [names.index(c) for c in COLUMNS]
 
 
-def parse_trajectory_csv(text: str, s: Scenario, *, source: str | None = None,
+def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str | None = None,
                          allow_speed: bool = False) -> Trajectory:
-    """A CSV trajectory, validated (``validate``); errors name the file and line."""
-    lines = text.splitlines()
-    order = csv_column_order(lines[0] if lines else "", source)
-    last = len(lines)
-    while last > 1 and not lines[last - 1].strip():
-        last -= 1                                   # trailing blank lines are no rows
-    rows: list[list[float]] = []
+    """A CSV trajectory (its text, or its lines as ``files.bounded_lines`` streams them),
+    validated (``validate``); errors name the file and line, echoing at most ECHO_CHARS of a
+    value. Rows are kept as doubles only (8 bytes a value), not as text."""
+    lines = iter(text.splitlines() if isinstance(text, str) else text)
+    order = csv_column_order(next(lines, ""), source)
+    vals: array[float] = array("d")
     where: list[int] = []
-    for no in range(2, last + 1):
-        line = lines[no - 1]
+    blank: int | None = None                        # the first of blank lines not yet followed
+    no = 1
+    for line in lines:
+        no += 1
         if not line.strip():
-            raise _fail("row", line, "is blank (rows must follow one another)", source, no)
-        fields = line.split(",")
+            blank = no if blank is None else blank
+            continue
+        if blank is not None:                       # trailing blank lines are no rows; others
+            raise _fail("row", "", "is blank (rows must follow one another)", source, blank)
+        fields = line.rstrip("\r\n").split(",")
         if len(fields) != len(COLUMNS):
-            raise _fail("row", line, f"must have {len(COLUMNS)} values, has {len(fields)}",
-                        source, no)
-        vals = []
+            raise _fail("row", echo(line.strip()), f"must have {len(COLUMNS)} values, has "
+                        f"{len(fields)}", source, no)
         for name, i in zip(COLUMNS, order):
             try:
                 v = float(fields[i])
             except ValueError:
-                raise _fail(name, fields[i].strip(), "must be a number", source, no) from None
+                raise _fail(name, echo(fields[i].strip()), "must be a number", source,
+                            no) from None
             if not math.isfinite(v):
                 raise _fail(name, v, "must be finite", source, no)
             vals.append(v)
-        rows.append(vals)
         where.append(no)
-    if not rows:
+    if not where:
         raise _fail("trajectory", MISSING, "must have at least one row", source, 1)
-    arr = np.asarray(rows, dtype=float)
+    arr = np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
     traj = Trajectory(arr[:, 0].copy(), arr[:, 1:].copy(), source, tuple(where))
     validate(traj, s, allow_speed=allow_speed)
     return traj
@@ -166,14 +173,14 @@ def parse_trajectory_json(doc: Any, s: Scenario, *, source: str | None = None,
             raise _fail(name, type(col).__name__, "must be a list of numbers", source, None)
         for k, v in enumerate(col):
             if isinstance(v, bool) or not isinstance(v, (int, float)):
-                raise _fail(f"{name}[{k}]", v, "must be a number", source, None)
+                raise _fail(f"{name}[{k}]", echo(v), "must be a number", source, None)
             if not math.isfinite(float(v)):
                 raise _fail(f"{name}[{k}]", v, "must be finite", source, None)
         cols.append([float(v) for v in col])
     extra = sorted(set(doc) - set(COLUMNS))
     if extra:
-        raise _fail("trajectory", extra, f"has unknown keys (columns are {', '.join(COLUMNS)})",
-                    source, None)
+        raise _fail("trajectory", echo(extra),
+                    f"has unknown keys (columns are {', '.join(COLUMNS)})", source, None)
     counts = {len(c) for c in cols}
     if len(counts) != 1:
         raise _fail("trajectory", {n: len(c) for n, c in zip(COLUMNS, cols)},
@@ -187,16 +194,32 @@ def parse_trajectory_json(doc: Any, s: Scenario, *, source: str | None = None,
 
 
 def load_trajectory(path: str | Path, s: Scenario, *, allow_speed: bool = False) -> Trajectory:
-    """A trajectory file: JSON if it ends in .json (or starts with ``{``), else CSV."""
+    """A trajectory file: JSON if it ends in .json (or its first line starts with ``{``), else
+    CSV. Bounded (docs/model.md §12): CSV is streamed line by line, each line within
+    LIMITS["line"], the file within LIMITS["trajectory"]; JSON, read whole, within the latter."""
     p = Path(path)
-    text = p.read_text(encoding="utf-8")
-    if p.suffix.lower() == ".json" or text.lstrip().startswith("{"):
+    source = str(p)
+    limit = LIMITS["trajectory"]
+    if p.suffix.lower() != ".json":
         try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise _fail("JSON", exc.msg, "is not valid JSON", str(p), exc.lineno) from None
-        return parse_trajectory_json(doc, s, source=str(p), allow_speed=allow_speed)
-    return parse_trajectory_csv(text, s, source=str(p), allow_speed=allow_speed)
+            fh = open(p, "rb")
+        except OSError as exc:
+            raise _fail("trajectory", MISSING, f"cannot be read ({exc.strerror or exc})", source,
+                        None) from None
+        with fh:
+            lines = bounded_lines(fh, source, total=limit)
+            first = next(lines, "")
+            if not first.lstrip().startswith("{"):
+                return parse_trajectory_csv(itertools.chain([first], lines), s, source=source,
+                                            allow_speed=allow_speed)
+    data = read_bounded(p, limit, source, lines=False, field="trajectory")
+    try:
+        doc = json.loads(data.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise _fail("trajectory", MISSING, "is not UTF-8 text", source, None) from None
+    except json.JSONDecodeError as exc:
+        raise _fail("JSON", echo(exc.msg), "is not valid JSON", source, exc.lineno) from None
+    return parse_trajectory_json(doc, s, source=source, allow_speed=allow_speed)
 
 
 def validate(traj: Trajectory, s: Scenario, *, allow_speed: bool = False) -> None:

@@ -69,6 +69,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
+from ..files import LIMITS, check_file_size
 from ._layers import Layers, npz_member
 from ._paths import J1, J2, MOVES, SearchResult, SearchStatus, path_violations
 from ._triples import Failure
@@ -197,6 +198,17 @@ def load_witness(path: str | Path) -> Witness:
     def bad(field: str, value: Any, message: str) -> InputError:
         return InputError(field, value, message, source=source)
 
+    # Bounded (docs/model.md §11): the file and its arrays unpacked within LIMITS["witness"].
+    limit = LIMITS["witness"]
+    check_file_size(path, limit, source, field="witness")
+    try:
+        with zipfile.ZipFile(path) as zf:
+            unpacked = sum(info.file_size for info in zf.infolist())
+    except (OSError, zipfile.BadZipFile):
+        unpacked = 0                                   # np.load below says what is wrong
+    if unpacked > limit.value():
+        raise bad("witness", MISSING, f"unpacks to {unpacked:,} bytes, more than "
+                  f"{limit.words(limit.value())}")
     try:
         z = np.load(path, allow_pickle=False)
         if not isinstance(z, np.lib.npyio.NpzFile):

@@ -188,3 +188,15 @@ def test_reference_speeds_over_an_interval_are_the_pieces_it_meets():
             [0, 0, 0, 0.5], [1, 3, 0, 0.5], [0, 0, 0, 0], [1, 0, 0, 0]]
     assert got.tolist() == want
     assert ref.top().tolist() == [1, 3, 0, 0.5]
+
+
+def test_blocks_are_bounded_in_characters_too(cell, monkeypatch):
+    # Long lines (valid numbers padded with zeros) make smaller blocks; the result is the same.
+    keep = _hole(cell)
+    ref = _monitor(cell, keep)
+    monkeypatch.setattr(_trajectory_runs, "BLOCK_CHARS", 500)
+    got = _monitor(cell, keep)
+    assert (got.samples, got.unobserved, got.covered_fraction) == (
+        ref.samples, ref.unobserved, ref.covered_fraction)
+    sizes = [len(b) for b in _trajectory_runs._blocks(iter(["x" * 100 + "\n"] * 50), 16_384)]
+    assert sizes == [5] * 10
