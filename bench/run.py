@@ -15,7 +15,10 @@ its stages (the numbers behind the 0.15 s target's note). `make prove` itself (`
 
 The campaign item (`cfmpa compare`, a fixed campaign with 1 and 2 local workers, and the
 speed-up) runs in the full bench and alone with ``--only campaign`` (merged into an existing
-results.json); --quick leaves it out (its cluster start alone is seconds).
+results.json); --quick leaves it out (its cluster start alone is seconds). Likewise
+``plan_scaling`` (``--only plan_scaling``): `cfmpa plan --contracts full` of the default
+workcell at dt = 0.02, 0.01, 0.0075 in fresh processes, with cells, seconds, peak resident
+memory and bytes a cell (docs/model.md §3's cell budget rests on it).
 """
 
 from __future__ import annotations
@@ -52,6 +55,9 @@ class Config:
     sample: int = 2000                     # per-cell shapely loop
     dwithin_stride: int = 8                # vectorised dwithin: every 8th layer, extrapolated
     scaling_dts: tuple[float, ...] = (0.04, 0.02, 0.01)
+    #: `cfmpa plan --contracts full` of the default workcell per dt, fresh processes (item 1 of
+    #: issue 24: bytes a cell); 0.005 (381 M cells) is left to a quiet machine.
+    plan_scaling_dts: tuple[float, ...] = (0.02, 0.01, 0.0075)
     one_degree: dict[str, Any] = field(default_factory=dict)
     prove: bool = False                    # time `make prove` (cfmpa prove --audit): one run
     monitor_samples: int = 1_000_000       # the monitor's log (10^6 samples)
@@ -61,6 +67,7 @@ class Config:
         if quick:
             return cls(quick=True, runs=runs or 1, warmup=0, budget_s=20.0, dt=0.16, sample=100,
                        dwithin_stride=1, scaling_dts=(0.32, 0.16, 0.08),
+                       plan_scaling_dts=(0.16, 0.08),
                        one_degree=one_degree(10), prove=prove, monitor_samples=20_000)
         return cls(quick=False, runs=runs or 5, one_degree=one_degree(1), prove=prove)
 
@@ -278,6 +285,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
     if not cfg.quick:   # the smoke run's key set stays as it was (see the module docstring)
         res["campaign"] = campaign_section(cfg, tmp)
     res["monitor"] = monitor_section(cfg, tmp, base, have_cli and cli_has("monitor"))
+    res["plan_scaling"] = plan_scaling_section(cfg, tmp) if have_cli else no_cli
     res["targets"] = targets(res, cfg)
     res["informational"] = informational(res, cfg)
     res["meta"]["bench_wall_s"] = round(time.perf_counter() - t_start, 1)
@@ -285,6 +293,68 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
 
 
 CONTRACT_MODES = ("off", "sampled", "full")
+
+
+def plan_scaling_section(cfg: Config, tmp: Path) -> dict[str, Any]:
+    """Bytes a cell: `cfmpa plan --contracts full` of the default workcell (``default_at``) at
+    each of ``plan_scaling_dts``, one run each in a fresh process, the kernels loaded by one
+    unrecorded run at the coarsest dt first. Per dt: cells, seconds, the process's peak
+    resident memory (ru_maxrss of the child) and that peak over the cells; and the exponent of
+    a least-squares fit of log seconds against log cells."""
+    rows = []
+    for n, dt in enumerate(cfg.plan_scaling_dts):
+        spec = default_at(dt)
+        toml = scenario_file(spec, tmp)
+        folder = tmp / f"plan-scaling-{n}"
+        run = cli_run(cfg, ["plan", str(toml), "--variant", "modified", "--out", str(folder),
+                            "--contracts", "full"], runs=1, warmup=1 if n == 0 else 0)
+        doc = plan_json_of(folder)
+        g = doc.get("grid") or {}
+        cells = (g["N"] + 1) * g["m"] * g["n"] if g else None
+        row: dict[str, Any] = {"dt": dt, "cells": cells,
+                               "grid": [g["N"] + 1, g["m"], g["n"]] if g else None}
+        if "median_s" in run and cells:
+            peak_mib = run["peak_rss_mb"]
+            row |= {"seconds": round(run["median_s"], 3), "peak_mib": peak_mib,
+                    "bytes_per_cell": round(peak_mib * 2**20 / cells, 2),
+                    "status": doc.get("status"), "timings_s": doc.get("timings_s")}
+        else:
+            row["error"] = run.get("error") or run.get("skipped") or "no plan.json"
+        rows.append(row)
+    ok = [r for r in rows if "seconds" in r]
+    exponent = None
+    if len(ok) >= 2:
+        x = [math.log(r["cells"]) for r in ok]
+        y = [math.log(r["seconds"]) for r in ok]
+        mx, my = statistics.fmean(x), statistics.fmean(y)
+        exponent = round(sum((a - mx) * (b - my) for a, b in zip(x, y))
+                         / sum((a - mx) ** 2 for a in x), 3)
+    return {"rows": rows, "time_exponent": exponent,
+            "note": "`cfmpa plan --contracts full` of the default workcell (start and goal "
+                    "scaled to the grid), one run per dt in a fresh process; peak_mib is its "
+                    "ru_maxrss, bytes_per_cell that over (N + 1) m n; time_exponent: the slope "
+                    "of log seconds against log cells (least squares)"}
+
+
+def plan_json_of(folder: Path) -> dict[str, Any]:
+    try:
+        return json.loads((folder / "plan.json").read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def plan_scaling_lines(sec: dict[str, Any]) -> list[str]:
+    lines = ["", "cfmpa plan --contracts full, default workcell (bytes a cell):",
+             f"{'dt':>8s} {'cells':>12s} {'seconds':>9s} {'peak MiB':>9s} {'B/cell':>7s}"]
+    for r in sec.get("rows", []):
+        if "seconds" in r:
+            lines.append(f"{r['dt']:8g} {r['cells']:12d} {r['seconds']:9.2f} "
+                         f"{r['peak_mib']:9.1f} {r['bytes_per_cell']:7.2f}")
+        else:
+            lines.append(f"{r['dt']:8g} {str(r.get('cells')):>12s} {r.get('error')}")
+    if sec.get("time_exponent") is not None:
+        lines.append(f"time ~ cells^{sec['time_exponent']}")
+    return lines
 
 
 def cli_default_contracts() -> str | None:
@@ -827,6 +897,8 @@ def table(res: dict[str, Any]) -> str:
     camp = res.get("campaign")
     if camp is not None:
         lines += campaign_lines(camp)
+    if "rows" in (res.get("plan_scaling") or {}):
+        lines += plan_scaling_lines(res["plan_scaling"])
     lines += profile_lines(res.get("builtdr_profile"))
     lines.append("")
     lines.append("targets (measured, limit, verdict, what was measured):")
@@ -892,22 +964,24 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent),
                     help="folder for results.json (default: bench/)")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
-    ap.add_argument("--only", choices=["campaign"], default=None,
+    ap.add_argument("--only", choices=["campaign", "plan_scaling"], default=None,
                     help="run only this item and merge it into OUT/results.json")
     ap.add_argument("--prove", action="store_true",
                     help="also time `make prove` (cfmpa prove --audit DIR), one run of a minute "
                          "or two; `make bench` passes it")
     args = ap.parse_args(argv)
     cfg = Config.of(args.quick, args.runs, prove=args.prove)
-    if args.only == "campaign":
+    if args.only is not None:
+        section, lines = {"campaign": (campaign_section, campaign_lines),
+                          "plan_scaling": (plan_scaling_section, plan_scaling_lines)}[args.only]
         out = Path(args.out) / "results.json"
         res = json.loads(out.read_text()) if out.exists() else {}
         with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:
-            res["campaign"] = campaign_section(cfg, Path(tmp))
+            res[args.only] = section(cfg, Path(tmp))
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text(json.dumps(res, indent=1, default=str) + "\n")
-        print("\n".join(campaign_lines(res["campaign"])))
-        print(f"\nwrote {out} (campaign merged)")
+        print("\n".join(lines(res[args.only])))
+        print(f"\nwrote {out} ({args.only} merged)")
         return 0
     with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:
         res = bench(cfg, Path(tmp))

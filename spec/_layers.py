@@ -12,7 +12,8 @@ in order and looks at steps s and min(s + 1, N) together), so neither needs it w
   that ndarray, for small grids and tests).
 - ``LayerSpill``: layers appended in order to an unnamed temporary file (``tempfile``, in
   ``TMPDIR``; removed when the last reference goes), then read back as ``Layers``. The file is
-  in the page cache or on disk, not in the process's memory.
+  in the page cache or on disk, not in the process's memory (on a tmpfs ``TMPDIR`` it is memory
+  again, outside the process: point TMPDIR at a disk there).
 - ``npz_layers``: a member of an uncompressed ``.npz`` file as ``Layers``, read in place.
 - ``save_npz``: an uncompressed ``.npz`` written member by member and layer by layer; ``np.load``
   reads it as it reads ``np.savez``'s.

@@ -44,9 +44,12 @@ __all__ = [
     "MAX_STEP_RAD",
 ]
 
-#: Cells of D_R, (N + 1) * m * n, allowed before any work starts. About 1 byte per cell for
-#: dr.npy and ~20 bytes per cell at the search's peak; raise with CFMPA_MAX_CELLS.
-DEFAULT_MAX_CELLS = 60_000_000
+#: Cells of D_R, (N + 1) * m * n, allowed before any work starts: what fits in 6 GiB at the
+#: peak of a fully checked `cfmpa plan` measured on the default workcell at dt = 0.01, 15.6
+#: bytes a cell (714 MiB for 48 M cells; D_R is 1 byte a cell, the search's back-pointers and
+#: the witness are per layer or spilled to a temporary file, docs/model.md §3), 6 GiB / 15.6 =
+#: 413 M, rounded down. Raise with CFMPA_MAX_CELLS.
+DEFAULT_MAX_CELLS = 400_000_000
 #: An angle given for the right arm's start or goal must be this close to a grid point (rad).
 ANGLE_TOLERANCE = 1e-9
 #: Physical range: |base coordinate| <= MAX_BASE_M (m); 0 < link length, width <= MAX_LENGTH_M (m).

@@ -38,7 +38,9 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert set(res) == {"meta", "builtdr", "builtdr_profile", "search", "shapely", "scaling",
                         "plan", "dr_cli", "check", "prove", "contracts", "one_degree", "monitor",
-                        "targets", "informational"}
+                        "plan_scaling", "targets", "informational"}
+    assert [r["dt"] for r in res["plan_scaling"]["rows"]] == [0.16, 0.08]
+    assert all("error" not in r and r["bytes_per_cell"] > 0 for r in res["plan_scaling"]["rows"])
     for v in Variant:
         assert set(res["builtdr"][v.value]) == {"reference", "fast", "fast_regions_given"}
         assert set(res["search"][v.value]) == {"reference", "fast"}
@@ -186,3 +188,27 @@ def test_informational_rows_are_former_targets_only():
     names = {r["target"] for r in rows}
     assert all(r["former_target"] for r in rows)
     assert not names & {r["target"] for r in run.targets(made_up(), run.Config.of(False, None))}
+
+
+def test_plan_scaling_reports_cells_peak_bytes_a_cell_and_the_exponent(tmp_path, monkeypatch):
+    # cli_run and plan.json made up: two grids, the second 8x the cells and 8x the seconds.
+    run = bench_module()
+    cfg = run.Config.of(True, None)
+    grids = iter([(2, 10, 10), (4, 20, 20)])
+    seconds = iter([1.0, 8.0])
+
+    def fake_cli_run(cfg, argv, *a, **k):
+        N1, m, n = next(grids)
+        out = Path(argv[argv.index("--out") + 1])
+        out.mkdir(parents=True)
+        (out / "plan.json").write_text(json.dumps({"grid": {"N": N1 - 1, "m": m, "n": n},
+                                                   "status": "found", "timings_s": {}}))
+        return {"median_s": next(seconds), "min_s": 0, "max_s": 0, "runs": 1,
+                "peak_rss_mb": N1 * m * n / 2**20 * 15}
+
+    monkeypatch.setattr(run, "cli_run", fake_cli_run)
+    sec = run.plan_scaling_section(cfg, tmp_path)
+    assert [r["cells"] for r in sec["rows"]] == [200, 1600]
+    assert [r["bytes_per_cell"] for r in sec["rows"]] == [15.0, 15.0]
+    assert sec["time_exponent"] == 1.0
+    assert "time ~ cells^1.0" in run.plan_scaling_lines(sec)[-1]

@@ -16,7 +16,7 @@ from hypothesis import given, settings
 import factory
 from cfmpa import cli
 from cfmpa.errors import MISSING, InputError
-from cfmpa.spec import (Variant, exact_n, exact_tf, left_angles, left_box, link_corners,
+from cfmpa.spec import (DEFAULT_MAX_CELLS, Variant, exact_n, exact_tf, left_angles, left_box, link_corners,
                         load_scenario, make_grid, parse_scenario, right_box)
 from cfmpa.spec._regions import SNAP, right_region_polygons
 
@@ -103,7 +103,7 @@ def test_budget_message_names_the_grid_and_caps_its_numbers():
     err = refused(dt=0.0005)
     text = str(err)
     assert "N=2801, m=12568, n=12568" in text
-    assert "442588856448 cells" in text and "60000000 cells" in text
+    assert "442588856448 cells" in text and f"{DEFAULT_MAX_CELLS} cells" in text
     assert "CFMPA_MAX_CELLS" in text and "largest factor is m" in text
     huge = str(refused(right__omega=[1e-300, 1.0]))
     assert "m=2.513e+301" in huge and "cells, over" in huge
@@ -129,7 +129,7 @@ def test_angles_on_grid_points_are_accepted_as_cells():
 def test_budget_can_be_raised_by_environment(monkeypatch):
     monkeypatch.setenv("CFMPA_MAX_CELLS", str(10**9))
     s = parse_scenario(factory.doc(dt=0.005))
-    assert s.cells > 60_000_000 // 100  # accepted now, and really large
+    assert s.cells > DEFAULT_MAX_CELLS  # over the default budget, accepted now
     monkeypatch.setenv("CFMPA_MAX_CELLS", "lots")
     with pytest.raises(InputError, match="CFMPA_MAX_CELLS"):
         parse_scenario(factory.doc())
@@ -252,7 +252,7 @@ def test_extreme_floats_are_refused_by_name_or_give_a_sane_grid(key, xs):
         assert f"got {err.value!r}" in str(err)
         return
     g = make_grid(s)   # an accepted scenario has a grid within the budget, every step finite
-    assert (g.N + 1) * g.m * g.n <= 60_000_000
+    assert (g.N + 1) * g.m * g.n <= DEFAULT_MAX_CELLS
     assert all(math.isfinite(x) and x >= 0 for x in g.h)
     assert all(s.left.omega[q] * s.dt <= 3.14 and s.right.omega[q] * s.dt <= 3.14
                for q in range(2))
