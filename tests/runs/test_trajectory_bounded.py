@@ -90,8 +90,18 @@ def test_a_sparse_2_gb_file_cut_short(cell, tmp_path):
     _one_line_error(_cli("certify", str(scen), "--traj", str(js)), str(js), None,
                     "CFMPA_MAX_TRAJECTORY_BYTES")
     wit = _sparse(tmp_path / "w.npz")
+    # Under the witness limit (32 GiB: it is read a layer at a time in place), it is no npz.
     with pytest.raises(InputError) as e:
         load_witness(wit)
+    assert "is not an .npz witness file" in e.value.render()
+    # Over a lowered limit, the limit is named.
+    monkeypatch = pytest.MonkeyPatch()
+    monkeypatch.setenv("CFMPA_MAX_WITNESS_BYTES", str(2**30))
+    try:
+        with pytest.raises(InputError) as e:
+            load_witness(wit)
+    finally:
+        monkeypatch.undo()
     assert "CFMPA_MAX_WITNESS_BYTES" in e.value.render()
 
 
