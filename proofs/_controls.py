@@ -48,8 +48,8 @@ __all__ = ["Control", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS", "
            "collect_controls", "premise_controls", "run_control"]
 
 #: Z3's budget per premise control: with the composition's pins, then without them.
-PREMISE_PINNED_MS = 2_000
-PREMISE_FREE_MS = 1_500
+PREMISE_PINNED_MS = 1_000
+PREMISE_FREE_MS = 1_000
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,9 @@ __all__ = ["CVC5_TIMEOUT_MS", "Cvc5Answer", "Cvc5Pool", "Cvc5Worker", "cvc5_vers
 #: cvc5's time limit per query. A run replays only the statements cvc5 decided when they were
 #: pinned (``_pins.cvc5_skips``), so a query that runs into it is rare; ``--repin`` tries all.
 CVC5_TIMEOUT_MS = 5_000
+#: cvc5's limit on a statement it did not decide when pinned: re-run every time (it may decide
+#: it now, with another version or machine), on a shorter budget than a new statement's.
+CVC5_RECHECK_MS = 1_500
 #: How long past its own limit a query may run before the worker is killed.
 _GRACE_S = 1.0
 #: The worker's start-up (importing cvc5), allowed on top on a query that starts it.
@@ -118,8 +121,10 @@ class Cvc5Pool:
         self._worker = Cvc5Worker()
         self._ex = ThreadPoolExecutor(max_workers=1, thread_name_prefix="cvc5")
 
-    def submit(self, text: str) -> Future[Cvc5Answer]:
-        return self._ex.submit(self._worker.check, text, self.timeout_ms)
+    def submit(self, text: str, timeout_ms: int | None = None) -> Future[Cvc5Answer]:
+        """Queue ``text``; ``timeout_ms`` (default the pool's) is cvc5's limit on it."""
+        return self._ex.submit(self._worker.check, text,
+                               self.timeout_ms if timeout_ms is None else timeout_ms)
 
     def close(self) -> None:
         self._ex.shutdown(wait=True)

@@ -318,7 +318,8 @@ class _Pending:
                     else:
                         disagree.append(f"{r.name} (Z3 {r.answer}, cvc5 {cvc5})")
                 if cvc5 == "unknown":
-                    note = f"cvc5 unknown ({reason})"
+                    note = (f"{note}: still unknown ({reason})" if "when pinned" in note
+                            else f"cvc5 unknown ({reason})")
             vc = self.certificates[n]
             if "cvc5" not in solvers and r.answer == "unsat" and vc is not None:
                 t0 = time.perf_counter()
@@ -344,9 +345,10 @@ class _Pending:
 def discharge_pending(ob: Obligation, pool: Any,
                       skip: dict[str, str] | None = None) -> _Pending:
     """Run one obligation with Z3 (or sympy, or the data check), handing each VC's standard
-    SMT-LIB to ``pool`` (a ``_cvc5.Cvc5Pool``) for the replay, except the statements in
-    ``skip`` (hash -> why: cvc5 did not decide them when they were pinned); ``settle()`` gives
-    the Proof. Any exception is a FAILED verdict that says why."""
+    SMT-LIB to ``pool`` (a ``_cvc5.Cvc5Pool``) for the replay; the statements in ``skip`` (hash
+    -> why: cvc5 did not decide them when they were pinned) are replayed too, on the shorter
+    ``_cvc5.CVC5_RECHECK_MS``; ``settle()`` gives the Proof. Any exception is a FAILED verdict
+    that says why."""
     t0 = time.perf_counter()
     text = ""
     futures: list[Any] = []
@@ -525,6 +527,7 @@ def _short_text(f: z3.ExprRef, width: int = 50) -> str:
 
 def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
             ) -> tuple[dict[str, Any], list[Any], list[Any]]:
+    from ._cvc5 import CVC5_RECHECK_MS
     from ._depth import deepest, is_nonlinear, vc_depth
 
     if not q.vcs:
@@ -570,13 +573,14 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
         depth = None
         if ans == z3.unsat and ob.expected is Verdict.PROVED:
             depth = vc_depth(hyps, vc.goal)
-        replay = std is not None and ans != z3.unknown and sha not in skip
-        futures.append(pool.submit(std) if replay else None)
+        replay = std is not None and ans != z3.unknown
+        # A statement cvc5 did not decide when pinned is re-run too, on a shorter budget.
+        futures.append(pool.submit(std, CVC5_RECHECK_MS if sha in skip else None)
+                       if replay else None)
         certs.append(vc if vc.certificate is not None else None)
         cvc5 = why = ""
         if sha in skip:
-            cvc5, why = "skipped", skip[sha]
-            note = f"cvc5 undecided when pinned ({why}); not re-run"
+            note = f"cvc5 undecided when pinned ({skip[sha]}); re-run for {CVC5_RECHECK_MS} ms"
         results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
                                 cvc5=cvc5, cvc5_reason=why,
                                 solvers=("z3",) if str(ans) == want else (), note=note,

@@ -83,7 +83,8 @@ def _statement(entry: dict[str, Any]) -> dict[str, Any]:
 
 
 def cvc5_skips(lock: dict[str, dict[str, Any]]) -> dict[str, str]:
-    """Statement hash -> why cvc5 is not re-run on it: cvc5 did not decide it when pinned."""
+    """Statement hash -> why cvc5 did not decide it when pinned (it is re-run on a shorter
+    budget, _cvc5.CVC5_RECHECK_MS)."""
     out: dict[str, str] = {}
     for entry in lock.values():
         answers = entry.get("cvc5") or {}
