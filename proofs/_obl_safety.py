@@ -41,7 +41,7 @@ from fractions import Fraction
 import z3
 
 from ..impl import SNAP, lattice_range, link_reach, sweep_margin
-from ..spec import DISTANCE_ERROR_M, EPS, Arm, Variant, cell_box, ptp_angles
+from ..spec import DISTANCE_ERROR_M, EPS, Arm, Variant, cell_box, ptp_angles, ptp_fraction
 from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
                             is_path_fixed, member, position, z3_path)
 from ._obl_margin import margin_obligations
@@ -1256,18 +1256,87 @@ def step_window(k: z3.ArithRef, t: z3.ArithRef, dt: z3.ArithRef) -> z3.BoolRef:
     return z3.And(K * dt <= t, t <= (K + 1) * dt)
 
 
+def principal_steps(P: Principal) -> dict[str, Lemma]:
+    """Small lemmas of (a), each decided by Z3 and by cvc5, that the motion and rest VCs use by
+    substitution (cvc5 does not decide those VCs without them): the PTP fraction
+    f(x) = spec.ptp_fraction(x, Tf) moves forward by at most dt / Tf over a window of dt
+    (frac_step); the travel time bounds each joint's travel (travel); a joint's displacement
+    over a forward step of the fraction is within omega_q dt, with the travel's sign (step_q);
+    N dt covers Tf (n_covers), and from N dt on the fraction is 1 (at_rest)."""
+    Tf, dt, om = P.Tf, P.dt, P.omega
+    d = [P.goal[q] - P.start[q] for q in range(2)]
+    a, b, x, t = z3.Reals("fs.a fs.b st.x ar.t")
+    N = z3.ToReal(P.N)
+
+    def f(y: z3.ArithRef) -> z3.ArithRef:
+        return ptp_fraction(y, Tf)
+    out: dict[str, Lemma] = {}
+    key = "0 <= a <= b <= a + dt"
+    out["frac_step"] = lemma(
+        "frac_step", (("dt > 0", dt > 0), ("Tf >= 0", Tf >= 0),
+                      (key, z3.And(0 <= a, a <= b, b <= a + dt))),
+        z3.And(f(a) <= f(b), (f(b) - f(a)) * Tf <= dt, 0 <= f(a), f(b) <= 1), key,
+        names=dict(a=a, b=b))
+    travel = z3.And(Tf >= 0, *[z3.And(d[q] <= om[q] * Tf, -d[q] <= om[q] * Tf) for q in range(2)])
+    tf = P.tf_def()
+    out["travel"] = lemma("travel", (("omega_q > 0", z3.And(om[0] > 0, om[1] > 0)), tf), travel,
+                          tf[0])
+    for q in range(2):
+        kq = "x Tf <= dt"
+        out[f"step{q + 1}"] = lemma(
+            f"step{q + 1}", (("omega_q > 0", om[q] > 0), ("dt > 0", dt > 0),
+                             ("travel (Tf >= 0, |goal_q - start_q| <= omega_q Tf)",
+                              z3.And(Tf >= 0, d[q] <= om[q] * Tf, -d[q] <= om[q] * Tf)),
+                             ("x >= 0", x >= 0), (kq, x * Tf <= dt)),
+            z3.And(d[q] * x <= om[q] * dt, -(d[q] * x) <= om[q] * dt,
+                   z3.Implies(d[q] >= 0, d[q] * x >= 0), z3.Implies(d[q] <= 0, d[q] * x <= 0)),
+            kq, names=dict(x=x))
+    nd = P.n_def()
+    out["n_covers"] = lemma("n_covers", (("dt > 0", dt > 0), ("Tf >= 0", Tf >= 0), nd),
+                            z3.And(N * dt >= Tf, P.N >= 1), nd[0])
+    kr = "t >= N dt"
+    out["at_rest"] = lemma("at_rest", (("dt > 0", dt > 0), ("Tf >= 0", Tf >= 0),
+                                       ("N dt >= Tf, N >= 1", z3.And(N * dt >= Tf, P.N >= 1)),
+                                       (kr, t >= N * dt)),
+                           z3.And(f(t) == 1, f(N * dt) == 1), kr, names=dict(t=t))
+    return out
+
+
+def _step_instances(steps: dict[str, Lemma], P: Principal, lo: z3.ArithRef, hi: z3.ArithRef,
+                    at: str) -> list[Hyp]:
+    """frac_step over [lo, hi] and step_q at the fraction's advance there."""
+    adv = ptp_fraction(hi, P.Tf) - ptp_fraction(lo, P.Tf)
+    out = steps["frac_step"].at(at, a=lo, b=hi)
+    for q in (1, 2):
+        out += steps[f"step{q}"].at(at, x=adv)
+    return out
+
+
 def principal_lemmas(variant: str, *, sign_flip: bool = False,
                      n_def: Hyp | None = None) -> tuple[Lemma, Lemma]:
     """(a) for ``variant``: the motion in layer k's box over [k dt, (k+1) dt], and in the rest
-    layer's box from N dt on. ``sign_flip`` and ``n_def`` are the tests' mutants."""
+    layer's box from N dt on, each using principal_steps' lemmas by substitution.
+    ``sign_flip`` and ``n_def`` are the tests' mutants."""
     P = Principal.named()
+    steps = principal_steps(P)
     k, t = z3.Int("k"), z3.Real("t")
+    K = z3.ToReal(k)
     key = "k dt <= t <= (k+1) dt"
-    motion = lemma("motion", P.basics() + (("k >= 0", k >= 0), (key, step_window(k, t, P.dt))),
-                   in_box(P.theta(t), P.box(variant, z3.ToReal(k), sign_flip=sign_flip)), key,
+    used = list(steps["travel"].at("the travel time"))
+    for lo, hi, at in ((K * P.dt, t, "[k dt, t]"), (t, (K + 1) * P.dt, "[t, (k+1) dt]")):
+        used += _step_instances(steps, P, lo, hi, at)
+    used += steps["frac_step"].at("[k dt, (k+1) dt]", a=K * P.dt, b=(K + 1) * P.dt)
+    motion = lemma("motion", P.basics() + (("k >= 0", k >= 0), (key, step_window(k, t, P.dt)))
+                   + tuple(used),
+                   in_box(P.theta(t), P.box(variant, K, sign_flip=sign_flip)), key,
                    names=dict(k=k, t=t))
     nd = n_def or P.n_def()
-    rest = lemma("rest", P.basics() + (nd, ("t >= N dt", t >= z3.ToReal(P.N) * P.dt)),
+    N = z3.ToReal(P.N)
+    used = list(steps["travel"].at("the travel time"))
+    used += steps["n_covers"].at("N")
+    used += steps["at_rest"].at("t", t=t)
+    used += _step_instances(steps, P, (N - 1) * P.dt, N * P.dt, "[(N-1) dt, N dt]")
+    rest = lemma("rest", P.basics() + (nd, ("t >= N dt", t >= N * P.dt)) + tuple(used),
                  in_box(P.theta(t), P.rest_box(variant, sign_flip=sign_flip)), nd[0],
                  names=dict(t=t))
     return motion, rest
@@ -1534,8 +1603,9 @@ _RULES = {
 
 
 def _principal_query(variant: str) -> Z3Query:
+    steps = principal_steps(Principal.named())
     motion, rest = principal_lemmas(variant)
-    return Z3Query((motion.vc, rest.vc))
+    return Z3Query(tuple(L.vc for L in steps.values()) + (motion.vc, rest.vc))
 
 
 def _subordinate_query() -> Z3Query:
@@ -1565,7 +1635,11 @@ def safety_obligations() -> list[Obligation]:
             f"[k dt, (k+1) dt], theta_L(t) lies in layer k's box, {rule}; (rest) with N = "
             "max(1, ceil(Tf / dt)) (spec.exact_n), for every t >= N dt it lies in the rest "
             f"layer's box, {rest}. Quantifier-free nonlinear real arithmetic (division, min, max, "
-            "ceil); the box rule is docs/model.md §4.1's, and the tests check it against "
+            "ceil), split so that cvc5 decides every VC as Z3 does: frac_step (the PTP fraction "
+            "advances by at most dt / Tf over a window of dt), travel (|goal_q - start_q| <= "
+            "omega_q Tf), step1/step2 (a joint's displacement over such an advance is within "
+            "omega_q dt, with the travel's sign), n_covers (N dt >= Tf) and at_rest (the "
+            "fraction is 1 from N dt on), used by substitution in motion and rest; the box rule is docs/model.md §4.1's, and the tests check it against "
             "spec.left_box on every layer of the bundled scenarios.",
             Z, P, lambda v=v: _principal_query(v)))
     out.append(Obligation(
