@@ -575,8 +575,12 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
             depth = vc_depth(hyps, vc.goal)
         replay = std is not None and ans != z3.unknown
         # A statement cvc5 did not decide when pinned is re-run too, on a shorter budget.
-        futures.append(pool.submit(std, CVC5_RECHECK_MS if sha in skip else None)
-                       if replay else None)
+        if not replay:
+            futures.append(None)
+        elif sha in skip:
+            futures.append(pool.submit(std, CVC5_RECHECK_MS))
+        else:
+            futures.append(pool.submit(std))
         certs.append(vc if vc.certificate is not None else None)
         cvc5 = why = ""
         if sha in skip:
