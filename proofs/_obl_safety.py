@@ -1506,6 +1506,107 @@ def _regions(variant: str) -> tuple[Callable[..., z3.ExprRef], Callable[..., z3.
 LINKS = (0, 1)
 
 
+@dataclass(frozen=True)
+class _At:
+    """The instant, the cells, the configurations and the point the composition reasons at."""
+
+    P: Principal
+    S: Subordinate
+    d: Z3Dims
+    k: z3.ArithRef
+    here: tuple[z3.ArithRef, z3.ArithRef]
+    theta_l: Vec
+    theta_r: Vec
+    p: Vec
+
+    @classmethod
+    def named(cls) -> _At:
+        P, S, d = Principal.named(), Subordinate.named(), Z3Dims.named()
+        L, k, t = z3_path("L"), z3.Int("kk"), z3.Real("t")
+        here, nxt = position(L, k), position(L, k + 1)
+        return cls(P, S, d, k, here, P.theta(t), S.theta(here, nxt, k, t, P.dt), _v("p"))
+
+
+def region_hypotheses(variant: str, at: _At) -> list[Hyp]:
+    """(c) as the compositions use it: the links of both arms, at the instant's configurations
+    and the point, lie in the regions of their boxes (layer k's, the rest layer's, the cell's).
+    ``region_instance_vc`` proves each an instance of ``region_statement``."""
+    region_l, region_rest, region_r = _regions(variant)
+    P, k, p, theta_l, theta_r, here = at.P, at.k, at.p, at.theta_l, at.theta_r, at.here
+    box_k = P.box(variant, z3.ToReal(k))
+    return [
+        ("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) "
+         "in layer k's regions (its box, k < N; at p)",
+         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N, in_box(theta_l, box_k)),
+                            z3.Implies(link_l(x, theta_l, p), member(region_l(k, x), p)))
+                 for x in LINKS])),
+        ("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) "
+         "in the rest regions (its box; at p)",
+         z3.And([z3.Implies(in_box(theta_l, P.rest_box(variant)),
+                            z3.Implies(link_l(x, theta_l, p), member(region_rest(x), p)))
+                 for x in LINKS])),
+        ("(c) Safety.region_soundness: links 1 and 2 of the subordinate at theta_R(t) "
+         "in the regions of its cell (its box; at p)",
+         z3.And([z3.Implies(z3.And(in_grid(at.d, here), in_box(theta_r, at.S.box(here))),
+                            z3.Implies(link_r(x, theta_r, p),
+                                       member(region_r(here[0], here[1], x), p)))
+                 for x in LINKS])),
+    ]
+
+
+#: swept(x, lo1, hi1, lo2, hi2): the region built for link x and a box (impl.swept_region).
+_SWEPT_L = z3.Function("sweptL", z3.IntSort(), _R, _R, _R, _R, REGION)
+_SWEPT_R = z3.Function("sweptR", z3.IntSort(), _R, _R, _R, _R, REGION)
+
+
+def _swept(f: z3.FuncDeclRef, x: z3.ArithRef | int, box: tuple[Vec, Vec]) -> z3.ExprRef:
+    return f(x, box[0][0], box[0][1], box[1][0], box[1][1])
+
+
+def region_statement(link: Callable[..., z3.BoolRef], swept: z3.FuncDeclRef) -> z3.BoolRef:
+    """Safety.region_soundness's conclusion, over opaque links and regions, stated once: for
+    every link x, box, configuration theta in the box and point p, a point of link x at theta
+    is a member of the region built for x and the box."""
+    x = z3.Int("rs!x")
+    lo1, hi1, lo2, hi2, t1, t2, p1, p2 = z3.Reals("rs!lo1 rs!hi1 rs!lo2 rs!hi2 rs!t1 rs!t2 "
+                                                  "rs!p1 rs!p2")
+    box = ((lo1, hi1), (lo2, hi2))
+    return z3.ForAll([x, lo1, hi1, lo2, hi2, t1, t2, p1, p2], z3.Implies(
+        z3.And(in_box((t1, t2), box), link(x, (t1, t2), (p1, p2))),
+        member(_swept(swept, x, box), (p1, p2))))
+
+
+def region_instance_vc(variant: str) -> VC:
+    """The compositions' (c) hypotheses are instances of region_statement, once the regions are
+    read as BuiltDR builds them (layer k's: the region of its box, k < N; the rest layer's: of
+    the rest box; a cell's: of its box). A (c) hypothesis stronger than the statement (a box
+    condition dropped, say) is refuted here."""
+    at = _At.named()
+    region_l, region_rest, region_r = _regions(variant)
+    P, k, here = at.P, at.k, at.here
+    key = "Safety.region_soundness for the principal's links (its statement)"
+    hyps: list[Hyp] = [
+        (key, region_statement(link_l, _SWEPT_L)),
+        ("Safety.region_soundness for the subordinate's links (its statement)",
+         region_statement(link_r, _SWEPT_R)),
+        ("layer k's regions are the regions built for its box (k < N)",
+         z3.Implies(z3.And(0 <= k, k < at.d.N), z3.And([
+             region_l(k, x) == _swept(_SWEPT_L, x, P.box(variant, z3.ToReal(k)))
+             for x in LINKS]))),
+        ("the rest layer's regions are the regions built for the rest box",
+         z3.And([region_rest(x) == _swept(_SWEPT_L, x, P.rest_box(variant)) for x in LINKS])),
+        ("a cell's regions are the regions built for its box",
+         z3.Implies(in_grid(at.d, here), z3.And([
+             region_r(here[0], here[1], x) == _swept(_SWEPT_R, x, at.S.box(here))
+             for x in LINKS]))),
+    ]
+    goal = z3.And([h for _, h in region_hypotheses(variant, at)])
+    one = z3.IntVal(1)
+    pins = ((at.d.N, one), (at.d.m, one), (at.d.n, one))
+    return VC(f"region_instances_{variant}", tuple(hyps), goal, key_premise=key, witness=pins,
+              counter_witness=pins)
+
+
 def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
                    b: tuple[Lemma, Lemma] | None = None) -> VC:
     """(e) for ``variant``; the lemmas may be replaced (the tests' mutants).
@@ -1558,23 +1659,7 @@ def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
     hyps += motion.at("the step k (a)", k=k, t=t)
     hyps += rest.at("t (a)", t=t)
     hyps += move.at("the step k (b)", c=here, c2=nxt, k=k, t=t)
-    box_k = P.box(variant, z3.ToReal(k))
-    hyps.append(("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) "
-                 "in layer k's regions (its box, k < N; at p)",
-                 z3.And([z3.Implies(z3.And(0 <= k, k < d.N, in_box(theta_l, box_k)),
-                                    z3.Implies(link_l(x, theta_l, p), member(region_l(k, x), p)))
-                         for x in LINKS])))
-    hyps.append(("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) "
-                 "in the rest regions (its box; at p)",
-                 z3.And([z3.Implies(in_box(theta_l, P.rest_box(variant)),
-                                    z3.Implies(link_l(x, theta_l, p), member(region_rest(x), p)))
-                         for x in LINKS])))
-    hyps.append(("(c) Safety.region_soundness: links 1 and 2 of the subordinate at theta_R(t) "
-                 "in the regions of its cell (its box; at p)",
-                 z3.And([z3.Implies(z3.And(in_grid(d, here), in_box(theta_r, S.box(here))),
-                                    z3.Implies(link_r(x, theta_r, p),
-                                               member(region_r(here[0], here[1], x), p)))
-                         for x in LINKS])))
+    hyps += region_hypotheses(variant, _At.named())
     target = z3.And([z3.Not(z3.And(link_l(x, theta_l, p), link_r(y, theta_r, p)))
                      for x in LINKS for y in LINKS])
     one, zero = z3.IntVal(1), z3.IntVal(0)
@@ -1618,7 +1703,7 @@ def _separation_query() -> Z3Query:
 
 
 def _composition_query(variant: str) -> Z3Query:
-    return Z3Query((_step_lemma().vc, composition_vc(variant)))
+    return Z3Query((_step_lemma().vc, region_instance_vc(variant), composition_vc(variant)))
 
 
 def safety_obligations() -> list[Obligation]:
@@ -1715,7 +1800,11 @@ def safety_obligations() -> list[Obligation]:
             "eight pairs of regions of layer k and of the rest layer, what a positive distance "
             "means). Safety.region_soundness enters as its statement for the regions involved "
             "(a link at a configuration of a region's box lies in the region), instantiated at "
-            "theta_L(t), theta_R(t) and the point, its links and regions opaque here. Every "
+            "theta_L(t), theta_R(t) and the point, its links and regions opaque here; the VC "
+            "region_instances proves each such hypothesis an instance of that one statement "
+            "(for every link, box, configuration in it and point), with the regions read as "
+            "BuiltDR builds them (layer k's, the rest layer's and a cell's: the region of its "
+            "box), so a hypothesis stronger than the statement fails. Every "
             "hypothesis that is not a proved lemma's instance is needed: cfmpa prove's negative "
             "controls drop each and require the composition without it not proved.",
             Z, P, lambda v=v: _composition_query(v)))

@@ -92,6 +92,11 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                  "        i_hi = ceil_of((hi - anchor) / g - SNAP)\n",
                  "        i_lo = floor_of((lo - anchor) / g + 1000 * SNAP)\n"
                  "        i_hi = ceil_of((hi - anchor) / g - 1000 * SNAP)\n"),)),
+    CodeMutant("composition_region_strengthened", "the compositions' region hypothesis "
+               "strengthened: a link of the principal lies in layer k's region whatever its box",
+               "proofs/_obl_safety.py",
+               (("         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N, in_box(theta_l, box_k)),\n",
+                 "         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N),\n"),)),
     CodeMutant("eps_zero", "BuiltDR frees a cell at any positive float distance (EPS = 0)",
                "spec/_grid.py", (("\nEPS = 1e-9\n", "\nEPS = 0.0\n"),)),
 )

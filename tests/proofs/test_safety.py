@@ -322,6 +322,24 @@ def test_composition_needs_the_postcondition_and_the_regions(variant):
     assert _refuted(stripped)
 
 
+@pytest.mark.parametrize("variant", S.VARIANTS)
+def test_a_strengthened_region_hypothesis_is_refuted_by_the_instance_check(variant, monkeypatch):
+    # Seeded fault: the principal's layer-k region hypothesis without its box condition. The
+    # composition still proves (a stronger hypothesis), the instance check must not.
+    real = S.region_hypotheses
+
+    def strong(v, at):
+        hs = real(v, at)
+        region_l, _, _ = S._regions(v)
+        hs[0] = (hs[0][0], z3.And([z3.Implies(z3.And(0 <= at.k, at.k < at.d.N), z3.Implies(
+            S.link_l(x, at.theta_l, at.p), S.member(region_l(at.k, x), at.p)))
+            for x in S.LINKS]))
+        return hs
+    assert _proved(S.region_instance_vc(variant))
+    monkeypatch.setattr(S, "region_hypotheses", strong)
+    assert _refuted(S.region_instance_vc(variant))
+
+
 def test_the_time_step_needs_t_nonnegative():
     L = S._step_lemma()
     assert _refuted(L.vc, L.vc.key_premise)

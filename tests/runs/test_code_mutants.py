@@ -84,6 +84,7 @@ def test_cfmpa_prove_catches_every_mutant(tmp_path: Path):
 SAFETY_FAULTS = {"modified_box_half_step": "Safety.modified.principal_in_layer_box",
                  "lattice_snap_widened": "Safety.region_soundness",
                  "eps_zero": "Safety.separation",
+                 "composition_region_strengthened": "Safety.modified.composition",
                  "witness_edge_loosened": "Witness.labels_sound"}
 
 
