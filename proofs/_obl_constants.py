@@ -49,8 +49,8 @@ from .. import spec
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 
 __all__ = ["CONSTANT_MUTANTS", "GROUP_CERTIFICATE", "GROUP_EXACT", "GROUP_TUBE", "SUMMARIES",
-           "ExtractionError", "certificate_vcs", "constants_obligations", "exact_vcs",
-           "sqrt_free", "tube_factor_vcs"]
+           "ExtractionError", "ToleranceParts", "certificate_vcs", "constants_obligations",
+           "exact_vcs", "on_terms", "sqrt_free", "tolerance_parts", "tube_factor_vcs"]
 
 GROUP_CERTIFICATE = "Continuous-time certificate (docs/model.md §7.2)"
 GROUP_TUBE = "Trajectories (docs/model.md §12)"
@@ -307,12 +307,12 @@ def _interval_vc() -> VC:
     """On [t0, t1], a distance changing by at most L per second is at least ``interval_bound``."""
     t0, t, t1, lip, d0, dt, d1 = z3.Reals("t0 t t1 L d(t0) d(t) d(t1)")
     bound = _term(spec.interval_bound(d0, d1, lip, t1 - t0))
-    key = "d(t) >= d(t0) - L (t - t0) (VC distance_rate from t0)"
+    key = "d(t) >= d(t0) - L (t - t0) (VC distance_rate from t back to t0, time reversed)"
     return VC("interval", (
         ("t0 <= t <= t1", z3.And(t0 <= t, t <= t1)),
         ("L >= 0", lip >= 0),
         (key, dt >= d0 - lip * (t - t0)),
-        ("d(t) >= d(t1) - L (t1 - t) (VC distance_rate from t, backwards)",
+        ("d(t) >= d(t1) - L (t1 - t) (VC distance_rate from t to t1)",
          dt >= d1 - lip * (t1 - t)),
     ), dt >= bound, key_premise=key,
         witness=tuple((x, z3.RealVal(0)) for x in (t0, t, lip, d0, dt, d1)) + (
@@ -321,8 +321,8 @@ def _interval_vc() -> VC:
 
 def certificate_vcs() -> tuple[VC, ...]:
     """Certificate.lipschitz's VCs, from the spec's functions as they are now."""
-    return (_reach_vc(0, "base"), _reach_vc(1, "elbow"), _reach_vc(1, "base"), _velocity_vc(), _speed_vc(0), _speed_vc(1),
-            _distance_rate_vc(), _interval_vc())
+    return (_reach_vc(0, "base"), _reach_vc(1, "elbow"), _reach_vc(1, "base"), _velocity_vc(),
+            _speed_vc(0), _speed_vc(1), _distance_rate_vc(), _interval_vc())
 
 
 # --- Tolerance.tube_factor ----------------------------------------------------------------------
@@ -511,6 +511,7 @@ def tube_factor_vcs() -> tuple[VC, ...]:
 
 # --- Exact.gap_formula --------------------------------------------------------------------------
 
+#: Corners per hull in VC bounds: in the plane a point of a hull is a combination of three.
 _CORNERS = 3
 
 
@@ -581,7 +582,8 @@ def constants_obligations() -> list[Obligation]:
             "dimensions; a point fixed on a link moves with velocity sum_j w_j J(p - joint_j) "
             "over the joints that move it (its position's derivative term by term); so its speed "
             "is at most spec.link_speeds; two links' distance changes by at most "
-            "spec.pair_lipschitz(v_a, v_b) h over a time h; and on [t0, t1] it is at least "
+            "spec.pair_lipschitz(v_a, v_b) h over a time h (either way: reversed time has the same "
+            "bounds); and on [t0, t1] it is at least "
             "spec.interval_bound(d0, d1, L, t1 - t0). Named, not checked: the triangle "
             "inequality at the instances used (proved in Tolerance.tube); that a speed bound v "
             "gives a move of at most v h (integration); that nearest points exist; that the "

@@ -72,8 +72,11 @@ def test_the_gap_is_the_former_ball_formula_bit_for_bit():
     ctx.prec = 128
     try:
         for _ in range(50):
-            a = [(arb(float(x)) + arb(0, 1e-20), arb(float(y))) for x, y in rng.normal(0, 1, (5, 2))]
-            b = [(arb(float(x)), arb(float(y)) + arb(0, 1e-20)) for x, y in rng.normal(3, 1, (5, 2))]
+            # Balls of a small radius, as the corners are.
+            a = [(arb(float(x)) + arb(0, 1e-20), arb(float(y)))
+                 for x, y in rng.normal(0, 1, (5, 2))]
+            b = [(arb(float(x)), arb(float(y)) + arb(0, 1e-20))
+                 for x, y in rng.normal(3, 1, (5, 2))]
             nx, ny = (arb(float(v)) for v in rng.normal(0, 1, 2))
             hi_a = max((nx * x + ny * y).upper() for x, y in a)
             lo_b = min((nx * x + ny * y).lower() for x, y in b)
