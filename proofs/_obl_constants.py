@@ -515,34 +515,30 @@ def tube_factor_vcs() -> tuple[VC, ...]:
 _CORNERS = 3
 
 
-def _bounds_vc() -> VC:
-    """``projection_bounds`` bounds n.x over the hull of A's points from above and n.y over the
-    hull of B's from below."""
+def _bounds_vc(side: str) -> VC:
+    """``projection_bounds`` bounds n.x over the hull of A's points from above (``side`` "A")
+    or n.y over the hull of B's from below (``side`` "B"); one side per VC keeps each small."""
     n = _vec("n")
     a = [_vec(f"a{i + 1}") for i in range(_CORNERS)]
     b = [_vec(f"b{i + 1}") for i in range(_CORNERS)]
-    x, y = _vec("x"), _vec("y")
-    lam = z3.Reals(" ".join(f"lambda{i + 1}" for i in range(_CORNERS)))
-    mu = z3.Reals(" ".join(f"mu{i + 1}" for i in range(_CORNERS)))
     hi_a, lo_b = spec.projection_bounds(n[0], n[1], a, b)
-    hi, lo = z3.Reals("hi_a lo_b")
-    key = "hi_a = projection_bounds' upper end over A"
-
-    def convex(w: Sequence[z3.ArithRef], pts: Sequence[Vec], z: Vec, what: str) -> list[Hyp]:
-        comb = functools.reduce(_add, (_scale(wi, pi) for wi, pi in zip(w, pts)))
-        return [(f"the weights of {what} are >= 0 and sum to 1",
-                 z3.And(*[wi >= 0 for wi in w], sum(w) == 1)),
-                (f"{what} is their combination of the corners", _eq(z, comb))]
-
-    return VC("bounds", (
-        (key, hi == hi_a),
-        ("lo_b = projection_bounds' lower end over B", lo == lo_b),
-        *convex(lam, a, x, "x (a point of hull A)"),
-        *convex(mu, b, y, "y (a point of hull B)"),
-    ), z3.And(_dot(n, x) <= hi, _dot(n, y) >= lo), key_premise=key,
-        witness=tuple((v, z3.RealVal(0)) for v in (*n, *x, *y))
-        + tuple((v, z3.RealVal(0)) for p in a + b for v in p)
-        + ((lam[0], z3.RealVal(1)), (mu[0], z3.RealVal(1))))
+    z = _vec("x" if side == "A" else "y")
+    w = z3.Reals(" ".join(f"{'lambda' if side == 'A' else 'mu'}{i + 1}" for i in range(_CORNERS)))
+    pts = a if side == "A" else b
+    end = z3.Real("hi_a" if side == "A" else "lo_b")
+    key = ("hi_a = projection_bounds' upper end over A" if side == "A"
+           else "lo_b = projection_bounds' lower end over B")
+    comb = functools.reduce(_add, (_scale(wi, pi) for wi, pi in zip(w, pts)))
+    what = "x (a point of hull A)" if side == "A" else "y (a point of hull B)"
+    goal = _dot(n, z) <= end if side == "A" else _dot(n, z) >= end
+    return VC(f"bounds_{side}", (
+        (key, end == (hi_a if side == "A" else lo_b)),
+        (f"the weights of {what} are >= 0 and sum to 1",
+         z3.And(*[wi >= 0 for wi in w], sum(w) == 1)),
+        (f"{what} is their combination of the corners", _eq(z, comb)),
+    ), goal, key_premise=key,
+        witness=tuple((v, z3.RealVal(0)) for v in (*n, *z))
+        + tuple((v, z3.RealVal(0)) for p in pts for v in p) + ((w[0], z3.RealVal(1)),))
 
 
 def _gap_vc() -> VC:
@@ -566,7 +562,7 @@ def _gap_vc() -> VC:
 
 def exact_vcs() -> tuple[VC, ...]:
     """Exact.gap_formula's VCs, from the spec's functions as they are now."""
-    return (_bounds_vc(), _gap_vc())
+    return (_bounds_vc("A"), _bounds_vc("B"), _gap_vc())
 
 
 # --- the obligations ----------------------------------------------------------------------------

@@ -38,7 +38,7 @@ CAUGHT_BY = {"link_speed_halved": ("Certificate.lipschitz", {"speed_link1", "spe
              "tube_lipschitz_left_only": ("Tolerance.tube_factor", {"lipschitz"}),
              "gap_without_norm": ("Exact.gap_formula", {"gap"}),
              "gap_sign_flipped": ("Exact.gap_formula", {"gap"}),
-             "gap_projection_min": ("Exact.gap_formula", {"bounds"})}
+             "gap_projection_min": ("Exact.gap_formula", {"bounds_A"})}
 
 
 def _obligation(oid: str) -> Obligation:
