@@ -20,8 +20,8 @@ Three obligations (registered by the proofs' registry, not by this module):
   joint_j); so its speed is at most ``link_speeds``; the distance between two links then changes
   by at most ``pair_lipschitz`` per second, and on an interval the distance is at least
   ``interval_bound``.
-- ``Tolerance.tube_factor``: what ``tolerance_rad`` returns satisfies c > 2 L delta, the premise of
-  Tolerance.tube, with its own factor (``two_l``) and loop guard; and a joint deviation of at most
+- ``Tolerance.tube_factor``: what ``tolerance_rad`` returns is >= 0 and satisfies c > 2 L delta,
+  the premise of Tolerance.tube, with its own factor (``two_l``), start and loop guard; and a joint deviation of at most
   delta moves any link point by at most L delta with L = ``tube_lipschitz``. Tolerance.tube
   states c > 2 L delta and "L the largest R_base + R_elbow" by hand and reads neither; this
   obligation is what joins it to the code.
@@ -398,26 +398,29 @@ def _eval(node: ast.AST, env: dict[str, Any], glb: dict[str, Any]) -> Any:
 @dataclass(frozen=True)
 class ToleranceParts:
     """What ``tolerance_rad`` says, on terms: when it returns 0 at once (``early``), its factor
-    (``two_l``), the guard of its loop (``guard``: k is lowered while it holds) and its result
-    after the loop (``result``)."""
+    (``two_l``), the guard of its loop (``guard``: k is lowered by 1 while it holds), its result
+    after the loop (``result``) and k before it (``start``)."""
 
     early: z3.BoolRef
     two_l: z3.ArithRef
     guard: z3.BoolRef
     result: z3.ArithRef
+    #: k's value before the loop (an integer term: ``math.floor`` is ``spec.floor_of``).
+    start: z3.ArithRef
 
 
 def tolerance_parts(f: Callable[..., Any], env: dict[str, Any]) -> ToleranceParts:
     """Read ``f`` (``spec.tolerance_rad``) off its syntax tree: an early ``if ...: return 0.0``,
-    the assignment of ``two_l`` (and ``per``, evaluated), the ``while`` guard and the final
-    ``return``; the assignment of ``k`` is not read (k is any real at the loop's end)."""
+    the assignments (``two_l``, ``per``, and ``k``'s start, ``math.floor`` taken as
+    ``spec.floor_of``), the ``while`` guard (its body must be ``k -= 1``) and the final
+    ``return``, all evaluated with ``env`` (``k`` in it is k at the loop's end)."""
     tree = ast.parse(textwrap.dedent(inspect.getsource(f)))
     fn = tree.body[0]
     if not isinstance(fn, ast.FunctionDef):
         raise ExtractionError(f"{f.__name__} is not a plain function")
     glb = f.__globals__
-    env = dict(env)
-    early = guard = result = None
+    env = {"math": types.SimpleNamespace(floor=spec.floor_of, ceil=spec.ceil_of), **env}
+    early = guard = result = start = None
     for st in fn.body:
         if isinstance(st, ast.Expr) and isinstance(st.value, ast.Constant):
             continue                                            # the docstring
@@ -429,36 +432,55 @@ def tolerance_parts(f: Callable[..., Any], env: dict[str, Any]) -> TolerancePart
         elif (isinstance(st, ast.Assign) and len(st.targets) == 1
               and isinstance(st.targets[0], ast.Name)):
             name = st.targets[0].id
-            if name != "k":                     # k's start is not read: any k ends the loop
+            if name == "k":                     # env's k is k at the loop's end
+                start = _eval(st.value, env, glb)
+            else:
                 env[name] = _eval(st.value, env, glb)
         elif isinstance(st, ast.While) and guard is None:
+            body = st.body[0] if len(st.body) == 1 and not st.orelse else None
+            if not (isinstance(body, ast.AugAssign) and isinstance(body.op, ast.Sub)
+                    and isinstance(body.target, ast.Name) and body.target.id == "k"
+                    and isinstance(body.value, ast.Constant) and body.value.value == 1):
+                raise ExtractionError(f"line {st.lineno}: the loop's body is not k -= 1")
             guard = _as_bool(_eval(st.test, env, glb))
         elif isinstance(st, ast.Return) and result is None and st.value is not None:
             result = _term(_eval(st.value, env, glb))
         else:
             raise ExtractionError(f"line {st.lineno}: a statement outside the subset")
-    if early is None or guard is None or result is None or "two_l" not in env:
-        raise ExtractionError(f"{f.__name__}: no early return, two_l, loop or result found")
-    return ToleranceParts(early, _term(env["two_l"]), guard, result)
+    if early is None or guard is None or result is None or start is None or "two_l" not in env:
+        raise ExtractionError(f"{f.__name__}: no early return, two_l, k, loop or result found")
+    return ToleranceParts(early, _term(env["two_l"]), guard, result, start)
 
 
 def _factor_vc() -> VC:
-    """What ``tolerance_rad`` returns satisfies Tolerance.tube's premise c > 2 L delta."""
+    """What ``tolerance_rad`` returns is >= 0 and satisfies Tolerance.tube's premise
+    c > 2 L delta."""
     c, lip, k, delta = z3.Reals("c L k delta")
     clear = z3.Bool("clear")
     sym = object()
     parts = tolerance_parts(spec.tolerance_rad, {
         "s": sym, "cert": _SymCertificate(clear, c), "k": k,
-        # L is read in the VC deviation; here it is any L >= 0 the code computes.
+        # L is read in the VC lipschitz; here it is any L > 0 the code computes.
         "tube_lipschitz": lambda s: lip if s is sym else spec.tube_lipschitz(s)})
-    key = "the loop has ended: its guard is false (tolerance_rad's while)"
+    guard = "the loop has ended: its guard is false (tolerance_rad's while)"
+    # The loop only corrects float rounding: over the reals k0 itself meets the goal, so the key
+    # is where k ends up, not the guard.
+    key = ("the loop lowers k by 1 only while k > 0, from its start k0: k <= k0, and k >= 0 "
+           "when k0 >= 0")
+    # k0 a named integer: its declaration puts the query in a logic with to_int (standard
+    # SMT-LIB; without an Int symbol _smtlib's logic was QF_NRA, which cvc5 refused).
+    k0 = z3.Int("k0") if z3.is_int(parts.start) else z3.Real("k0")
     return VC("factor", (
-        ("L = tube_lipschitz(s) >= 0 (VC deviation: a maximum of lengths)", lip >= 0),
+        ("L = tube_lipschitz(s) > 0 (VC lipschitz: at least a sum of positive lengths)",
+         lip > 0),
         ("the certificate is clear and c > EPS: tolerance_rad's early return is not taken",
          z3.Not(parts.early)),
-        (key, z3.Not(parts.guard)),
+        ("k0 is k before the loop (tolerance_rad's assignment)", k0 == parts.start),
+        (key, z3.And(k <= z3.ToReal(k0) if z3.is_int(k0) else k <= k0,
+                     z3.Implies(k0 >= 0, k >= 0))),
+        (guard, z3.Not(parts.guard)),
         ("delta is what tolerance_rad returns after its loop", delta == parts.result),
-    ), c > 2 * lip * delta, key_premise=key,
+    ), z3.And(delta >= 0, c > 2 * lip * delta), key_premise=key,
         witness=((c, z3.RealVal(1)), (lip, z3.RealVal(1)), (k, z3.RealVal(0)),
                  (clear, z3.BoolVal(True))))
 
@@ -588,9 +610,11 @@ def constants_obligations() -> list[Obligation]:
             label="speed integrated in prose"),
         Obligation(
             "Tolerance.tube_factor", GROUP_TUBE, "docs/model.md §12 (tolerance tube)",
-            "What spec.tolerance_rad returns meets Tolerance.tube's premise c > 2 L delta: its "
-            "factor two_l, its early return and its loop guard read off its syntax tree and run "
-            "on terms (k any real at the loop's end); and a max-norm joint deviation delta moves "
+            "What spec.tolerance_rad returns is >= 0 and meets Tolerance.tube's premise "
+            "c > 2 L delta: its factor two_l, its early return, k's start (math.floor as "
+            "ToInt) and its loop guard read off its syntax tree and run on terms, the loop "
+            "(body k -= 1) summed up as k <= k0 and k >= 0 when k0 >= 0, L > 0 any; and a "
+            "max-norm joint deviation delta moves "
             "any point of any link of either arm by at most L delta, L = spec.tube_lipschitz "
             "(its bytecode on terms, Python's max as an If) over spec.reach of each link. Named, "
             "not checked: a point moves by at most |dtheta1| R_base + |dtheta2| R_elbow (the "
@@ -647,6 +671,10 @@ CONSTANT_MUTANTS: tuple[tuple[str, str, str, tuple[tuple[str, str], ...]], ...] 
     ("tube_factor_halved", "the tube's margin 2 L delta halved to L delta",
      "spec/_trajectory.py",
      (("    two_l = 2.0 * tube_lipschitz(s)\n", "    two_l = 1.0 * tube_lipschitz(s)\n"),)),
+    ("tolerance_early_return_loosened", "the tube's radius computed for any positive clearance "
+     "(c > 0 instead of c > EPS: a negative radius for c <= EPS)", "spec/_trajectory.py",
+     (("    if not cert.clear or cert.lower_bound_m <= EPS:\n",
+       "    if not cert.clear or cert.lower_bound_m <= 0.0:\n"),)),
     ("tube_lipschitz_left_only", "the tube's L taken over the principal's links only",
      "spec/_trajectory.py",
      (("    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in (0, 1))\n",

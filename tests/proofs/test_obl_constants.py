@@ -35,6 +35,7 @@ CAUGHT_BY = {"link_speed_halved": ("Certificate.lipschitz", {"speed_link1", "spe
              "pair_lipschitz_halved": ("Certificate.lipschitz", {"distance_rate"}),
              "reach_without_cap": ("Certificate.lipschitz", {"reach_link2_elbow"}),
              "tube_factor_halved": ("Tolerance.tube_factor", {"factor"}),
+             "tolerance_early_return_loosened": ("Tolerance.tube_factor", {"factor"}),
              "tube_lipschitz_left_only": ("Tolerance.tube_factor", {"lipschitz"}),
              "gap_without_norm": ("Exact.gap_formula", {"gap"}),
              "gap_sign_flipped": ("Exact.gap_formula", {"gap"}),
