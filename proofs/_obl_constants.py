@@ -21,8 +21,9 @@ Three obligations (registered by the proofs' registry, not by this module):
   by at most ``pair_lipschitz`` per second, and on an interval the distance is at least
   ``interval_bound``.
 - ``Tolerance.tube_factor``: what ``tolerance_rad`` returns is >= 0 and satisfies c > 2 L delta,
-  the premise of Tolerance.tube, with its own factor (``two_l``), start and loop guard; and a joint deviation of at most
-  delta moves any link point by at most L delta with L = ``tube_lipschitz``. Tolerance.tube
+  the premise of Tolerance.tube, with its own factor (``two_l``), start and loop guard; and a
+  joint deviation of at most delta moves any link point by at most L delta with L =
+  ``tube_lipschitz``. Tolerance.tube
   states c > 2 L delta and "L the largest R_base + R_elbow" by hand and reads neither; this
   obligation is what joins it to the code.
 - ``Exact.gap_formula``: ``projection_bounds`` bounds n.x over the hull of A from above and n.y
