@@ -223,7 +223,7 @@ def _reach_vc(link: int, of: str) -> VC:
              ("triangle inequality at p, elbow, base: |p - base| <= |p - elbow| + "
               "|elbow - base| (Tolerance.tube's triangle VC)", nb <= ne + nl)] + roots
     return VC("reach_link2_base", tuple(hyps), nb <= rb, key_premise=key2[0],
-              witness=tuple(pins[:6]) + ((p[0], one), (p[1], zero)))
+              witness=tuple(pins[:5]) + ((p[0], one), (p[1], zero)))
 
 
 def _velocity_vc() -> VC:
