@@ -35,6 +35,7 @@ from ._obl_geometry import geometry_obligations
 from ._obl_margin import margin_obligations
 from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
 from ._obl_witness import witness_obligations
+from ._obl_constants import constants_obligations
 from ._obl_monitor import monitor_obligations
 from ._obl_tolerance import tolerance_obligations
 from ._obl_safety import safety_obligations
@@ -87,6 +88,7 @@ EXPECTED_VERDICTS: dict[str, Verdict] = {
     "Prop8.valid_transfer": _P, "Prop8.path_exists": _P, "Prop8.optimal_cost": _P,
     "Prop8.prestrength_thm4": _P,
     "Tolerance.tube": _P, "Monitor.between_samples": _P,
+    "Certificate.lipschitz": _P, "Tolerance.tube_factor": _P, "Exact.gap_formula": _P,
     "Safety.original.principal_in_layer_box": _P, "Safety.modified.principal_in_layer_box": _P,
     "Safety.tight.principal_in_layer_box": _P, "Safety.subordinate_in_cell_box": _P,
     "Safety.region_soundness": _P, "Safety.separation": _P, "Safety.original.composition": _P,
@@ -153,7 +155,8 @@ def collect_obligations(scenarios_dir: str | Path = BUNDLED_DIR,
     obs = (geometry_obligations() + margin_obligations() + builtdr_obligations()
            + path_obligations() + theorem_obligations() + witness_obligations()
            + prop8_obligations()
-           + tolerance_obligations() + monitor_obligations() + safety_obligations()
+           + tolerance_obligations() + monitor_obligations() + constants_obligations()
+           + safety_obligations()
            + scenario_obligations(scenarios_dir))
     return tuple(o for o in obs if selected(o.id, only))
 

@@ -148,6 +148,17 @@ SUMMARIES: dict[str, str] = {
                               "by strengthening its precondition; the paper's route through "
                               "Property 8 is not valid.",
     # Trajectories
+    "Certificate.lipschitz": (
+        "The speed bound the motion certificate uses is safe as computed: no point of a link "
+        "moves faster than it says, so the arms' distance changes no faster than the sum of two "
+        "links' bounds, and the interval bound holds."),
+    "Tolerance.tube_factor": (
+        "The tolerance the tube reports is small enough: with the factor and the constant the "
+        "code uses, twice the constant times the tolerance stays below the proved clearance, and "
+        "no link point moves more than the constant times the tolerance."),
+    "Exact.gap_formula": (
+        "The gap the exact re-check computes along a separating direction, divided by that "
+        "direction's length, never exceeds the true distance between the two regions."),
     "Tolerance.tube": "A robot that tracks a plan proved clear by c to within delta in every "
                       "joint cannot collide while c > 2 L delta, L the largest reach of a link "
                       "about its two joints (metres per radian).",

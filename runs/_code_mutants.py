@@ -97,6 +97,44 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "proofs/_obl_safety.py",
                (("         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N, in_box(theta_l, box_k)),\n",
                  "         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N),\n"),)),
+    # --- issue 21 items 5, 9: the certificate's, the tube's and the ball gap's constants
+    # (proofs/_obl_constants.py; each caught by its obligation under --repin) ---
+    CodeMutant("link_speed_halved", "the certificate's link speed bound halved "
+     "(0.5 (|w1| R_base + |w2| R_elbow))", "spec/_certificate.py",
+     (("    return w[:, 0:1] * r_base[None, :] + w[:, 1:2] * r_elbow[None, :]\n",
+       "    return 0.5 * (w[:, 0:1] * r_base[None, :] + w[:, 1:2] * r_elbow[None, :])\n"),)),
+    CodeMutant("interval_lipschitz_halved", "the certificate's interval bound with half its Lipschitz "
+     "term ((d0 + d1 - L (t1 - t0) / 2) / 2)", "spec/_certificate.py",
+     (("    return (d0 + d1 - lip * length) / 2.0\n",
+       "    return (d0 + d1 - 0.5 * lip * length) / 2.0\n"),)),
+    CodeMutant("pair_lipschitz_halved", "the distance's Lipschitz constant of a link pair halved "
+     "((v_a + v_b) / 2)", "spec/_certificate.py",
+     (("    return v_left + v_right\n", "    return 0.5 * (v_left + v_right)\n"),)),
+    CodeMutant("reach_without_cap", "the forearm's reach forgets the w/2 cap past the tip "
+     "(hypot(l2, w/2))", "spec/_kinematics.py",
+     (("    far = hypot_of(arm.links[1] + r, r)\n", "    far = hypot_of(arm.links[1], r)\n"),)),
+    CodeMutant("tube_factor_halved", "the tube's margin 2 L delta halved to L delta",
+     "spec/_trajectory.py",
+     (("    two_l = 2.0 * tube_lipschitz(s)\n", "    two_l = 1.0 * tube_lipschitz(s)\n"),)),
+    CodeMutant("tolerance_early_return_loosened", "the tube's radius computed for any positive clearance "
+     "(c > 0 instead of c > EPS: a negative radius for c <= EPS)", "spec/_trajectory.py",
+     (("    if not cert.clear or cert.lower_bound_m <= EPS:\n",
+       "    if not cert.clear or cert.lower_bound_m <= 0.0:\n"),)),
+    CodeMutant("tube_lipschitz_left_only", "the tube's L taken over the principal's links only",
+     "spec/_trajectory.py",
+     (("    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in (0, 1))\n",
+       "    return max(sum(reach(arm, link)) for arm in (s.left,) for link in (0, 1))\n"),)),
+    CodeMutant("gap_without_norm", "the ball-arithmetic gap not divided by |n|", "spec/_exact.py",
+     (("    return (lo_b - hi_a) / sqrt_of(nx * nx + ny * ny)\n",
+       "    return lo_b - hi_a\n"),)),
+    CodeMutant("gap_sign_flipped", "the ball-arithmetic gap with its sign flipped ((hi_a - lo_b) / |n|)",
+     "spec/_exact.py",
+     (("    return (lo_b - hi_a) / sqrt_of(nx * nx + ny * ny)\n",
+       "    return (hi_a - lo_b) / sqrt_of(nx * nx + ny * ny)\n"),)),
+    CodeMutant("gap_projection_min", "the upper projection end of A taken as the least, not the greatest",
+     "spec/_exact.py",
+     (("    hi_a = functools.reduce(max_of, (_upper(nx * x + ny * y) for x, y in a))\n",
+       "    hi_a = functools.reduce(min_of, (_upper(nx * x + ny * y) for x, y in a))\n"),)),
     CodeMutant("eps_zero", "BuiltDR frees a cell at any positive float distance (EPS = 0)",
                "spec/_grid.py", (("\nEPS = 1e-9\n", "\nEPS = 0.0\n"),)),
 )

@@ -4,20 +4,21 @@ The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 """
 
 from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
-from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
+from ._arith import cases, ceil_of, floor_of, hypot_of, if_then, max_of, min_of, sqrt_of
 from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
                     VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
                     left_box, make_grid, ptp_angles, ptp_fraction, rest_box, right_box,
                     rule_of)
 from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
-                           contact_links_text, require_clear)
-from ._exact import ExactCell, ExactGaps, exact_path_gaps
+                           contact_links_text, interval_bound, link_speeds, pair_lipschitz,
+                           require_clear)
+from ._exact import ExactCell, ExactGaps, exact_path_gaps, gap_over_norm, projection_bounds
 from ._trajectory import (ReferenceSpeeds, Trajectory, between_samples_bound, certify_trajectory,
                           csv_column_order, executed_trajectory,
                           load_trajectory, parse_trajectory_csv, parse_trajectory_json,
                           tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
 from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
-from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name
+from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name, reach
 from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                      Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
                      is_opt_path, is_path, is_path_paper, opt_path, path_violations)
@@ -43,7 +44,7 @@ __all__ = [
     "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_box", "right_box",
     "VariantRule", "cell_box", "ptp_angles", "ptp_fraction", "rule_of",
     # one definition on floats and on Z3 terms (the rules the proofs read)
-    "cases", "ceil_of", "floor_of", "if_then", "max_of", "min_of",
+    "cases", "ceil_of", "floor_of", "hypot_of", "if_then", "max_of", "min_of", "sqrt_of",
     # geometry
     "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
     # links named 1-based with words, as docs/model.md §2 names them
@@ -73,4 +74,7 @@ __all__ = [
     "tolerance_rad", "trajectory_csv", "trajectory_distances", "tube_lipschitz",
     # the monitor between samples (docs/model.md §12; proofs/_obl_monitor.py)
     "ReferenceSpeeds", "between_samples_bound",
+    # the constants the certificate, the tube and the ball gaps rest on (proofs/_obl_constants.py)
+    "gap_over_norm", "interval_bound", "link_speeds", "pair_lipschitz", "projection_bounds",
+    "reach",
 ]

@@ -1,10 +1,10 @@
 """The few operations a rule needs beyond + - * /, on floats (and numpy arrays) or on Z3 terms.
 
 A rule the proofs read (the principal's box per layer, the subordinate's cell box, the PTP
-motion, impl.lattice_range) is written once with these and runs on either: on floats it performs
-the same IEEE operations as before (Python's ``min``/``max``, ``math.floor``/``ceil``, numpy's
-``minimum``/``maximum`` on arrays), on Z3 terms it builds the term the proof is about (``If``,
-``ToInt``). So a changed rule changes the proved statement, and a wrong rule fails a proof.
+motion, impl.lattice_range, the links' reach, the ball-arithmetic gap) is written once with these and runs on either: on floats it performs
+the same IEEE operations as before (Python's ``min``/``max``, ``math.floor``/``ceil``/``hypot``/``sqrt``,
+numpy's ``minimum``/``maximum`` on arrays, python-flint's ``arb.sqrt`` on balls), on Z3 terms it builds the term the proof is about (``If``,
+``ToInt``, ``Sqrt``: a square root the proofs replace by a real s >= 0 with s^2 = its argument). So a changed rule changes the proved statement, and a wrong rule fails a proof.
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ceil_of", "cases", "floor_of", "if_then", "is_term", "max_of", "min_of"]
+__all__ = ["ceil_of", "cases", "floor_of", "hypot_of", "if_then", "is_term", "max_of", "min_of",
+           "sqrt_of"]
 
 
 def is_term(*xs: Any) -> bool:
@@ -86,3 +87,20 @@ def ceil_of(x: Any) -> Any:
     if is_term(x):
         return -_z3().ToInt(-x)
     return math.ceil(x)
+
+
+def sqrt_of(x: Any) -> Any:
+    """The square root of x: math.sqrt on a float, ``x.sqrt()`` on a ball (python-flint's arb:
+    a ball containing the exact root), Z3's Sqrt (x ** (1/2)) on a term."""
+    if is_term(x):
+        return _z3().Sqrt(x)
+    if hasattr(x, "sqrt"):
+        return x.sqrt()
+    return math.sqrt(x)
+
+
+def hypot_of(x: Any, y: Any) -> Any:
+    """The length of (x, y): math.hypot on floats, Sqrt(x^2 + y^2) on terms."""
+    if is_term(x, y):
+        return _z3().Sqrt(x * x + y * y)
+    return math.hypot(x, y)

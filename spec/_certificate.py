@@ -60,8 +60,10 @@ __all__ = [
     "contact_links_text",
     "prove_motion",
     "require_clear",
+    "interval_bound",
     "link_speeds",
     "link_rects",
+    "pair_lipschitz",
     "DEFAULT_MAX_DEPTH",
     "DEFAULT_BOUND_RATIO",
     "DEFAULT_MAX_INTERVALS",
@@ -179,7 +181,7 @@ def prove_motion(motion: Any, *, max_depth: int = DEFAULT_MAX_DEPTH,
             t0, t1, seg, d0, d1, lip, depth = (x[before] for x in (t0, t1, seg, d0, d1, lip,
                                                                     depth))
         deepest = max(deepest, int(depth.max())) if first_contact else int(depth.max())
-        lb = np.min((d0 + d1 - lip * (t1 - t0)[:, None, None]) / 2.0, axis=(1, 2))
+        lb = np.min(interval_bound(d0, d1, lip, (t1 - t0)[:, None, None]), axis=(1, 2))
         proved = lb > EPS
         tm = (t0 + t1) / 2.0
         # Halving cannot tighten an atomic interval's bound: it has no interior instant (zero
@@ -392,7 +394,7 @@ class _Motion:
         wr = np.where(seg[:, None] >= 0, steps[np.maximum(seg, 0)], 0.0)
         vl = link_speeds(s.left, wl)                                    # (K, 2)
         vr = link_speeds(s.right, wr)
-        return vl[:, :, None] + vr[:, None, :]
+        return pair_lipschitz(vl[:, :, None], vr[:, None, :])
 
     def right_angles(self, t: FloatArray, seg: IntArray) -> FloatArray:
         a = self.path_angles
@@ -452,8 +454,23 @@ def _reach(arm: Arm) -> tuple[FloatArray, FloatArray]:
     return np.array([r[0] for r in per_link]), np.array([r[1] for r in per_link])
 
 
+def interval_bound(d0: Any, d1: Any, lip: Any, length: Any) -> Any:
+    """The least distance on an interval of ``length`` with samples d0, d1 at its ends and
+    Lipschitz constant ``lip``: (d0 + d1 - lip length) / 2 (the module docstring). On floats,
+    numpy arrays or Z3 terms (proofs/_obl_constants.py proves it a lower bound)."""
+    return (d0 + d1 - lip * length) / 2.0
+
+
+def pair_lipschitz(v_left: Any, v_right: Any) -> Any:
+    """L_ab of a left link moving at most v_left and a right link at most v_right: their
+    distance changes by at most v_left + v_right per second. On arrays or Z3 terms."""
+    return v_left + v_right
+
+
 def link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
-    """Upper bound on any link point's speed, |w1| R_base + |w2| R_elbow; w (K, 2) -> (K, 2)."""
+    """Upper bound on any link point's speed, |w1| R_base + |w2| R_elbow; w (K, 2) -> (K, 2).
+
+    Runs on object arrays of Z3 terms as well (``reach`` does, ``abs`` is an If there)."""
     r_base, r_elbow = _reach(arm)
     w = np.abs(w)
     return w[:, 0:1] * r_base[None, :] + w[:, 1:2] * r_elbow[None, :]

@@ -15,19 +15,23 @@ cell that passes is free whatever the float rounding of the polygons. A cell tha
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import shapely
 from flint import arb, ctx
 
+from ._arith import is_term, max_of, min_of, sqrt_of
 from ._grid import EPS, Grid, Variant, left_angles, left_box, rest_box
 from ._regions import SNAP, lattice
 from ._scenario import Arm, Scenario
 
-__all__ = ["EXACT_PREC_BITS", "ExactCell", "ExactGaps", "exact_path_gaps", "path_layer_cells"]
+__all__ = ["EXACT_PREC_BITS", "ExactCell", "ExactGaps", "exact_path_gaps", "gap_over_norm",
+           "path_layer_cells", "projection_bounds"]
 
 #: Working precision of the balls (bits); doubles carry 53, so rounding is far below any gap.
 EXACT_PREC_BITS = 128
@@ -140,9 +144,35 @@ def _gap(a: tuple[Points, np.ndarray], b: tuple[Points, np.ndarray]) -> arb:
     if dx == 0.0 and dy == 0.0:
         return arb(0)
     nx, ny = arb(dx), arb(dy)
-    hi_a = max((nx * x + ny * y).upper() for x, y in a[0])
-    lo_b = min((nx * x + ny * y).lower() for x, y in b[0])
-    return (lo_b - hi_a) / (nx * nx + ny * ny).sqrt()
+    hi_a, lo_b = projection_bounds(nx, ny, a[0], b[0])
+    return gap_over_norm(hi_a, lo_b, nx, ny)
+
+
+def _upper(x: Any) -> Any:
+    """A value at or above every point of ``x``: the upper end of a ball; a Z3 term itself."""
+    return x if is_term(x) else x.upper()
+
+
+def _lower(x: Any) -> Any:
+    """A value at or below every point of ``x``: the lower end of a ball; a Z3 term itself."""
+    return x if is_term(x) else x.lower()
+
+
+def projection_bounds(nx: Any, ny: Any, a: Sequence[tuple[Any, Any]],
+                      b: Sequence[tuple[Any, Any]]) -> tuple[Any, Any]:
+    """(hi_a, lo_b): hi_a at or above n.x for every point x of ``a``, lo_b at or below n.y for
+    every point y of ``b`` (the ends of the balls; exact on Z3 terms, max_of and min_of an If
+    there, Python's max and min on balls)."""
+    hi_a = functools.reduce(max_of, (_upper(nx * x + ny * y) for x, y in a))
+    lo_b = functools.reduce(min_of, (_lower(nx * x + ny * y) for x, y in b))
+    return hi_a, lo_b
+
+
+def gap_over_norm(hi_a: Any, lo_b: Any, nx: Any, ny: Any) -> Any:
+    """The separating-axis gap (lo_b - hi_a) / |n|: a lower bound on the distance between the
+    hulls when n.x <= hi_a on the one and n.y >= lo_b on the other, n != 0 (proved in
+    proofs/_obl_constants.py). On balls (``arb.sqrt``) and on Z3 terms (``Sqrt``)."""
+    return (lo_b - hi_a) / sqrt_of(nx * nx + ny * ny)
 
 
 def _lower_float(x: arb) -> float:

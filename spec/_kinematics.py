@@ -11,6 +11,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from ._arith import hypot_of
 from ._scenario import Arm
 
 __all__ = ["LINK_WORDS", "joints", "link_corners", "arm_corners", "corners", "link_name", "reach"]
@@ -59,11 +60,14 @@ def arm_corners(arm: Arm, theta: tuple[float, float]) -> list[list[Point]]:
 
 
 def reach(arm: Arm, link: int) -> tuple[float, float]:
-    """(R_base, R_elbow): no point of the link is farther than these from the base / the elbow."""
+    """(R_base, R_elbow): no point of the link is farther than these from the base / the elbow.
+
+    Runs on floats and on Z3 terms (``hypot_of``): proofs/_obl_constants.py proves these bounds of
+    the rectangle of docs/model.md §2 and the certificate's and the tube's speeds built on them."""
     r = arm.width / 2
     if link == 0:
-        return math.hypot(arm.links[0] + r, r), 0.0
-    far = math.hypot(arm.links[1] + r, r)
+        return hypot_of(arm.links[0] + r, r), 0.0
+    far = hypot_of(arm.links[1] + r, r)
     return arm.links[0] + far, far
 
 
