@@ -304,3 +304,28 @@ def test_omega_dt_just_over_the_margin_bound_is_refused() -> None:
 def test_min_points_needs_no_float() -> None:
     assert min_points(0.0, 2.5, 2.5, 0.02) == 51
     assert min_points(0.0, 1.0, 1.0, 5e-324 * 2**60) > 2**53
+
+
+# --- pre.grid.h's rounding allowance: what it admits and what it refuses -----------------------
+
+
+def test_pre_grid_h_admits_rounding_and_refuses_more() -> None:
+    from dataclasses import replace
+
+    doc = workcell(0.02, (2.5, 2.5), (4.0, 4.0), (-2.0, -2.0))
+    s = parse_scenario(doc, check_budget=False)
+    g = make_grid(s)
+    assert (g.m, g.h[0]) == (81, 0.05) and grid_failures(s, g) == []
+    # Seeded fault: a float h beyond the rounding allowance (ten times it, and 1e-7 rad) is a
+    # pre.grid.h failure naming the float h, before the span is even looked at.
+    for h in (0.05 * (1 + 1e-9), 0.0500001):
+        fails = grid_failures(s, replace(g, h=(h, g.h[1])))
+        assert [f.condition for f in fails][:1] == ["pre.grid.h"], h
+        assert dict(fails[0].values)["reading"].startswith("float h"), fails[0].values
+
+
+def test_the_margin_lemmas_bound_is_held_on_the_float_h() -> None:
+    conds = _counts.spacing_conditions(0.0, 6.28, 1000.0, 0.01, 3, 3.14)
+    margin = [c for c in conds if c.reading == "margin lemma"]
+    assert len(margin) == 1 and not margin[0].holds      # the double 3.14 is above 157/50
+    assert margin[0].bound == Fraction(157, 50)
