@@ -182,3 +182,37 @@ def test_the_old_float_reading_is_caught_by_the_strategy(monkeypatch: pytest.Mon
     load()
     assert refused, "the old float reading refused none of the drawn workcells"
     assert any("must be a grid point" in r for r in refused)
+
+
+# --- the text as written, not the double's shortest repr ---------------------------------------
+
+
+def load_text(text: str):  # type: ignore[no-untyped-def]
+    with tempfile.TemporaryDirectory() as d:
+        f = Path(d) / "round.toml"
+        f.write_text(text)
+        return load_scenario(f)
+
+
+def with_dt(text: str) -> str:
+    return EXAMPLE.replace("dt = 0.02\n", f"dt = {text}\n").replace(
+        "start = [0.0, 0.0]", "start_cell = [0, 0]").replace("goal = [1.5, -1.0]",
+                                                              "goal_cell = [1, 1]")
+
+
+def test_the_decimal_is_the_files_text() -> None:
+    assert "dt = 0.02\n" in EXAMPLE
+    # 0.020 and 0.02 are the same number; 0.01999999999999999999 is the same double but a
+    # smaller speed step as written (4 / (2.5 dt) is just above 80), so one point more.
+    for text, points in (("0.02", 81), ("0.020", 81), ("2e-2", 81), ("0.01999999999999999999", 82)):
+        s = load_text(with_dt(text))
+        assert s.dt == 0.02
+        assert make_grid(s).m == points, text
+        assert s.right.omega[0] * s.dt == 2.5 * 0.02
+
+
+def test_a_reader_that_drops_the_text_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    from cfmpa.spec import _scenario
+    # Seeded fault: tomllib's floats kept as plain doubles (the text lost).
+    monkeypatch.setattr(_scenario, "written", float)
+    assert make_grid(load_text(with_dt("0.01999999999999999999"))).m == 81
