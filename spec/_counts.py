@@ -148,20 +148,22 @@ def spacing_readings(lo: float, hi: float, omega: float, dt: float
 class SpacingCondition:
     """One condition a joint's grid must meet: ``value <= bound``, exactly. ``what`` names the
     quantity (the grid's exact spacing, or the float h), ``reading`` the reading of the scenario's
-    numbers the bound is taken in (or "margin lemma")."""
+    numbers the bound is taken in (or "margin lemma"), ``bound_is`` the bound in words."""
 
     what: str
     reading: str
     value: Fraction
     bound: Fraction
+    bound_is: str = ""
 
     @property
     def holds(self) -> bool:
         return self.value <= self.bound
 
     def words(self) -> str:
-        return (f"{self.what} ({self.reading}) = {_fmt(self.value)} <= {_fmt(self.bound)}: "
-                f"{self.holds}")
+        named = f"{self.bound_is} = " if self.bound_is else ""
+        return (f"{self.what} ({self.reading}) = {_fmt(self.value)} <= {named}"
+                f"{_fmt(self.bound)}: {self.holds}")
 
 
 def _fmt(x: Fraction) -> str:
@@ -176,11 +178,12 @@ def spacing_conditions(lo: float, hi: float, omega: float, dt: float, m: int, h:
     (the margin lemma's bound, as the regions use h). m >= 2."""
     readings = spacing_readings(lo, hi, omega, dt)
     span, step = readings[SPEED_READING]
-    out = [SpacingCondition("(hi - lo)/(m - 1)", SPEED_READING, span / (m - 1), step)]
+    out = [SpacingCondition("(hi - lo)/(m - 1)", SPEED_READING, span / (m - 1), step, "omega dt")]
     slack = 1 + Fraction(SPACING_ROUNDING)
-    out += [SpacingCondition("float h", r, Fraction(h), st * slack)
+    out += [SpacingCondition("float h", r, Fraction(h), st * slack,
+                             f"omega dt (1 + {SPACING_ROUNDING:g})")
             for r, (_, st) in readings.items()]
-    out.append(SpacingCondition("float h", "margin lemma", Fraction(h), MAX_SPACING))
+    out.append(SpacingCondition("float h", "margin lemma", Fraction(h), MAX_SPACING, "3.14"))
     return tuple(out)
 
 
