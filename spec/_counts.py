@@ -7,7 +7,7 @@ and the obligations count and judge the same way. This module owns the counts.
 Two readings of every number (``READINGS``). *Binary*: the IEEE double the code computes with,
 as the exact rational it is (``Fraction(0.02)`` = 0.0200000000000000004163...). *Decimal*: the
 number as written: for a number read from a scenario file, the TOML text itself, exactly
-(``Written``: ``tomllib.loads(text, parse_float=Written)``; an integer's digits likewise); for
+(``Written``: ``tomllib.loads(text, parse_float=written)``; an integer's digits likewise); for
 a plain float (a document built in Python) ``Fraction(repr(x))``, the shortest decimal that
 rounds to it.
 
