@@ -9,11 +9,13 @@ found and unique.
 
 The two readings of a number in the file. *Binary*: the IEEE double the code computes with,
 as the exact rational it is (``Fraction(float)``), e.g. dt = 0.02 is
-0.0200000000000000004163...; this is the reading the planner's safety rests on. *Decimal*: the
-number as written, e.g. dt = 1/50: the TOML text itself, exactly (the reader keeps it,
-``spec.Written``; 0.020 reads as 0.02, the same number). Both readings are the spec's own (``Grid.READINGS``,
-``Grid.time_readings``, ``Grid.spacing_readings``, spec/_counts.py), the ones the loader builds
-the grid with and the contracts check.
+0.0200000000000000004163.... *Decimal*: the number as written, e.g. dt = 1/50: the TOML text
+itself, exactly (the reader keeps it, ``spec.Written``; 0.020 reads as 0.02, the same number);
+the C-space grid is counted in it, the reading in which the file states the speed limit, and
+the float h is held within rounding of omega dt in both (docs/model.md §2). Both readings are
+the spec's own (``Grid.READINGS``, ``Grid.time_readings``, ``Grid.spacing_readings``,
+``spec.spacing_conditions``, spec/_counts.py), the ones the loader builds the grid with and the
+contracts check.
 """
 
 from __future__ import annotations
