@@ -3,7 +3,8 @@
 The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 """
 
-from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
+from ._counts import (MAX_EXTRA_POINTS, SPACING_ROUNDING, SPEED_READING, SpacingCondition,
+                      Written, decimal, joint_grid, spacing_conditions, written)
 from ._arith import cases, ceil_of, floor_of, hypot_of, if_then, max_of, min_of, sqrt_of
 from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
                     VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
@@ -40,7 +41,8 @@ __all__ = [
     "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "DISTANCE_ERROR_M", "EPS", "MAX_COORD_M",
     "UNIT_ROUNDOFF", "Arm", "Grid", "LeftArm", "RightArm",
     "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
-    "MAX_EXTRA_POINTS", "decimal", "joint_grid",
+    "MAX_EXTRA_POINTS", "SPACING_ROUNDING", "SPEED_READING", "SpacingCondition", "Written",
+    "decimal", "joint_grid", "spacing_conditions", "written",
     "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_box", "right_box",
     "VariantRule", "cell_box", "ptp_angles", "ptp_fraction", "rule_of",
     # one definition on floats and on Z3 terms (the rules the proofs read)

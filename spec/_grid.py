@@ -1,11 +1,13 @@
 """Time and C-space grids (docs/model.md §2), computed in exact rationals so rounding is the safe way.
 
-The counts come from ``spec._counts`` (one owner): N and m are derived from the doubles' exact
-values in two readings (binary and decimal, ``Grid.READINGS``), and the float spacing h the
-planner uses is confirmed against the exact bound (a point is added when it fails), so
-``N * dt >= Tf`` and ``h_q <= omega_q * dt`` hold exactly, not just up to rounding. The loader,
+The counts come from ``spec._counts`` (one owner): N is derived from the numbers' exact values
+in two readings (binary and decimal, ``Grid.READINGS``), so ``N * dt >= Tf`` holds exactly in
+both; m is counted in the decimal reading, the numbers as written, so
+``(hi_q - lo_q)/(m_q - 1) <= omega_q * dt`` holds exactly there, and the float spacing h the
+planner uses is confirmed within rounding of omega_q * dt in both readings and <= 157/50
+(``spacing_conditions``; a point is added only when that fails, docs/model.md §2). The loader,
 ``make_grid``, the contracts (``grid_failures``) and the obligations judge through the same
-``Grid.time_readings`` and ``Grid.spacing_readings``.
+``spacing_conditions``, ``Grid.time_readings`` and ``Grid.spacing_readings``.
 """
 
 from __future__ import annotations
@@ -208,7 +210,7 @@ class Grid:
     h: tuple[float, float]
 
     #: The two exact readings every grid condition is judged in: "binary" (the doubles as the
-    #: rationals they are) and "decimal" (the numbers as written, Fraction(repr(x))).
+    #: rationals they are) and "decimal" (the numbers as written: a file's text, exactly).
     READINGS = READINGS
 
     @staticmethod
@@ -220,7 +222,8 @@ class Grid:
     @staticmethod
     def spacing_readings(s: Scenario, q: int) -> dict[str, tuple[Fraction, Fraction]]:
         """{reading: (hi_q - lo_q, omega_q dt)} of the subordinate's joint q, exactly; the grid
-        must satisfy (hi - lo) / (m_q - 1) <= omega_q dt in each (and its float h in binary)."""
+        must satisfy (hi - lo) / (m_q - 1) <= omega_q dt exactly in the decimal reading, and its
+        float h within rounding of omega_q dt in each (``spacing_conditions``)."""
         R = s.right
         return spacing_readings(R.limits[q][0], R.limits[q][1], R.omega[q], s.dt)
 

@@ -7,10 +7,13 @@ MAX_BASE_M = 1000 m, link lengths and widths in (0, MAX_LENGTH_M = 100 m], angle
 limits) within MAX_ANGLE_RAD = 1000 rad, and omega_q * dt <= 157/50 = 3.14 rad for every
 joint of both arms, exactly, both as the exact product of the doubles and as the float product
 the code uses (the margin lemma, ``Lemma.sweep_margin``, is proved for lattice spacings
-g <= 3.14; the left spacing is the float omega dt, the right h_q <= omega_q dt). The grid's size
-is computed in exact integers and held to the memory budget before any float grid step exists;
-each joint's grid then comes from ``joint_grid`` (spec/_counts.py), the same function
-``make_grid`` uses, and a joint it cannot confirm safe is refused naming right.limits[q].
+g <= 3.14; the left spacing is the float omega dt, the right the float h_q, which
+``joint_grid`` holds to 157/50 itself). Numbers are read as written: tomllib's ``parse_float``
+keeps each TOML float's text as an exact decimal (``spec._counts.Written``), and integers keep
+their digits, so the grid is counted on the decimals in the file (docs/model.md §2, §3). The
+grid's size is computed in exact integers and held to the memory budget before any float grid
+step exists; each joint's grid then comes from ``joint_grid`` (spec/_counts.py), the same
+function ``make_grid`` uses, and a joint it cannot confirm is refused naming right.limits[q].
 """
 
 from __future__ import annotations
@@ -26,7 +29,8 @@ from typing import Any
 
 from ..errors import MISSING, InputError
 from ..files import LIMITS, echo, read_bounded
-from ._counts import GridRefused, joint_grid, min_points, time_steps
+from ._counts import (MAX_SPACING, GridRefused, joint_grid, min_points, spacing_conditions,
+                      time_steps, Written, written)
 
 __all__ = [
     "Arm",
@@ -202,7 +206,9 @@ class _Reader:
         if bound is not None and not abs(x) <= bound:
             within = f"<= {bound:g}{unit}" if positive else f"within [-{bound:g}, {bound:g}]{unit}"
             raise self.fail(field, value, f"must be {within} (the physical range)")
-        return x
+        # Keep the decimal as written (a file's float text, an integer's digits): the grid is
+        # counted on it (spec._counts.decimal). A plain float from a Python document stays one.
+        return written(value) if isinstance(value, (int, Written)) else x
 
     def pair(self, value: Any, field: str, *, positive: bool = False,
              bound: float | None = None, unit: str = "") -> Pair:
@@ -259,7 +265,7 @@ def _arm_common(r: _Reader, doc: dict[str, Any], side: str, dt: float) -> dict[s
 
 
 #: The margin lemma's bound on a lattice spacing, exactly (MAX_STEP_RAD as written).
-_G_MAX = Fraction(157, 50)
+_G_MAX = MAX_SPACING
 
 
 def _joint_grids(r: _Reader, limits: tuple[Pair, Pair], omega: Pair, dt: float
@@ -330,10 +336,12 @@ def _grid_point(r: _Reader, doc: dict[str, Any], which: str, limits: tuple[Pair,
             base = min_points(lo, hi, omega[q], dt)
             why = ""
             if m > base:
+                failed = [c.words() for c in spacing_conditions(
+                    lo, hi, omega[q], dt, base, (hi - lo) / (base - 1)) if not c.holds]
+                reason = "; ".join(failed) or "its last point would miss the upper limit"
                 why = (f"; joint {q + 1}'s grid has {m} points, not {base}: with {base} the float "
-                       f"spacing {(hi - lo) / (base - 1)!r} would exceed omega * dt = "
-                       f"{omega[q]!r} * {dt!r} in exact arithmetic, so a point was added and the "
-                       f"spacing is {h!r}")
+                       f"spacing {(hi - lo) / (base - 1)!r} would fail ({reason}), so a point was "
+                       f"added and the spacing is {h!r}")
             raise r.fail(field, angles[q],
                          f"must be a grid point (within {ANGLE_TOLERANCE} rad); nearest are index "
                          f"{below} = {lo + below * h!r} and index {above} = {lo + above * h!r}"
@@ -398,7 +406,7 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     except UnicodeDecodeError:
         raise InputError("scenario", MISSING, "is not UTF-8 text", source=source) from None
     try:
-        doc = tomllib.loads(text)
+        doc = tomllib.loads(text, parse_float=written)
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+)", str(exc))
         raise InputError("toml", echo(str(exc)), "is not valid TOML", source=source,

@@ -19,7 +19,7 @@ import numpy.typing as npt
 
 from ..errors import ContractViolation
 from ._builtdr_post import CellMismatch, dr_postcondition
-from ._counts import SPAN_TOLERANCE, decimal
+from ._counts import SPAN_TOLERANCE, decimal, spacing_conditions
 from ._grid import Grid, Variant, exact_tf
 from ._paths import J1, J2, SearchResult, SearchStatus, path_violations
 from ._scenario import Scenario
@@ -137,9 +137,11 @@ _GRID_PRE = (
     Condition("pre.grid.N", "N >= 1 and N * dt >= Tf in exact arithmetic, in both readings "
               "(binary: the doubles; decimal: the numbers as written): the layers cover the "
               "principal's whole motion"),
-    Condition("pre.grid.h", "h_q <= omega_q * dt for both joints in exact arithmetic (the float "
-              "h_q against the doubles, and (hi_q - lo_q)/(m_q - 1) in both readings), and the "
-              "m x n grid points span the subordinate's joint limits"),
+    Condition("pre.grid.h", "(hi_q - lo_q)/(m_q - 1) <= omega_q * dt for both joints exactly "
+              "in the decimal reading (the speed limit as the file states it); the float h_q "
+              "within rounding (1e-10 relative) of omega_q * dt in both readings and <= 157/50 "
+              "rad (the margin lemma's bound); and the m x n grid points span the subordinate's "
+              "joint limits"),
     Condition("pre.grid.scenario", "the grid's dt, Tf and lower limits are the scenario's"),
     Condition("pre.cells", "the start and goal cells lie inside the m x n grid"),
 )
@@ -253,10 +255,10 @@ def grid_failures(s: Scenario, grid: Grid) -> list[Failure]:
     for q, points in enumerate((grid.m, grid.n)):
         if not (isinstance(points, int) and points >= 2):
             continue  # reported below, as points that do not span the limits
-        spans = Grid.spacing_readings(s, q)
-        checks = [("binary (float h)", Fraction(grid.h[q]), spans["binary"][1])]
-        checks += [(r, spans[r][0] / (points - 1), spans[r][1]) for r in Grid.READINGS]
-        bad = [(q, r, h, step) for r, h, step in checks if not h <= step]
+        # The conditions joint_grid builds the grid to meet (spec/_counts.py, docs/model.md §2).
+        conds = spacing_conditions(R.limits[q][0], R.limits[q][1], R.omega[q], s.dt, points,
+                                   grid.h[q])
+        bad = [(q, f"{c.what}, {c.reading}", c.value, c.bound) for c in conds if not c.holds]
         bad_h += bad[:1]
     if bad_h:
         q, r, h, step = bad_h[0]

@@ -1,6 +1,7 @@
 """Grids satisfy their contracts by construction: valid round-number workcells never
-get a false ``pre.grid.*`` violation, their per-scenario obligations hold, and a joint that
-cannot be gridded safely is refused by the loader (exit 2, the field named).
+get a false ``pre.grid.*`` violation, their per-scenario obligations hold, a round-number grid is
+counted on the decimals as written (no point added where the doubles round the other way), and a
+joint that cannot be gridded is refused by the loader (exit 2, the field named).
 """
 
 from __future__ import annotations
@@ -35,17 +36,35 @@ LOWS = [-3.0, -2.5, -2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, -
 
 
 def old_grid(lo: float, hi: float, omega: float, dt: float) -> tuple[int, float]:
-    """The former construction: the exact binary count, then the float spacing."""
+    """The first construction: the exact binary count, then the float spacing."""
     m = ceil_fraction((Fraction(hi) - Fraction(lo)) / (Fraction(omega) * Fraction(dt))) + 1
     return m, (hi - lo) / (m - 1)
 
 
 def unsafe(lo: float, hi: float, omega: float, dt: float, m: int, h: float) -> bool:
-    """Whether m points spaced h break h <= omega dt (float h and both readings) or the span."""
+    """The second construction's test (a point added while it held): m points spaced h break
+    h <= omega dt for the float h and both readings exactly, or the span."""
     step_b = Fraction(omega) * Fraction(dt)
     return (Fraction(h) > step_b or (Fraction(hi) - Fraction(lo)) / (m - 1) > step_b
             or (decimal(hi) - decimal(lo)) / (m - 1) > decimal(omega) * decimal(dt)
             or abs(lo + (m - 1) * h - hi) > 1e-9)
+
+
+def off_grid(lo: float, hi: float, omega: float, dt: float, m: int, h: float) -> bool:
+    """What the grid must meet now (docs/model.md §2), restated here independently of
+    spec._counts: (hi - lo)/(m - 1) <= omega dt exactly as written (decimal), the float h within
+    1e-10 relative of omega dt in both readings and <= 157/50, the span within 1e-9 rad."""
+    step_d = decimal(omega) * decimal(dt)
+    step_b = Fraction(omega) * Fraction(dt)
+    slack = 1 + Fraction(1, 10**10)
+    return ((decimal(hi) - decimal(lo)) / (m - 1) > step_d or Fraction(h) > step_d * slack
+            or Fraction(h) > step_b * slack or Fraction(h) > Fraction(157, 50)
+            or abs(lo + (m - 1) * h - hi) > 1e-9)
+
+
+def decimal_count(lo: float, hi: float, omega: float, dt: float) -> int:
+    """The least m with (hi - lo)/(m - 1) <= omega dt in the numbers as written."""
+    return max(2, ceil_fraction((decimal(hi) - decimal(lo)) / (decimal(omega) * decimal(dt))) + 1)
 
 
 def workcell(dt: float, omega_r: tuple[float, float], spans: tuple[float, float],
@@ -76,32 +95,31 @@ def assert_sound(doc: dict[str, Any]) -> None:
 # --- one joint at a time: the construction adds a point exactly where the old one was unsafe --
 
 
-def test_new_construction_adds_a_point_exactly_where_the_old_was_unsafe() -> None:
+def test_every_grid_is_the_decimal_count_and_meets_its_conditions() -> None:
     combos = list(itertools.product(DTS, OMEGAS, SPANS, LOWS))
-    old_bad = added = 0
+    shifted = 0
     for dt, w, span, lo in combos:
         hi = lo + span
-        mo, ho = old_grid(lo, hi, w, dt)
         mn, hn = joint_grid(lo, hi, w, dt)
-        was_unsafe = unsafe(lo, hi, w, dt, mo, ho)
-        old_bad += was_unsafe
-        added += mn != mo
-        assert not unsafe(lo, hi, w, dt, mn, hn), (dt, w, span, lo)
-        assert mn == mo + was_unsafe, (dt, w, span, lo, mo, mn)
+        assert not off_grid(lo, hi, w, dt, mn, hn), (dt, w, span, lo)
+        assert mn == decimal_count(lo, hi, w, dt), (dt, w, span, lo)   # no point added
+        shifted += unsafe(lo, hi, w, dt, *old_grid(lo, hi, w, dt))
     assert len(combos) == 6300
-    assert old_bad == added == 289   # measured: the old construction is unsafe on 289
+    assert shifted == 289   # measured: the second construction added a point on these 289
 
 
-def test_the_issues_example_gets_one_point_more() -> None:
-    m, h = joint_grid(0.0, 2.5, 2.5, 0.02)
-    assert old_grid(0.0, 2.5, 2.5, 0.02) == (51, 0.05)
-    assert (m, h) == (52, 2.5 / 51)
-    assert Fraction(0.05) > Fraction(2.5) * Fraction(0.02)   # why 51 points were unsafe
+def test_the_issues_example_keeps_its_round_grid() -> None:
+    assert joint_grid(0.0, 2.5, 2.5, 0.02) == (51, 0.05)
+    assert joint_grid(-2.0, 2.0, 2.5, 0.02) == (81, 0.05)
+    # The double 0.05 exceeds the product of the doubles 2.5 and 0.02 (and 1/20) by rounding:
+    # within SPACING_ROUNDING, so no point is added (docs/model.md §2).
+    step_b = Fraction(2.5) * Fraction(0.02)
+    assert step_b < Fraction(0.05) <= step_b * (1 + Fraction(_counts.SPACING_ROUNDING))
 
 
 # --- regression files on the boundary ----------------------------------------------------------
 
-BOUNDARY = [  # (dt, omega, span, lo): integer span / (omega dt) in decimal, unsafe before
+BOUNDARY = [  # (dt, omega, span, lo): integer span / (omega dt) in decimal, a point added before
     (0.02, 2.5, 2.5, 0.0),
     (0.02, 2.5, 3.0, 0.0),
     (0.04, 5.0, 3.0, 0.0),
@@ -115,6 +133,7 @@ BOUNDARY = [  # (dt, omega, span, lo): integer span / (omega dt) in decimal, uns
 def test_boundary_workcells_satisfy_their_contracts(dt: float, w: float, span: float,
                                                     lo: float) -> None:
     assert unsafe(lo, lo + span, w, dt, *old_grid(lo, lo + span, w, dt))
+    assert joint_grid(lo, lo + span, w, dt)[0] == decimal_count(lo, lo + span, w, dt)
     assert_sound(workcell(dt, (w, w), (span, span), (lo, lo)))
 
 
@@ -186,7 +205,8 @@ def test_round_number_workcells_never_violate_pre_grid_long(doc: dict[str, Any])
 
 
 def test_the_strategy_hits_the_boundary() -> None:
-    """About one workcell in six the strategy draws has a joint on the boundary."""
+    """About one workcell in six the strategy draws has a joint on the boundary (where the
+    second construction added a point)."""
     hits = 0
 
     @settings(max_examples=300, deadline=None, database=None)
@@ -194,8 +214,8 @@ def test_the_strategy_hits_the_boundary() -> None:
     def count(doc: dict[str, Any]) -> None:
         nonlocal hits
         R = doc["right"]
-        hits += any(joint_grid(lo, hi, R["omega"][q], doc["dt"])[0]
-                    > old_grid(lo, hi, R["omega"][q], doc["dt"])[0]
+        hits += any(unsafe(lo, hi, R["omega"][q], doc["dt"],
+                           *old_grid(lo, hi, R["omega"][q], doc["dt"]))
                     for q, (lo, hi) in enumerate(R["limits"]))
 
     count()
@@ -220,10 +240,28 @@ def test_coarse_boundary_workcells_plan_in_every_variant(tmp_path: Path, dt: flo
 # --- refusals: exit 2 naming the field, never a contract violation -----------------------------
 
 
+# A joint where the float h misses the decimal spacing by more than rounding allows: a 0.0002 rad
+# span at 1000 rad (the doubles' subtraction is off by 3e-14 rad), so a point is added.
+FAR = dict(lo=999.9997, hi=999.9999, omega=1.0, dt=0.0001)
+
+
+def far_workcell() -> dict[str, Any]:
+    return factory.doc(dt=FAR["dt"], left__goal=[0.3, 0.8],
+                       right__omega=[1.0, FAR["omega"]],
+                       right__limits=[[0.0, 0.0002], [FAR["lo"], FAR["hi"]]],
+                       right__start_cell=[0, 0], right__goal_cell=[2, 1])
+
+
+def test_a_point_is_added_only_where_rounding_exceeds_its_allowance() -> None:
+    lo, hi, w, dt = FAR["lo"], FAR["hi"], FAR["omega"], FAR["dt"]
+    assert decimal_count(lo, hi, w, dt) == 3 and joint_grid(lo, hi, w, dt)[0] == 4
+    assert off_grid(lo, hi, w, dt, 3, (hi - lo) / 2)
+
+
 def test_a_joint_that_cannot_be_confirmed_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
-    doc = workcell(0.02, (1.0, 2.5), (3.0, 2.5), (0.0, 0.0))
+    doc = far_workcell()
     parse_scenario(doc, check_budget=False)   # accepted, with a point added to joint 2
-    # Seeded fault: allow no extra point, so the boundary joint cannot be made safe.
+    # Seeded fault: allow no extra point, so the joint cannot be gridded.
     monkeypatch.setattr(_counts, "MAX_EXTRA_POINTS", 0)
     with pytest.raises(InputError) as info:
         parse_scenario(doc, check_budget=False)
@@ -232,25 +270,27 @@ def test_a_joint_that_cannot_be_confirmed_is_refused(monkeypatch: pytest.MonkeyP
 
 
 def test_a_start_off_the_shifted_grid_is_refused_with_the_reason() -> None:
-    doc = workcell(0.02, (2.5, 2.5), (2.5, 2.5), (0.0, 0.0))
+    doc = far_workcell()
     del doc["right"]["start_cell"]
-    doc["right"]["start"] = [1.25, 1.25]
+    doc["right"]["start"] = [0.0, 999.9998]
     with pytest.raises(InputError) as info:
         parse_scenario(doc, check_budget=False)
     msg = str(info.value)
-    assert info.value.field == "right.start[0]"
-    assert "nearest are index 25" in msg and "index 26" in msg
-    assert "52 points, not 51" in msg and "a point was added" in msg
+    assert info.value.field == "right.start[1]"
+    assert "nearest are index 1" in msg and "index 2" in msg
+    assert "4 points, not 3" in msg and "a point was added" in msg
+    assert "float h (decimal)" in msg and ": False" in msg
 
 
-def test_a_start_on_the_grid_is_placed_with_make_grids_spacing() -> None:
-    doc = workcell(0.02, (2.5, 2.5), (2.5, 2.5), (0.0, 0.0))
+def test_a_round_start_on_the_round_grid_is_a_grid_point() -> None:
+    doc = workcell(0.02, (2.5, 2.5), (4.0, 2.5), (-2.0, 0.0))
     del doc["right"]["start_cell"]
-    doc["right"]["start"] = [30 * (2.5 / 51), 2.5]
+    doc["right"]["start"] = [0.0, 1.25]
     s = parse_scenario(doc, check_budget=False)
-    assert s.right.start_cell == (30, 51)
+    assert s.right.start_cell == (40, 25)
     g = make_grid(s)
-    assert g.angles(s.right.start_cell) == (30 * (2.5 / 51), 2.5)
+    assert (g.m, g.n) == (81, 51)
+    assert all(abs(a - b) <= 1e-15 for a, b in zip(g.angles(s.right.start_cell), (0.0, 1.25)))
 
 
 def test_omega_dt_just_over_the_margin_bound_is_refused() -> None:
@@ -264,3 +304,28 @@ def test_omega_dt_just_over_the_margin_bound_is_refused() -> None:
 def test_min_points_needs_no_float() -> None:
     assert min_points(0.0, 2.5, 2.5, 0.02) == 51
     assert min_points(0.0, 1.0, 1.0, 5e-324 * 2**60) > 2**53
+
+
+# --- pre.grid.h's rounding allowance: what it admits and what it refuses -----------------------
+
+
+def test_pre_grid_h_admits_rounding_and_refuses_more() -> None:
+    from dataclasses import replace
+
+    doc = workcell(0.02, (2.5, 2.5), (4.0, 4.0), (-2.0, -2.0))
+    s = parse_scenario(doc, check_budget=False)
+    g = make_grid(s)
+    assert (g.m, g.h[0]) == (81, 0.05) and grid_failures(s, g) == []
+    # Seeded fault: a float h beyond the rounding allowance (ten times it, and 1e-7 rad) is a
+    # pre.grid.h failure naming the float h, before the span is even looked at.
+    for h in (0.05 * (1 + 1e-9), 0.0500001):
+        fails = grid_failures(s, replace(g, h=(h, g.h[1])))
+        assert [f.condition for f in fails][:1] == ["pre.grid.h"], h
+        assert dict(fails[0].values)["reading"].startswith("float h"), fails[0].values
+
+
+def test_the_margin_lemmas_bound_is_held_on_the_float_h() -> None:
+    conds = _counts.spacing_conditions(0.0, 6.28, 1000.0, 0.01, 3, 3.14)
+    margin = [c for c in conds if c.reading == "margin lemma"]
+    assert len(margin) == 1 and not margin[0].holds      # the double 3.14 is above 157/50
+    assert margin[0].bound == Fraction(157, 50)
