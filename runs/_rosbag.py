@@ -149,7 +149,7 @@ def _samples(path: str | os.PathLike[str], opts: BagOptions, option: str
                 k += 1
                 where = f"message {k} on {opts.topic}"
                 try:
-                    msg = store.deserialize_cdr(raw, conn.msgtype)
+                    msg: Any = store.deserialize_cdr(raw, conn.msgtype)
                 except Exception as exc:    # rosbags raises many kinds on a corrupt payload
                     raise InputError(opts.topic, f"message {k}", f"cannot be decoded as "
                                      f"{JOINT_STATE} ({type(exc).__name__}: {exc})",
@@ -246,8 +246,8 @@ def write_bag(path: str | os.PathLike[str], t: FloatArray, angles: FloatArray,
               opts: BagOptions = BagOptions()) -> Path:
     """Write samples (t (N,), angles (N, 4) in JOINTS order) as one .mcap file of JointState
     messages on ``opts.topic``, joints named ``opts.joints``, header.stamp = t to the nearest ns
-    (the last one rounded up) and the same as the bag's receive time. Atomic: built in a temporary folder beside ``path``,
-    then renamed onto it."""
+    (the last one rounded up) and the same as the bag's receive time. Atomic: built in a
+    temporary folder beside ``path``, then renamed onto it."""
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
