@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..errors import InputError
+from ..errors import MISSING, InputError
 from ..files import LIMITS, echo
 from ..spec import TRAJECTORY_COLUMNS, Scenario, Trajectory, parse_trajectory_csv
 
@@ -151,9 +151,8 @@ def _samples(path: str | os.PathLike[str], opts: BagOptions, option: str
                 try:
                     msg: Any = store.deserialize_cdr(raw, conn.msgtype)
                 except Exception as exc:    # rosbags raises many kinds on a corrupt payload
-                    raise InputError(opts.topic, f"message {k}", f"cannot be decoded as "
-                                     f"{JOINT_STATE} ({type(exc).__name__}: {exc})",
-                                     source=source) from None
+                    raise InputError(where, MISSING, f"cannot be decoded as {JOINT_STATE} "
+                                     f"({type(exc).__name__}: {exc})", source=source) from None
                 ns = _stamp_ns(msg.header.stamp.sec, msg.header.stamp.nanosec)
                 if t0 is None:
                     t0 = ns

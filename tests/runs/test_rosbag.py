@@ -190,6 +190,18 @@ def test_a_file_that_is_not_a_bag_is_exit_2_naming_it(cell, tmp_path, capsys, ma
         assert "Traceback" not in err
 
 
+def test_a_message_that_cannot_be_decoded_is_exit_2_naming_it(cell, tmp_path, capsys):
+    s, scen, traj_csv, traj, tol = cell
+    with Writer(tmp_path / "bag", version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        conn = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=STORE)
+        w.write(conn, 1, b"\x00\x01\x00\x00\x07")                  # cut short
+    assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log",
+                 str(tmp_path / "bag")]) == 2
+    err = capsys.readouterr().err
+    assert "error: message 1 on /joint_states cannot be decoded as sensor_msgs/msg/JointState" in err
+    assert "Traceback" not in err
+
+
 def test_stamps_that_do_not_increase_are_exit_2_naming_the_message(cell, tmp_path, capsys):
     s, scen, traj_csv, traj, tol = cell
     ns, t, a = samples(traj, tol, samples=20)
