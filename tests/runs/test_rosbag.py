@@ -254,6 +254,14 @@ def test_certify_from_a_bag_equals_certify_from_the_csv(cell, tmp_path):
     assert a["trajectory"].pop("file") != b["trajectory"].pop("file")
     assert a["trajectory"].pop("sha256") != b["trajectory"].pop("sha256") is not None
     assert a == b and a["clear"] is True and a["trajectory"]["rows"] == traj.rows
+    # monitor's --traj may be the bag too: the same verdict and JSON as with its CSV.
+    ns_log, t, angles = samples(traj, tol, samples=400)
+    log = tmp_path / "log.csv"
+    log.write_bytes(log_csv(t, angles))
+    _, m_csv = monitor_doc(scen, csv, log, tmp_path / "mc.json")
+    _, m_bag = monitor_doc(scen, bag, log, tmp_path / "mb.json", "--joints", JOINT_NAMES)
+    assert m_csv.pop("trajectory") != m_bag.pop("trajectory")
+    assert m_csv == m_bag
 
 
 def test_simulate_out_mcap_round_trips(cell, tmp_path, capsys):
