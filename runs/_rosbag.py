@@ -19,6 +19,8 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
+import sqlite3
+import struct
 import tempfile
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -111,7 +113,9 @@ def _reader(path: Path, option: str, source: str) -> Any:
         reader.open()
     except FileNotFoundError as exc:
         raise InputError(option, str(path), f"is not a ROS 2 bag ({exc})", source=source) from None
-    except (ReaderError, OSError, ValueError, KeyError, TypeError) as exc:
+    # rosbags 0.11.0 lets sqlite3's own error through for a .db3 that is no database.
+    except (ReaderError, OSError, ValueError, KeyError, TypeError, EOFError, struct.error,
+            sqlite3.Error) as exc:
         raise InputError(option, str(path), f"is not a readable ROS 2 bag ({exc})",
                          source=source) from None
     return reader
