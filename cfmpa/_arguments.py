@@ -19,7 +19,7 @@ from typing import Any
 from .errors import InputError
 
 __all__ = ["FILE", "FOLDER", "Budget", "budgets", "check_output", "checked", "cpus",
-           "engine_arguments", "json_argument", "kernel_argument", "number", "out_argument",
+           "bag_arguments", "engine_arguments", "json_argument", "kernel_argument", "number", "out_argument",
            "output", "positive", "run_checks", "scenario_argument", "trajectory_arguments",
            "variant_argument"]
 
@@ -150,6 +150,8 @@ def budgets() -> dict[str, Budget]:
         "samples": Budget(1, MAX_LOG_SAMPLES, "the simulated log's budget"),
         # A joint speed in rad/s (a --max-speed of monitor's): 100 rad/s is ~950 rpm at a joint.
         "speed": Budget(0, 100, "a joint's speed in rad/s"),
+        # --t0 of a ROS 2 bag: a builtin_interfaces/Time's seconds are an int32.
+        "t0": Budget(-2**31, 2**31 - 1, "a ROS 2 stamp's seconds, an int32"),
     }
 
 
@@ -223,6 +225,21 @@ def trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned tr
     scenario_argument(p, "scenario (the geometry): a bundled name or a TOML file")
     p.add_argument("--traj", required=True, metavar="FILE", help=traj)
     p.add_argument("--allow-speed", action="store_true", help=speed)
+
+
+def bag_arguments(p: argparse.ArgumentParser, *, read: bool = True) -> None:
+    """--topic and --joints of a ROS 2 bag (runs.BagOptions), and with ``read`` --t0 (the
+    stamp that is t = 0; numeric, budgeted)."""
+    p.add_argument("--topic", default=None, metavar="TOPIC",
+                   help="a ROS 2 bag's topic of sensor_msgs/msg/JointState (default "
+                        "/joint_states)")
+    p.add_argument("--joints", default=None, metavar="L1,L2,R1,R2",
+                   help="the ROS joint names of left1,left2,right1,right2, matched by name "
+                        "(default left1,left2,right1,right2)")
+    if read:
+        number(p, "--t0", budgets()["t0"], type=float, default=None, metavar="SECONDS",
+               help="the stamp that is t = 0: t = header.stamp - t0 (default: the first "
+                    "message's stamp)")
 
 
 def positive(value: str) -> int:

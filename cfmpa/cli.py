@@ -141,7 +141,7 @@ def cmd_certify(args: argparse.Namespace) -> int:
     from .runs import run_certify
 
     return run_certify(resolve(args.scenario), args.traj, json_out=args.json,
-                       allow_speed=args.allow_speed)
+                       allow_speed=args.allow_speed, bag=_bag(args))
 
 
 def cmd_monitor(args: argparse.Namespace) -> int:
@@ -149,7 +149,7 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     from .runs import run_monitor
 
     return run_monitor(resolve(args.scenario), args.traj, args.log, json_out=args.json,
-                       allow_speed=args.allow_speed, max_speed=args.max_speed)
+                       allow_speed=args.allow_speed, max_speed=args.max_speed, bag=_bag(args))
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
@@ -160,7 +160,18 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                         noise=args.noise, seed=args.seed,
                         excursions=[parse_excursion(e) for e in args.excursion],
                         period=args.period, samples=args.samples, tail=args.tail,
-                        allow_speed=args.allow_speed)
+                        allow_speed=args.allow_speed, bag=_bag(args))
+
+
+def _bag(args: argparse.Namespace) -> Any:
+    """runs.BagOptions of --topic, --joints and --t0; None when none of them is given."""
+    from .runs import DEFAULT_TOPIC, BagOptions, parse_joints
+
+    t0 = getattr(args, "t0", None)
+    if args.topic is None and args.joints is None and t0 is None:
+        return None
+    return BagOptions(DEFAULT_TOPIC if args.topic is None else args.topic,
+                      parse_joints(args.joints), t0)
 
 
 def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
@@ -333,25 +344,29 @@ def _parser() -> argparse.ArgumentParser:
                                   "tolerance tube",
                   "cfmpa certify default --traj plan/traj.csv --json certify.json", cmd_certify)
     opt.trajectory_arguments(ce, "trajectory: CSV t,left1,left2,right1,right2 or the same columns "
-                              "as JSON (docs/model.md §12)",
+                              "as JSON, or a ROS 2 bag (docs/model.md §12)",
                           "certify even when a joint speed exceeds the scenario's omega")
     opt.json_argument(ce)
+    opt.bag_arguments(ce)
 
     mo = _command(sub, "monitor", "check a measured joint log against the certified tube",
                   "cfmpa monitor default --traj plan/traj.csv --log log.csv", cmd_monitor)
     opt.trajectory_arguments(mo)
     mo.add_argument("--log", required=True, metavar="LOG",
-                    help="measured samples, CSV t,left1,left2,right1,right2 (- for stdin)")
+                    help="measured samples: CSV t,left1,left2,right1,right2 (- for stdin), or "
+                         "a ROS 2 bag (a folder with metadata.yaml, a .mcap or .db3 file)")
     mo.add_argument("--max-speed", default=None, metavar="W[,W2,W3,W4]",
                     help="the robot's joint speed bound in rad/s, one for all joints or one per "
                          "joint (default: the scenario's omega; docs/model.md §12)")
     opt.json_argument(mo)
+    opt.bag_arguments(mo)
 
     si = _command(sub, "simulate", "write a simulated measured log of a trajectory",
                   "cfmpa simulate default --traj plan/traj.csv --out log.csv --noise 0.001",
                   cmd_simulate)
     opt.trajectory_arguments(si)
-    opt.out_argument(si, "the log file to write (CSV)", metavar="LOG", kind=opt.FILE)
+    opt.out_argument(si, "the log file to write: CSV, or a ROS 2 bag if it ends in .mcap",
+                     metavar="LOG", kind=opt.FILE)
     opt.number(si, "--lag", b["lag"], type=float, default=0.0,
                help="tracking lag in s (default 0)")
     opt.number(si, "--noise", b["noise"], type=float, default=0.0,
@@ -365,6 +380,7 @@ def _parser() -> argparse.ArgumentParser:
                help="this many evenly spaced samples instead of --period")
     opt.number(si, "--tail", b["tail"], type=float, default=0.0,
                help="keep sampling this many s after the trajectory ends (default 0)")
+    opt.bag_arguments(si, read=False)
     return p
 
 

@@ -44,8 +44,10 @@ from ._bundled import run_scenarios
 from ._trajectory_runs import (AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, BLOCK_ROWS, MAX_LOG_SAMPLES,
                                MIN_PERIOD_S, LISTED_UNOBSERVED, Excursion, MonitorResult,
                                Unobserved, certify_json, log_csv, monitor_json, monitor_log,
-                               parse_excursion, parse_max_speed, run_certify, run_monitor,
+                               monitor_rows, parse_excursion, parse_max_speed, run_certify, run_monitor,
                                run_simulate, simulate_log)
+from ._rosbag import (DEFAULT_TOPIC, JOINT_STATE, BagOptions, bag_rows, bag_sha256, is_bag,
+                      load_bag_trajectory, parse_joints, write_bag)
 from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
                             code_mutation_rows, code_mutation_table, imports_copy, mutated_copy,
                             run_code_selftest)
@@ -75,7 +77,10 @@ __all__ = [
     "BLOCK_ROWS", "Excursion", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult",
     "certify_json", "log_csv", "monitor_json",
     "monitor_log", "parse_excursion", "run_certify", "run_monitor", "run_simulate",
-    "simulate_log",
+    "simulate_log", "monitor_rows",
+    # ROS 2 bags as trajectories and logs (docs/model.md §12)
+    "BagOptions", "DEFAULT_TOPIC", "JOINT_STATE", "bag_rows", "bag_sha256", "is_bag",
+    "load_bag_trajectory", "parse_joints", "write_bag",
     # seeded faults
     "FAULTS", "Fault", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault", "run_selftest",
     "selftest_rows", "selftest_table", "workcell",

@@ -26,6 +26,7 @@ import numpy.typing as npt
 
 from ..errors import MISSING, InputError
 from ..files import bounded_lines, dumps_json, echo, write_bytes_atomic
+from ._rosbag import BagOptions, bag_rows, bag_sha256, is_bag, load_bag_trajectory, write_bag
 from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
                     between_samples_bound, certify_trajectory, closest_links, contact_links_text,
                     csv_column_order, load_scenario, load_trajectory, tolerance_rad,
@@ -33,8 +34,8 @@ from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, 
 
 __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
            "LISTED_UNOBSERVED", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult", "Unobserved",
-           "certify_json", "log_csv", "monitor_json", "monitor_log", "parse_excursion",
-           "parse_max_speed", "run_certify", "run_monitor", "run_simulate", "simulate_log"]
+           "certify_json", "log_csv", "monitor_json", "monitor_log", "monitor_rows",
+           "parse_excursion", "parse_max_speed", "run_certify", "run_monitor", "run_simulate", "simulate_log"]
 
 #: The most samples `cfmpa simulate` writes: the log is built in memory (about 0.5 KB a sample
 #: at its peak, a 100 MB CSV), so a count beyond is refused before anything is allocated.
@@ -55,7 +56,26 @@ def _scenario(s: Scenario | str | Path) -> Scenario:
 
 
 def _sha256(path: str | Path) -> str:
+    if is_bag(path):
+        return bag_sha256(path)
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _bag_options(bag: BagOptions | None, *paths: str | Path) -> BagOptions:
+    """The options a bag among ``paths`` is read with; --topic, --joints or --t0 given
+    (``bag`` not None) when none is a bag is refused: they would be ignored."""
+    if bag is not None and not any(str(p) != "-" and is_bag(p) for p in paths):
+        raise InputError("--topic/--joints/--t0", MISSING, "apply to a ROS 2 bag only (a "
+                         "folder with metadata.yaml, or a .mcap or .db3 file), and none was "
+                         f"given ({', '.join(str(p) for p in paths)})")
+    return BagOptions() if bag is None else bag
+
+
+def _trajectory(path: str | Path, s: Scenario, allow_speed: bool, bag: BagOptions) -> Trajectory:
+    """A trajectory file (CSV or JSON, ``spec.load_trajectory``) or a ROS 2 bag."""
+    if is_bag(path):
+        return load_bag_trajectory(path, s, bag, allow_speed=allow_speed)
+    return load_trajectory(path, s, allow_speed=allow_speed)
 
 
 def certify_json(s: Scenario, traj: Trajectory, cert: Certificate,
@@ -95,12 +115,14 @@ def certify_json(s: Scenario, traj: Trajectory, cert: Certificate,
 
 
 def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
-                json_out: str | Path | None = None, allow_speed: bool = False) -> int:
-    """Certify the trajectory file; print the summary; 0 clear, 1 not clear (bad input raises
-    InputError, exit 2, nothing written)."""
+                json_out: str | Path | None = None, allow_speed: bool = False,
+                bag: BagOptions | None = None) -> int:
+    """Certify the trajectory file (or ROS 2 bag, read with ``bag``); print the summary; 0
+    clear, 1 not clear (bad input raises InputError, exit 2, nothing written)."""
     s = _scenario(scenario)
+    opts = _bag_options(bag, traj_path)
     t0 = time.perf_counter()
-    traj = load_trajectory(traj_path, s, allow_speed=allow_speed)
+    traj = _trajectory(traj_path, s, allow_speed, opts)
     t1 = time.perf_counter()
     cert = certify_trajectory(s, traj)
     t2 = time.perf_counter()
@@ -303,9 +325,50 @@ def parse_max_speed(text: str | None, s: Scenario, traj: Trajectory) -> FloatArr
     return np.broadcast_to(np.array(vals, dtype=float), (4,)).copy()
 
 
+def _csv_blocks(stream: Iterable[str], block_rows: int, source: str
+                ) -> Iterator[tuple[int, FloatArray]]:
+    """A CSV log's samples in blocks: (the first row's line, rows (K, 5) in COLUMNS order).
+    InputError for an empty log, a bad header or row, a blank line that a sample follows, or a
+    log with no samples."""
+    it = iter(stream)
+    header = next(it, None)
+    if header is None or not header.strip():
+        raise InputError("log", MISSING, "is empty (needs the header "
+                         f"{','.join(TRAJECTORY_COLUMNS)} and at least one sample)",
+                         source=source, line=1)
+    order = csv_column_order(header, source)
+    no = 1                                            # lines read so far
+    blank: int | None = None
+    samples = 0
+    for block in _blocks(it, block_rows):
+        start = no + 1
+        no += len(block)
+        arr, trailing = _parse_rows(block, start, order, source)
+        if blank is not None and len(arr):
+            raise InputError("row", "", "is blank (samples must follow one another)",
+                             source=source, line=blank)
+        if trailing is not None and blank is None:
+            blank = trailing
+        if len(arr):
+            samples += len(arr)
+            yield start, arr
+    if samples == 0:
+        raise InputError("log", MISSING, "has no samples (only a header)", source=source,
+                         line=no)
+
+
 def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str], *,
                 source: str = "<log>", block_rows: int = BLOCK_ROWS,
                 max_speed: npt.ArrayLike | None = None) -> MonitorResult:
+    """``monitor_rows`` of a CSV log's lines (``stream``): its header, then ``block_rows``
+    lines parsed at a time (constant memory); blank lines may only end the log."""
+    return monitor_rows(s, traj, tol, _csv_blocks(stream, block_rows, source), source=source,
+                        max_speed=max_speed)
+
+
+def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
+                 blocks: Iterable[tuple[int, FloatArray]], *, source: str = "<log>",
+                 max_speed: npt.ArrayLike | None = None) -> MonitorResult:
     """Check the log against the tube of radius ``tol`` around ``traj``, at every instant.
 
     At a sample: inside when each joint is within ``tol`` of the trajectory at its time (at
@@ -314,8 +377,9 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
     robot's speed bound ``max_speed`` (4,), default ``parse_max_speed(None, ...)``, and the
     trajectory's speed on the gap) is within ``tol`` for every joint; a gap not covered, and
     the trajectory's time before the log's first or after its last sample, is unobserved.
-    Times must strictly increase. Reads ``block_rows`` lines at a time (constant memory; the
-    last sample is carried into the next block's first gap); blank lines may only end the log.
+    ``blocks``: the samples as (the first one's line, rows (K, 5) in COLUMNS order), a CSV's
+    (``monitor_log``) or a bag's (``bag_rows``); times must strictly increase. One block at a
+    time (constant memory; the last sample is carried into the next block's first gap).
     """
     res = MonitorResult()
     w_robot = (parse_max_speed(None, s, traj) if max_speed is None else
@@ -335,29 +399,10 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
             res._record(run.closed(), (span0, span1))
         run = _Open(a, b, line, why)
 
-    it = iter(stream)
-    header = next(it, None)
-    if header is None or not header.strip():
-        raise InputError("log", MISSING, "is empty (needs the header "
-                         f"{','.join(TRAJECTORY_COLUMNS)} and at least one sample)",
-                         source=source, line=1)
-    order = csv_column_order(header, source)
-    no = 1                                            # lines read so far
     prev_t = -math.inf
     prev_dev: FloatArray | None = None                # the last sample's deviation per joint
     prev_line = 0
-    blank: int | None = None
-    for block in _blocks(it, block_rows):
-        start = no + 1
-        no += len(block)
-        arr, trailing = _parse_rows(block, start, order, source)
-        if blank is not None and len(arr):
-            raise InputError("row", "", "is blank (samples must follow one another)",
-                             source=source, line=blank)
-        if trailing is not None and blank is None:
-            blank = trailing
-        if not len(arr):
-            continue
+    for start, arr in blocks:
         t = arr[:, 0]
         dtv = np.diff(np.concatenate([[prev_t], t]))
         bad = np.flatnonzero(~(dtv > 0))
@@ -416,8 +461,7 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
                              "links": list(links), "links_text": contact_links_text(links)}
             res.outside += len(out)
     if res.samples == 0:
-        raise InputError("log", MISSING, "has no samples (only a header)", source=source,
-                         line=no)
+        raise InputError("log", MISSING, "has no samples", source=source)
     if prev_t < span1:
         extend(prev_t, span1, prev_line, AFTER_LOG)
     if run is not None:
@@ -465,14 +509,17 @@ def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
 
 def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str | Path, *,
                 json_out: str | Path | None = None, allow_speed: bool = False,
-                stdin: IO[str] | None = None, max_speed: str | None = None) -> int:
+                stdin: IO[str] | None = None, max_speed: str | None = None,
+                bag: BagOptions | None = None) -> int:
     """Monitor a measured log (a file, or ``-`` for standard input) against the certified tube
     at every instant: 0 inside, 1 some sample outside or some time unobserved (or the trajectory
     is not certified clear: no JSON then), 2 bad input (InputError). ``max_speed``: the
-    robot's joint speed bound as ``--max-speed`` gives it (``parse_max_speed``)."""
+    robot's joint speed bound as ``--max-speed`` gives it (``parse_max_speed``). The log (and
+    the trajectory) may be a ROS 2 bag, read with ``bag`` (``runs._rosbag``)."""
     s = _scenario(scenario)
+    opts = _bag_options(bag, traj_path, log)
     t0 = time.perf_counter()
-    traj = load_trajectory(traj_path, s, allow_speed=allow_speed)
+    traj = _trajectory(traj_path, s, allow_speed, opts)
     w_robot = parse_max_speed(max_speed, s, traj)
     cert = certify_trajectory(s, traj)
     t1 = time.perf_counter()
@@ -484,7 +531,11 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
     tol = tolerance_rad(s, cert)
     source = "<stdin>" if str(log) == "-" else str(log)
     # Lines within LIMITS["line"] (docs/model.md §12): /dev/zero ends at its first line's limit.
-    if str(log) == "-":
+    in_bag = str(log) != "-" and is_bag(log)
+    if in_bag:
+        res = monitor_rows(s, traj, tol, bag_rows(log, opts, block_rows=BLOCK_ROWS),
+                           source=source, max_speed=w_robot)
+    elif str(log) == "-":
         res = monitor_log(s, traj, tol, bounded_lines(stdin if stdin is not None else sys.stdin,
                                                       source), source=source, max_speed=w_robot)
     else:
@@ -505,17 +556,21 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
           f"(tolerance {tol:.6f} rad): {res.status}, {res.outside} outside; largest gap "
           f"{res.max_gap_s:.6g} s, {100 * res.covered_fraction:.4g}% of the trajectory's time "
           f"covered ({rate:,.0f} samples/s)")
+    # A bag's sample k stands at line k + 1 (its CSV's line); the user is told its message.
+    def at(line: int) -> str:
+        return f"message {line - 1} on {opts.topic}" if in_bag else f"line {line}"
+
     if res.first is not None:
         f = res.first
         kind = (f"IN CONTACT ({f['links_text']})" if f["in_contact"] else
                 "not in contact, outside the certified tube")
-        print(f"first     outside at t={f['t_s']!r} s (line {f['line']}): {f['joint']} off by "
+        print(f"first     outside at t={f['t_s']!r} s ({at(f['line'])}): {f['joint']} off by "
               f"{f['deviation_rad']:.6g} rad; {kind}", file=sys.stderr)
     if res.unobserved_count:
         u = res.unobserved[0]
-        at = "" if u.line is None else f" (line {u.line})"
+        where = "" if u.line is None else f" ({at(u.line)})"
         print(f"unobserved {res.unobserved_count} interval(s), {res.unobserved_s:.6g} s in all; "
-              f"first from t={u.t_s!r} s for {u.length_s:.6g} s{at}: {u.why} (no sample vouches "
+              f"first from t={u.t_s!r} s for {u.length_s:.6g} s{where}: {u.why} (no sample vouches "
               "for the robot then)", file=sys.stderr)
     doc = monitor_json(s, traj, tol, res, source)
     if json_out is not None:
@@ -617,13 +672,22 @@ def run_simulate(scenario: Scenario | str | Path, traj_path: str | Path, out: st
                  lag: float = 0.0, noise: float = 0.0, seed: int = 0,
                  excursions: Sequence[Excursion] = (), period: float | None = None,
                  samples: int | None = None, tail: float = 0.0,
-                 allow_speed: bool = False) -> int:
-    """Write a simulated measured log of the trajectory to ``out`` (atomically); 0 on success."""
+                 allow_speed: bool = False, bag: BagOptions | None = None) -> int:
+    """Write a simulated measured log of the trajectory to ``out`` (atomically): CSV, or a ROS 2
+    bag (one .mcap file: JointState on ``bag``'s topic and joint names, header.stamp = t) when
+    ``out`` ends in .mcap; 0 on success."""
     s = _scenario(scenario)
-    traj = load_trajectory(traj_path, s, allow_speed=allow_speed)
+    as_bag = Path(out).suffix.lower() == ".mcap"
+    if bag is not None and not as_bag:
+        raise InputError("--topic/--joints", MISSING, f"apply to a bag only: --out {out} does "
+                         "not end in .mcap")
+    traj = _trajectory(traj_path, s, allow_speed, BagOptions() if bag is None else bag)
     t, a = simulate_log(traj, lag=lag, noise=noise, seed=seed, excursions=excursions,
                         period=period, samples=samples, tail=tail)
-    write_bytes_atomic(out, log_csv(t, a))
+    if as_bag:
+        write_bag(out, t, a, BagOptions() if bag is None else bag)
+    else:
+        write_bytes_atomic(out, log_csv(t, a))
     print(f"simulate  {len(t)} samples of {traj_path} (lag {lag:g} s, noise {noise:g} rad, seed "
           f"{seed}, {len(excursions)} excursion(s)) -> {out}")
     return 0
