@@ -1724,7 +1724,8 @@ def safety_obligations() -> list[Obligation]:
             "advances by at most dt / Tf over a window of dt), travel (|goal_q - start_q| <= "
             "omega_q Tf), step1/step2 (a joint's displacement over such an advance is within "
             "omega_q dt, with the travel's sign), n_covers (N dt >= Tf) and at_rest (the "
-            "fraction is 1 from N dt on), used by substitution in motion and rest; the box rule is docs/model.md §4.1's, and the tests check it against "
+            "fraction is 1 from N dt on), used by substitution in motion and rest; the box "
+            "rule is docs/model.md §4.1's, and the tests check it against "
             "spec.left_box on every layer of the bundled scenarios.",
             Z, P, lambda v=v: _principal_query(v)))
     out.append(Obligation(

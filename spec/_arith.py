@@ -1,10 +1,13 @@
 """The few operations a rule needs beyond + - * /, on floats (and numpy arrays) or on Z3 terms.
 
 A rule the proofs read (the principal's box per layer, the subordinate's cell box, the PTP
-motion, impl.lattice_range, the links' reach, the ball-arithmetic gap) is written once with these and runs on either: on floats it performs
-the same IEEE operations as before (Python's ``min``/``max``, ``math.floor``/``ceil``/``hypot``/``sqrt``,
-numpy's ``minimum``/``maximum`` on arrays, python-flint's ``arb.sqrt`` on balls), on Z3 terms it builds the term the proof is about (``If``,
-``ToInt``, ``Sqrt``: a square root the proofs replace by a real s >= 0 with s^2 = its argument). So a changed rule changes the proved statement, and a wrong rule fails a proof.
+motion, impl.lattice_range, the links' reach, the ball-arithmetic gap) is written once with
+these and runs on either: on floats it performs the same IEEE operations as before (Python's
+``min``/``max``, ``math.floor``/``ceil``/``hypot``/``sqrt``, numpy's ``minimum``/``maximum`` on
+arrays, python-flint's ``arb.sqrt`` on balls), on Z3 terms it builds the term the proof is
+about (``If``, ``ToInt``, ``Sqrt``: a square root the proofs replace by a real s >= 0 with
+s^2 = its argument). So a changed rule changes the proved statement, and a wrong rule fails a
+proof.
 """
 
 from __future__ import annotations
