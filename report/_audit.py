@@ -922,7 +922,10 @@ def _monitor_item(mon: Mapping[str, Any]) -> dict[str, Any]:
 
 def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, Any]:
     """Whether the obligation results are of the tree and scenario files this report describes:
-    a results.json from another commit, other scenario bytes, or carried-over rows fail it."""
+    a results.json from another commit, other scenario bytes, or carried-over rows fail it. It
+    holds only with a known commit, the same on both sides: where either side has none (an
+    install without a build record, a results.json that records none) it is None (unknown),
+    saying why."""
     check = "proof results are of this tree"
     if not ob["available"]:
         return _item(check, None, ob["source"])
@@ -930,9 +933,13 @@ def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, 
         if ob["source"].startswith("read from"):
             return _item(check, None, "results.json records no run (commit, scenario hashes)")
         return _item(check, True, "discharged afresh for this report")
-    run, problems = ob["run"], []
+    run, problems, unknown = ob["run"], [], []
     mine, theirs = prov["git"].get("commit"), (run.get("git") or {}).get("commit")
-    if mine != theirs:
+    if mine is None:
+        unknown.append(f"the report's code has no known commit ({prov['git'].get('note')})")
+    if theirs is None:
+        unknown.append("results.json records no commit for the prove run")
+    if mine is not None and theirs is not None and mine != theirs:
         problems.append(f"proved at commit {theirs}, report at {mine}")
     hashes = run.get("scenarios") or {}
     shown = {".".join(i["id"].split(".")[1:-1]) for i in ob["items"]
@@ -946,7 +953,12 @@ def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, 
     if ob["not_run"]:
         problems.append(f"{len(ob['not_run'])} results carried over from an earlier run "
                         f"(e.g. {ob['not_run'][0]})")
-    return _item(check, not problems, "; ".join(problems) or
+    if problems:
+        return _item(check, False, "; ".join(problems + unknown))
+    if unknown:
+        return _item(check, None, "unknown: " + "; ".join(unknown)
+                     + " (scenario hashes match), so the results cannot be tied to this tree")
+    return _item(check, True,
                  f"commit {theirs}, proved {run.get('date_utc')}, scenario hashes match")
 
 
