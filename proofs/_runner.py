@@ -27,7 +27,7 @@ import sympy
 import z3
 
 from .. import __version__
-from ..gitstate import git_state, repo_root
+from ..gitstate import package_state
 from ..scenarios import BUNDLED_DIR
 from ._ledger import ASSUMPTIONS, Assumption
 from ._obl_builtdr import builtdr_obligations
@@ -239,9 +239,10 @@ def compare_ids(ids: Sequence[str], expected: Sequence[str]
 
 
 def run_record(scenarios_dir: str | Path) -> dict[str, Any]:
-    """What these results are of: the date, the checkout's commit and cleanliness, and the
-    sha256 of every scenario file read, so a report can tell results of another tree."""
-    git = git_state(repo_root())
+    """What these results are of: the date, the checkout's commit and cleanliness (an installed
+    wheel's: as recorded when it was built), and the sha256 of every scenario file read, so a
+    report can tell results of another tree."""
+    git = package_state()
     return {"date_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
             "git": {"commit": git["commit"], "clean": git["clean"]},
             "scenarios": {f.name: hashlib.sha256(f.read_bytes()).hexdigest()

@@ -3,9 +3,9 @@
 Content, in order (docs/model.md §8): provenance; the obligations' summary table and each obligation;
 the assumptions ledger; the findings about the paper, drawn; the mutation self-check; per
 scenario the plans of the three variants with contracts, certificate, each found plan's
-tolerance tube (docs/model.md §12) and pictures; one monitored simulated run of the default
-workcell's modified plan, with and without an injected excursion; the seeded comparison
-campaign. Where a part's data is not available in this run, the part says so.
+tolerance tube (docs/model.md §12) and pictures; per audited workcell one monitored simulated
+run of its modified plan, with and without an injected excursion (or why there is none); the
+seeded comparison campaign. Where a part's data is not available in this run, the part says so.
 
 report.json holds every number of the HTML (not the pictures). For the same inputs and version
 it is the same apart from the provenance (date, git state, command line), the times (keys
@@ -47,8 +47,8 @@ from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
            "render_html", "run_audit", "write_report", "default_scenarios_dir",
-           "MONITOR_SCENARIO", "MONITOR_SIMULATION", "MONITOR_EXCURSION", "tube_problems",
-           "monitor_problems", "workcell_summary"]
+           "MONITOR_VARIANT", "MONITOR_SIMULATION", "MONITOR_EXCURSION", "MONITOR_MAX_SAMPLES",
+           "tube_problems", "monitor_problems", "monitor_settings", "workcell_summary"]
 
 #: report.json's format name and version (bump the version when a key changes meaning).
 FORMAT = {"name": "cfmpa-audit-report", "version": 1}
@@ -58,13 +58,16 @@ _OPTIONAL_PLAN_KEYS = ("kernel", "dr_sha256", "tolerance_rad")
 #: The scenarios the findings are shown on (file stems under the scenarios folder).
 FINDING_SCENARIOS = {"naive_hull": "default", "inconsistency": "original-fails",
                      "prop8_literal": "original-fails", "is_path_flaw": "early-arrival"}
-#: The monitored run (docs/model.md §8, §12): the modified plan of this scenario (a file stem
-#: under the scenarios folder), logged by the tracking model of `cfmpa simulate` with these
-#: settings, then again with the excursion added (the README's example).
-MONITOR_SCENARIO = "default"
+#: The monitored runs (docs/model.md §8, §12): each audited workcell's plan of this variant,
+#: logged by the tracking model of `cfmpa simulate` with these settings, then again with the
+#: excursion added (the README's example); ``monitor_settings`` scales them to a narrow tube and
+#: moves the excursion into a short motion.
+MONITOR_VARIANT = Variant.MODIFIED
 MONITOR_SIMULATION = {"lag_s": 0.001, "noise_rad": 0.002, "seed": 0, "period_s": 0.001,
                       "tail_s": 0.2}
 MONITOR_EXCURSION = {"t_s": 0.6, "joint": "right1", "rad": 0.02, "duration_s": 0.05}
+#: The most samples a monitored run's log may have (a narrower tube is not demonstrated).
+MONITOR_MAX_SAMPLES = 1_000_000
 #: cfmpa certify's proved bound on traj.csv agrees with the plan's to within this (m).
 BOUND_AGREEMENT_M = 1e-12
 
@@ -186,7 +189,7 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
         selftest = load_selftest()
     scenario_parts = [_scenario_entry(s, plans, figures, stages) for s in loaded]
     with stages.stage("monitored run"):
-        monitor = _monitor(sdir, loaded, plans, figures)
+        monitor = _monitor(loaded, plans, figures)
     with stages.stage("campaign" + (f" (recorded in {campaign})" if recorded is not None else
                                     f" ({compare_n} workcells)" if compare_n else " (not run)")):
         compare = _compare(compare_n, compare_seed, figures, recorded, campaign)
@@ -667,33 +670,80 @@ def tube_problems(doc: Mapping[str, Any]) -> list[str]:
     return out
 
 
-# --- the monitored run ------------------------------------------------------------------------
+# --- the monitored runs -----------------------------------------------------------------------
 
-def _monitor(sdir: Path, loaded: Sequence[Scenario], plans: _Plans,
+def _monitor(loaded: Sequence[Scenario], plans: _Plans,
              figures: dict[str, F.Figure]) -> dict[str, Any]:
-    """`cfmpa simulate` then `cfmpa monitor` in process, on MONITOR_SCENARIO's modified plan:
-    the tracking log, and the same log with MONITOR_EXCURSION added."""
+    """`cfmpa simulate` then `cfmpa monitor` in process, on each audited workcell's
+    MONITOR_VARIANT plan: the tracking log, and the same log with an excursion added. A
+    workcell without such a plan (no path found, the plan stopped, not certified clear) has
+    an entry saying why instead; ``available`` says whether any workcell was demonstrated."""
+    entries = [_monitor_one(s, plans, figures) for s in loaded]
+    shown = [e for e in entries if e["available"]]
+    note = "" if shown else "not available in this run: " + (
+        "; ".join(f"{e['scenario']}: {e['note']}" for e in entries) or "no workcell audited")
+    return {"available": bool(shown), "note": note, "workcells": entries}
+
+
+def monitor_settings(s: Scenario, traj: Any, tol: float
+                     ) -> tuple[dict[str, Any], dict[str, Any]] | str:
+    """The simulation and the excursion for one workcell's monitored runs, or why there are
+    none. MONITOR_SIMULATION as it is when its worst deviation fits in half the tube, else with
+    lag, noise and period scaled down until it does: a tracking log then deviates by at most
+    noise + lag w_ref at a sample and by (w_robot + w_ref) period / 2 more between samples
+    (docs/model.md §12), so it is inside. MONITOR_EXCURSION moved to mid-motion when the motion
+    ends before it, and at least 2 tol, so every sample in its window is outside by
+    2 tol - tol / 2 > tol."""
+    from ..runs import parse_max_speed
+    from ..spec import ReferenceSpeeds
+
+    w_ref = float(ReferenceSpeeds.of(traj).top().max())
+    w_robot = float(parse_max_speed(None, s, traj).max())
+    sim = dict(MONITOR_SIMULATION)
+    worst = (sim["noise_rad"] + sim["lag_s"] * w_ref + (w_robot + w_ref) * sim["period_s"] / 2)
+    if worst > tol / 2:
+        k = tol / 2 / worst
+        sim.update(lag_s=sim["lag_s"] * k, noise_rad=sim["noise_rad"] * k,
+                   period_s=sim["period_s"] * k)
+    t0, t1 = float(traj.t[0]), float(traj.t[-1])
+    samples = math.floor((t1 + sim["tail_s"] - t0) / sim["period_s"]) + 2
+    if samples > MONITOR_MAX_SAMPLES:
+        return (f"the tube of {tol!r} rad would need a log of {samples} samples "
+                f"(a sample every {sim['period_s']:.3g} s) to stay inside it, more than the "
+                f"report's {MONITOR_MAX_SAMPLES}")
+    exc = dict(MONITOR_EXCURSION)
+    if not t0 <= exc["t_s"] <= t1 - exc["duration_s"]:
+        exc["t_s"] = t0 + max(t1 - t0 - exc["duration_s"], 0.0) / 2
+    exc["rad"] = max(exc["rad"], 2 * tol)
+    return sim, exc
+
+
+def _monitor_one(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) -> dict[str, Any]:
+    """One workcell's monitored runs (``_monitor``), or an entry saying why there are none."""
     from ..runs import Excursion, log_csv, monitor_json, monitor_log, simulate_log
 
-    path = sdir / f"{MONITOR_SCENARIO}.toml"
-    by_path = {Path(x.source).resolve(): x for x in loaded}
-    variant = Variant.MODIFIED
-    try:
-        s = by_path.get(path.resolve()) or load_scenario(path)
-        p = plans.require(s, variant)
-    except CfmpaError as exc:
-        return {"available": False, "note": f"not available in this run: {exc}"}
+    variant = MONITOR_VARIANT
+
+    def none(why: str) -> dict[str, Any]:
+        return {"available": False, "scenario": s.name, "note": why}
+
+    p = plans.get(s, variant)
+    if isinstance(p, Exception):
+        return none(f"the {variant.value} plan stopped ({p}), so there is no plan to monitor")
     if p.search.status is not SearchStatus.FOUND:
-        return {"available": False, "note": f"not available in this run: {s.name} has no "
-                f"{variant.value} path ({p.search.reason})"}
+        return none(f"no {variant.value} path was found ({p.search.reason}), so there is no "
+                    f"plan to monitor")
     traj = executed_trajectory(s, p.grid, p.search.path)
     cert = certify_trajectory(s, traj)          # as `cfmpa monitor` does: its own tube
     if not cert.clear:
-        return {"available": False, "note": f"not available in this run: the {variant.value} "
-                f"plan of {s.name} is not certified clear, so there is no tube to monitor"}
+        return none(f"the {variant.value} plan is not certified clear, so there is no tube to "
+                    f"monitor")
     tol = tolerance_rad(s, cert)
-    sim = MONITOR_SIMULATION
-    exc = Excursion(**MONITOR_EXCURSION)
+    settings = monitor_settings(s, traj, tol)
+    if isinstance(settings, str):
+        return none(settings)
+    sim, exc_doc = settings
+    exc = Excursion(**exc_doc)
     runs, traces = [], []
     for name, excursions in (("tracking", ()), ("excursion", (exc,))):
         t, a = simulate_log(traj, lag=sim["lag_s"], noise=sim["noise_rad"], seed=sim["seed"],
@@ -707,7 +757,7 @@ def _monitor(sdir: Path, loaded: Sequence[Scenario], plans: _Plans,
         if excursions:
             expected = {"status": "outside", "first_outside_t": float(t[window][0]),
                         "first_outside_joint": exc.joint, "outside": int(window.sum())}
-        runs.append({"name": name, "excursion": dict(MONITOR_EXCURSION) if excursions else None,
+        runs.append({"name": name, "excursion": dict(exc_doc) if excursions else None,
                      "expected": expected,
                      "result": {k: mj[k] for k in _MONITOR_KEYS}})
         # The picture's per-sample deviation (the monitor itself keeps only counts).
@@ -718,14 +768,14 @@ def _monitor(sdir: Path, loaded: Sequence[Scenario], plans: _Plans,
         traces.append(F.MonitorTrace(
             f"{name}: {res.status}, {res.outside} of {res.samples} samples outside",
             t, dev, first))
-    fig = F.monitor_figure("fig-monitor", f"{s.name}, {variant.value} plan: monitored simulated "
-                           f"runs", tol, traces)
+    fig = F.monitor_figure(f"fig-monitor-{_anchor(s.name)}", f"{s.name}, {variant.value} plan: "
+                           f"monitored simulated runs", tol, traces)
     figures[fig.id] = fig
     return {"available": True, "note": "", "scenario": s.name, "variant": variant.value,
             "tolerance_rad": tol, "plan_tolerance_rad": tolerance_rad(s, p.certificate),
             "trajectory": {"rows": traj.rows, "t_start_s": float(traj.t[0]),
                            "t_end_s": float(traj.t[-1])},
-            "simulation": dict(sim), "runs": runs,
+            "simulation": sim, "runs": runs,
             "figure": {"id": fig.id, "caption": fig.caption}}
 
 
@@ -834,16 +884,7 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
                        f"{len(tubes)} found plans' tubes (c > 2 L delta; tolerance_rad as "
                        f"plan.json and cfmpa certify give it)"
                        + (f"; {'; '.join(problems)}" if problems else "")))
-    mon = doc["monitor"]
-    if mon["available"]:
-        bad_runs = monitor_problems(mon)
-        items.append(_item("monitored run as expected", not bad_runs,
-                           "; ".join(f"{r['name']}: {r['result']['status']}, "
-                                     f"{r['result']['outside']} of {r['result']['samples']} "
-                                     f"samples outside" for r in mon["runs"])
-                           + (f"; not as expected: {'; '.join(bad_runs)}" if bad_runs else "")))
-    else:
-        items.append(_item("monitored run as expected", None, mon["note"]))
+    items.append(_monitor_item(doc["monitor"]))
     cmp_ = doc["compare"]
     if cmp_["available"]:
         bad = {k: v for k, v in cmp_["checks"].items() if v}
@@ -856,9 +897,35 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     return {"ok": all(i["ok"] is not False for i in items), "items": items}
 
 
+def _monitor_item(mon: Mapping[str, Any]) -> dict[str, Any]:
+    """The row "monitored run as expected": each audited workcell named, with its runs' results
+    or why it has none; ok when every demonstrated workcell's runs are as expected, None when no
+    workcell was demonstrated."""
+    check = "monitored run as expected"
+    entries = mon.get("workcells", [])
+    if not mon["available"]:
+        return _item(check, None, mon["note"])
+    parts, bad = [], False
+    for e in entries:
+        if not e["available"]:
+            parts.append(f"{e['scenario']}: none ({e['note']})")
+            continue
+        problems = monitor_problems(e)
+        bad = bad or bool(problems)
+        parts.append(f"{e['scenario']} ({e['variant']} plan): "
+                     + "; ".join(f"{r['name']}: {r['result']['status']}, "
+                                 f"{r['result']['outside']} of {r['result']['samples']} "
+                                 f"samples outside" for r in e["runs"])
+                     + (f"; not as expected: {'; '.join(problems)}" if problems else ""))
+    return _item(check, not bad, " | ".join(parts))
+
+
 def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, Any]:
     """Whether the obligation results are of the tree and scenario files this report describes:
-    a results.json from another commit, other scenario bytes, or carried-over rows fail it."""
+    a results.json from another commit, other scenario bytes, or carried-over rows fail it. It
+    holds only with a known commit, the same on both sides: where either side has none (an
+    install without a build record, a results.json that records none) it is None (unknown),
+    saying why."""
     check = "proof results are of this tree"
     if not ob["available"]:
         return _item(check, None, ob["source"])
@@ -866,9 +933,13 @@ def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, 
         if ob["source"].startswith("read from"):
             return _item(check, None, "results.json records no run (commit, scenario hashes)")
         return _item(check, True, "discharged afresh for this report")
-    run, problems = ob["run"], []
+    run, problems, unknown = ob["run"], [], []
     mine, theirs = prov["git"].get("commit"), (run.get("git") or {}).get("commit")
-    if mine != theirs:
+    if mine is None:
+        unknown.append(f"the report's code has no known commit ({prov['git'].get('note')})")
+    if theirs is None:
+        unknown.append("results.json records no commit for the prove run")
+    if mine is not None and theirs is not None and mine != theirs:
         problems.append(f"proved at commit {theirs}, report at {mine}")
     hashes = run.get("scenarios") or {}
     shown = {".".join(i["id"].split(".")[1:-1]) for i in ob["items"]
@@ -882,7 +953,12 @@ def _proofs_of_this_tree(ob: dict[str, Any], prov: dict[str, Any]) -> dict[str, 
     if ob["not_run"]:
         problems.append(f"{len(ob['not_run'])} results carried over from an earlier run "
                         f"(e.g. {ob['not_run'][0]})")
-    return _item(check, not problems, "; ".join(problems) or
+    if problems:
+        return _item(check, False, "; ".join(problems + unknown))
+    if unknown:
+        return _item(check, None, "unknown: " + "; ".join(unknown)
+                     + " (scenario hashes match), so the results cannot be tied to this tree")
+    return _item(check, True,
                  f"commit {theirs}, proved {run.get('date_utc')}, scenario hashes match")
 
 

@@ -1,4 +1,5 @@
-"""Provenance of a report: tool and library versions, git commit and cleanliness, command, date."""
+"""Provenance of a report: tool and library versions, git commit and cleanliness (of the checkout,
+or as an installed wheel recorded them when it was built), command, date."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-from ..gitstate import git_state, repo_root
+from ..gitstate import git_state, package_state
 
 __all__ = ["REPORTED_DISTRIBUTIONS", "git_state", "library_versions", "provenance"]
 
@@ -38,12 +39,12 @@ def provenance(argv: Sequence[str] | None, scenarios: Sequence[Any]) -> dict[str
     v = versions()
     v.update(library_versions())
     args = list(sys.argv if argv is None else argv)
-    repo = repo_root()
     return {
         "tool": "cfmpa",
         "version": v["cfmpa"],
         "versions": dict(sorted(v.items())),
-        "git": git_state(repo),
+        # The checkout's state, or an installed wheel's build record (cfmpa.gitstate).
+        "git": package_state(),
         "command_line": shlex.join(args),
         "date_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "scenarios": [{"name": s.name, "path": s.source, "sha256": s.sha256} for s in scenarios],

@@ -1,5 +1,6 @@
 """The package as a user installs it: a wheel in a fresh virtual environment, run outside the
-checkout, plans a bundled scenario and proves every obligation (slow: CI runs it once)."""
+checkout, knows the commit it was built from (setup.py's build record), plans a bundled scenario
+and proves every obligation, recording that commit (slow: CI runs it once)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+#: The checkout's commit and cleanliness as the build saw them (read when the wheel is built).
+BUILT_FROM: dict = {}
 
 pytestmark = pytest.mark.slow
 
@@ -24,6 +27,10 @@ def _run(args: list[str], cwd: Path, timeout: float = 900) -> subprocess.Complet
 @pytest.fixture(scope="module")
 def venv(tmp_path_factory: pytest.TempPathFactory) -> Path:
     where = tmp_path_factory.mktemp("wheel")
+    head = _run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], cwd=where)
+    status = _run(["git", "-C", str(ROOT), "status", "--porcelain"], cwd=where)
+    BUILT_FROM.update(commit=head.stdout.strip() if head.returncode == 0 else None,
+                      clean=not status.stdout.strip() if head.returncode == 0 else None)
     built = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(where),
                   str(ROOT)], cwd=where)
     assert built.returncode == 0, built.stderr
@@ -47,6 +54,27 @@ def test_the_wheel_installs_one_package_with_its_scenarios(venv: Path):
     assert sysconfig.get_paths()["purelib"] != str(site)      # not this interpreter's own
 
 
+def test_the_installed_package_knows_the_commit_it_was_built_from(venv: Path, tmp_path: Path):
+    import zipfile
+
+    (wheel,) = venv.parent.glob("cfmpa-*.whl")
+    with zipfile.ZipFile(wheel) as z:
+        record = json.loads(z.read("cfmpa/_build_info.json"))
+    if BUILT_FROM["commit"] is None:
+        assert record == {"commit": None, "clean": None, "why": "not built from a git checkout"}
+    else:
+        assert record == BUILT_FROM
+    out = _run([str(venv / "bin" / "python"), "-c",
+                "import json; from cfmpa.gitstate import package_state; "
+                "print(json.dumps(package_state()))"], cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    state = json.loads(out.stdout)
+    assert state["available"] is False                     # no work tree: a build record
+    assert (state["commit"], state["clean"]) == (record["commit"], record["clean"])
+    assert (f"built from commit {record['commit']}" if record["commit"] else
+            "not built from a git checkout") in state["note"]
+
+
 def test_plan_and_prove_run_from_an_unrelated_folder(venv: Path, tmp_path: Path):
     cfmpa = str(venv / "bin" / "cfmpa")
     listed = _run([cfmpa, "scenarios"], cwd=tmp_path)
@@ -61,3 +89,5 @@ def test_plan_and_prove_run_from_an_unrelated_folder(venv: Path, tmp_path: Path)
     results = json.loads((tmp_path / "proofs" / "results.json").read_text())
     ids = [r["id"] for r in results["obligations"]]
     assert "Scenario.default.containment" in ids
+    # The prove run records the commit the wheel was built from, not None.
+    assert results["run"]["git"]["commit"] == BUILT_FROM["commit"]

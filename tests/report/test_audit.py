@@ -670,7 +670,7 @@ def _figure_refs(doc):
     refs = [f["figure"] for f in doc["findings"] if f.get("figure")]
     refs += [f for s in doc["scenarios"] for f in s["figures"]]
     refs += [s["tube"]["figure"] for s in doc["scenarios"] if s["tube"]]
-    refs += [doc["monitor"]["figure"]] if doc["monitor"]["available"] else []
+    refs += [m["figure"] for m in doc["monitor"]["workcells"] if m["available"]]
     return refs + [doc["compare"][k] for k in ("figure", "rate_figure") if doc["compare"].get(k)]
 
 

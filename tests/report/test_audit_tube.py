@@ -2,8 +2,8 @@
 
 One report per module, built as test_audit.py builds its own (the coarse copy of the default
 workcell, a small prove run, no campaign): per found plan its tolerance_rad, proved clearance,
-the tube's margin 2 L delta and `cfmpa certify` on its traj.csv; one monitored run of the bundled
-default's modified plan, inside, and with an injected excursion, flagged at its first sample.
+the tube's margin 2 L delta and `cfmpa certify` on its traj.csv; one monitored run of the audited
+workcell's modified plan, inside, and with an injected excursion, flagged at its first sample.
 The numbers are checked against the commands themselves (`cfmpa plan`, `certify`, `simulate`,
 `monitor`, in process), and seeded faults (a corrupted tolerance, a log outside the tube) must
 fail the report's own checks.
@@ -14,7 +14,6 @@ from __future__ import annotations
 import copy
 import io
 import json
-import re
 from pathlib import Path
 
 import jsonschema
@@ -57,11 +56,17 @@ def report(tiny_file, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def default_plan(tmp_path_factory):
-    """`cfmpa plan default --out DIR` (the modified variant): plan.json and traj.csv."""
-    out = tmp_path_factory.mktemp("plan-default")
-    assert cli.main(["plan", "default", "--out", str(out)]) == 0
+def tiny_plan(tiny_file, tmp_path_factory):
+    """`cfmpa plan TINY --out DIR` (the modified variant): plan.json and traj.csv."""
+    out = tmp_path_factory.mktemp("plan-tiny")
+    assert cli.main(["plan", str(tiny_file), "--out", str(out)]) == 0
     return out
+
+
+def _mon(doc):
+    """The monitored runs of the report's one workcell."""
+    (mon,) = doc["monitor"]["workcells"]
+    return mon
 
 
 def _schema_errors(doc):
@@ -120,8 +125,8 @@ def test_each_found_plan_has_its_tube_in_json_and_html(report):
 
 def test_the_monitored_run_comes_between_the_scenarios_and_the_campaign(report):
     html = report["html"]
-    marks = ['id="scenarios"', 'id="tube-tiny-default"', 'id="monitor"', 'id="fig-monitor"',
-             'id="compare"']
+    marks = ['id="scenarios"', 'id="tube-tiny-default"', 'id="monitor"',
+             'id="monitor-tiny-default"', 'id="fig-monitor-tiny-default"', 'id="compare"']
     where = [html.index(m) for m in marks]
     assert where == sorted(where)
     assert '<a href="#monitor">' in html
@@ -151,9 +156,15 @@ def test_tube_numbers_agree_with_cfmpa_plan_and_certify(report, tiny_file, tmp_p
 # --- the monitored run -------------------------------------------------------------------------
 
 def test_monitored_run_is_inside_and_the_excursion_outside_at_its_time(report):
-    mon = report["doc"]["monitor"]
-    assert mon["available"] and (mon["scenario"], mon["variant"]) == ("default", "modified")
-    assert mon["tolerance_rad"] == mon["plan_tolerance_rad"] == 0.005433
+    # The audited workcell's run (tiny-default), not the bundled default's.
+    assert report["doc"]["monitor"]["available"] is True
+    mon = _mon(report["doc"])
+    assert mon["available"] and (mon["scenario"], mon["variant"]) == ("tiny-default", "modified")
+    (s,) = report["doc"]["scenarios"]
+    (planned,) = [v for v in s["variants"] if v["variant"] == "modified"]
+    assert mon["tolerance_rad"] == mon["plan_tolerance_rad"] == planned["tolerance_rad"] > 0
+    # Its tube is wide enough for the settings as they are (monitor_settings: not scaled).
+    assert mon["simulation"] == MONITOR_SIMULATION
     tracking, excursion = mon["runs"]
     t_end = mon["trajectory"]["t_end_s"] + MONITOR_SIMULATION["tail_s"]
     samples = round(t_end / MONITOR_SIMULATION["period_s"]) + 1
@@ -162,19 +173,24 @@ def test_monitored_run_is_inside_and_the_excursion_outside_at_its_time(report):
     assert 0 < res["max_deviation_rad"] <= res["tolerance_rad"] == mon["tolerance_rad"]
     assert res["first_outside_t"] is None and res["contact"] is None
     res = excursion["result"]
-    assert excursion["excursion"] == MONITOR_EXCURSION
+    # The excursion at least 2 tol (here wider than MONITOR_EXCURSION's), at its time.
+    assert excursion["excursion"] == {**MONITOR_EXCURSION, "rad": 2 * mon["tolerance_rad"]}
+    assert excursion["excursion"]["rad"] > MONITOR_EXCURSION["rad"]
     assert res["status"] == "outside" and res["samples"] == samples
     # Flagged at the excursion's first sample (t = 0.6 s is on the 1 ms grid: line 602), on its
     # joint, and only in its window [0.6, 0.65] s: 51 samples.
     assert res["first_outside_t"] == MONITOR_EXCURSION["t_s"] == 0.6
     assert res["first_outside_line"] == 2 + 600
     assert res["first_outside_joint"] == "right1" and res["outside"] == 51
-    assert res["first_outside_deviation_rad"] > MONITOR_EXCURSION["rad"] - res["max_deviation_rad"]
+    assert res["first_outside_deviation_rad"] > (excursion["excursion"]["rad"]
+                                                 - tracking["result"]["max_deviation_rad"])
     assert res["contact"]["in_contact"] is False
     assert excursion["expected"] == {"status": "outside", "first_outside_t": 0.6,
                                      "first_outside_joint": "right1", "outside": 51}
     assert monitor_problems(mon) == []
-    assert _item(report["doc"], "monitored run as expected")["ok"] is True
+    item = _item(report["doc"], "monitored run as expected")
+    assert item["ok"] is True and item["detail"].startswith("tiny-default (modified plan): ")
+    assert "default" not in item["detail"].removeprefix("tiny-default")
     html = report["html"]
     sect = html[html.index('id="monitor"'):html.index('id="compare"')]
     assert "t = 0.6 s (line 602), right1 off by" in sect
@@ -183,20 +199,22 @@ def test_monitored_run_is_inside_and_the_excursion_outside_at_its_time(report):
     assert "badge ok\">inside" in sect and "badge bad\">outside" in sect
 
 
-def test_monitored_run_matches_cfmpa_simulate_and_monitor(report, default_plan, tmp_path):
-    # The same logs written by `cfmpa simulate` and read back by `cfmpa monitor`.
-    sim = MONITOR_SIMULATION
+def test_monitored_run_matches_cfmpa_simulate_and_monitor(report, tiny_file, tiny_plan,
+                                                           tmp_path):
+    # The same logs written by `cfmpa simulate` and read back by `cfmpa monitor`, with the
+    # settings the report records.
+    mon = _mon(report["doc"])
+    sim = mon["simulation"]
     common = ["--lag", str(sim["lag_s"]), "--noise", str(sim["noise_rad"]), "--seed",
               str(sim["seed"]), "--period", str(sim["period_s"]), "--tail", str(sim["tail_s"])]
-    exc = MONITOR_EXCURSION
-    traj = str(default_plan / "traj.csv")
-    excursion = f"{exc['t_s']}:{exc['joint']}:{exc['rad']}:{exc['duration_s']}"
-    for run, extra, code in zip(report["doc"]["monitor"]["runs"],
-                                ([], ["--excursion", excursion]), (0, 1)):
+    exc = mon["runs"][1]["excursion"]
+    traj = str(tiny_plan / "traj.csv")
+    excursion = f"{exc['t_s']!r}:{exc['joint']}:{exc['rad']!r}:{exc['duration_s']!r}"
+    for run, extra, code in zip(mon["runs"], ([], ["--excursion", excursion]), (0, 1)):
         log, out = tmp_path / f"{run['name']}.csv", tmp_path / f"{run['name']}.json"
-        assert cli.main(["simulate", "default", "--traj", traj, "--out", str(log),
+        assert cli.main(["simulate", str(tiny_file), "--traj", traj, "--out", str(log),
                          *common, *extra]) == 0
-        assert cli.main(["monitor", "default", "--traj", traj, "--log", str(log),
+        assert cli.main(["monitor", str(tiny_file), "--traj", traj, "--log", str(log),
                          "--json", str(out)]) == code
         got = json.loads(out.read_text())
         assert {k: got[k] for k in run["result"]} == run["result"], run["name"]
@@ -251,16 +269,23 @@ def test_the_schema_rejects_a_negative_or_missing_tolerance(report):
     del bad["scenarios"][0]["variants"][1]["tolerance_rad"]
     assert any("'tolerance_rad' is a required property" in e for e in _schema_errors(bad))
     bad = copy.deepcopy(doc)
-    bad["monitor"]["runs"][0]["result"]["status"] = "maybe"
+    bad["monitor"]["workcells"][0]["runs"][0]["result"]["status"] = "maybe"
     assert _schema_errors(bad)
 
 
-def test_a_log_outside_the_tube_is_reported_outside(report, monkeypatch):
-    # A tracking model far noisier than the tube: the "tracking" log is outside, and the
-    # report says so instead of calling the run inside.
-    tol = report["doc"]["monitor"]["tolerance_rad"]
-    monkeypatch.setitem(MONITOR_SIMULATION, "noise_rad", 3 * tol)
-    mon = _monitor(ROOT / "scenarios", [], _Plans("off"), {})
+def test_a_log_outside_the_tube_is_reported_outside(report, tiny_file, monkeypatch):
+    # A tracking model far noisier than the tube (the settings' scaling to the tube bypassed):
+    # the "tracking" log is outside, and the report says so instead of calling the run inside.
+    tol = _mon(report["doc"])["tolerance_rad"]
+    settings = _audit.monitor_settings
+
+    def noisy(s, traj, tol):
+        sim, exc = settings(s, traj, tol)
+        return {**sim, "noise_rad": 3 * tol}, exc
+
+    monkeypatch.setattr(_audit, "monitor_settings", noisy)
+    whole = _monitor([load_scenario(tiny_file)], _Plans("off"), {})
+    (mon,) = whole["workcells"]
     tracking = mon["runs"][0]["result"]
     assert tracking["status"] == "outside" and tracking["outside"] > 0
     assert tracking["max_deviation_rad"] > tol
@@ -270,15 +295,16 @@ def test_a_log_outside_the_tube_is_reported_outside(report, monkeypatch):
     # The excursion's log is now first outside before the excursion: also not as expected.
     assert any(p.startswith("excursion: first_outside_t") for p in problems), problems
     doc = copy.deepcopy(report["result"].doc)
-    doc["monitor"] = mon
+    doc["monitor"] = whole
     _reverdict(doc)
     item = _item(doc, "monitored run as expected")
-    assert item["ok"] is False and "tracking: outside" in item["detail"]
+    assert item["ok"] is False and "tiny-default (modified plan): tracking: outside" in (
+        item["detail"])
     assert doc["verdict"]["ok"] is False
 
 
 def test_a_flag_at_the_wrong_instant_is_not_as_expected(report):
-    mon = copy.deepcopy(report["doc"]["monitor"])
+    mon = copy.deepcopy(_mon(report["doc"]))
     res = mon["runs"][1]["result"]
     res["first_outside_t"] += MONITOR_SIMULATION["period_s"]
     res["first_outside_joint"] = "left1"
@@ -287,9 +313,10 @@ def test_a_flag_at_the_wrong_instant_is_not_as_expected(report):
         "excursion: first_outside_joint 'left1', expected 'right1'"]
 
 
-def test_no_default_workcell_leaves_the_monitored_run_not_available(report, tmp_path):
-    mon = _monitor(tmp_path, [], _Plans("off"), {})
-    assert mon["available"] is False and "not available in this run" in mon["note"]
+def test_no_workcell_leaves_the_monitored_run_not_available(report):
+    mon = _monitor([], _Plans("off"), {})
+    assert mon["available"] is False and mon["workcells"] == []
+    assert mon["note"] == "not available in this run: no workcell audited"
     doc = copy.deepcopy(report["result"].doc)
     doc["monitor"] = mon
     _reverdict(doc)
@@ -297,5 +324,4 @@ def test_no_default_workcell_leaves_the_monitored_run_not_available(report, tmp_
     assert doc["verdict"]["ok"] is True
     assert not _schema_errors(json.loads(dumps_json(doc)))
     text = render_html(AuditResult(doc, report["result"].figures))
-    assert re.search(r'<p class="unavailable">not available in this run: [^<]*default\.toml',
-                     text)
+    assert '<p class="unavailable">not available in this run: no workcell audited' in text
