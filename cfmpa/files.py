@@ -5,16 +5,17 @@ variables, and echoed values cut to ECHO_CHARS characters."""
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import math
 import os
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, BinaryIO
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from .errors import MISSING, InputError
 
 __all__ = ["ECHO_CHARS", "LIMITS", "Limit", "bounded_lines", "check_file_size", "dumps_json",
            "echo", "jsonable", "npy_bytes", "read_bounded", "save_npy_atomic",
-           "write_bytes_atomic"]
+           "write_atomic_with", "write_bytes_atomic"]
 
 #: An echoed value (a row, a field) longer than this in a message is cut to it.
 ECHO_CHARS = 80
@@ -175,23 +176,38 @@ def read_bounded(path: str | os.PathLike[str], limit: Limit, source: str | None,
     return data
 
 
-def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
-    """Write ``data`` so that ``path`` is either absent/old or complete, never half-written."""
+def write_atomic_with(path: str | os.PathLike[str], write: Callable[[BinaryIO], object], *,
+                      digest: bool = False) -> tuple[Path, str | None]:
+    """``write(fh)`` into a temporary file beside ``path``, flushed to disk, then renamed over
+    it: ``path`` is either absent/old or complete, never half-written. With ``digest``, also the
+    sha256 of the file as written, read back in chunks (a streamed file is never held whole)."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    sha = None
     try:
         # mkstemp makes the file private (0600); outputs are meant to be shared like any file.
         os.chmod(tmp, 0o644)
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+        with os.fdopen(fd, "w+b") as fh:
+            write(fh)
             fh.flush()
             os.fsync(fh.fileno())
+            if digest:
+                fh.seek(0)
+                h = hashlib.sha256()
+                for chunk in iter(lambda: fh.read(1 << 20), b""):
+                    h.update(chunk)
+                sha = h.hexdigest()
         os.replace(tmp, target)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return target
+    return target, sha
+
+
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` so that ``path`` is either absent/old or complete, never half-written."""
+    return write_atomic_with(path, lambda fh: fh.write(data))[0]
 
 
 def dumps_json(obj: Any) -> str:

@@ -25,13 +25,12 @@ same answer, and ``--repin`` replays every one again.
 from __future__ import annotations
 
 import json
-import os
 import re
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from ..files import write_bytes_atomic
 from ._obligation import Proof
 
 __all__ = ["LOCK", "Mismatch", "check_pins", "cvc5_skips", "load_lock", "pin_entry", "pin_key",
@@ -167,13 +166,5 @@ def repin(proofs: Iterable[Proof], path: str | Path | None = None, *,
                    "2.6 (or of a check's source); per-scenario checks once, as Scenario.*.",
            "obligations": {k: new[k] for k in sorted(new)}}
     text = json.dumps(doc, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
-    fd, tmp = tempfile.mkstemp(prefix=f".{f.name}.", dir=f.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, f)
-        os.chmod(f, 0o644)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_bytes_atomic(f, text.encode("utf-8"))
     return conflicts + lines

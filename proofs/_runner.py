@@ -16,7 +16,6 @@ import fnmatch
 import hashlib
 import json
 import os
-import tempfile
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -27,6 +26,7 @@ import sympy
 import z3
 
 from .. import __version__
+from ..files import write_bytes_atomic
 from ..gitstate import package_state
 from ..scenarios import BUNDLED_DIR
 from ._ledger import ASSUMPTIONS, Assumption
@@ -419,15 +419,8 @@ def _load_previous(path: Path) -> dict[str, dict[str, Any]]:
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    """Write to a temporary name in the same directory, then rename over the target."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """``text`` (UTF-8) written atomically by the one writer, cfmpa.files.write_bytes_atomic."""
+    write_bytes_atomic(path, text.encode("utf-8"))
 
 
 def _counts(proofs: Iterable[Proof]) -> dict[str, int]:

@@ -11,10 +11,8 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import os
 import platform
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -25,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from ..files import dumps_json, npy_bytes, write_bytes_atomic
+from ..files import dumps_json, npy_bytes, write_atomic_with, write_bytes_atomic
 from ..errors import ContractViolation
 from ..impl import build_dr_fast, kernel_name, search_opt_path, search_opt_path_fast
 from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
@@ -403,25 +401,9 @@ def clearance_line(c: Certificate) -> str:
             f"contact, first {c.undecided[0]} s; {sampled}")
 
 
-def _write_streamed(path: str | Path, write: Callable[[Any], None]) -> tuple[Path, str]:
-    """``write(fh)`` into a temporary file beside ``path``, then renamed over it (as
-    cfmpa.files.write_bytes_atomic does for bytes); returns the path and the sha256 of the file
-    written, read back in chunks."""
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        os.chmod(tmp, 0o644)
-        with os.fdopen(fd, "w+b") as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-            fh.seek(0)
-            digest = hashlib.sha256()
-            for chunk in iter(lambda: fh.read(1 << 20), b""):
-                digest.update(chunk)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return target, digest.hexdigest()
+def _write_streamed(path: str | Path, write: Callable[[Any], object]) -> tuple[Path, str]:
+    """``write(fh)`` atomically (``cfmpa.files.write_atomic_with``); the path and the sha256 of
+    the file written, read back in chunks."""
+    target, sha = write_atomic_with(path, write, digest=True)
+    assert sha is not None
+    return target, sha
