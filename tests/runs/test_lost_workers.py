@@ -1,0 +1,284 @@
+"""Campaigns that lose their workers (issue 22.7): `cfmpa compare --scheduler` and `cfmpa check
+--batch --scheduler` whose cluster loses its last worker mid-run warn, stop after
+--worker-timeout seconds with exit 2 and the command that resumes, and keep what was recorded;
+a refused --scheduler writes nothing.
+
+Each test has a cluster of its own (one in-process worker: it starts in a fraction of a second)
+whose worker a thread closes mid-run. Every run is in a thread joined with a time limit, so a
+run that waits forever fails the test instead of hanging the suite; the seeded faults (the
+watchdog disabled, the store opened before the scheduler is reached) show the tests fail
+without the code they test.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+import shlex
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import cfmpa.runs._batch as batch_module
+import cfmpa.runs._campaign as campaign_module
+import cfmpa.runs._engine as engine_module
+from cfmpa.cli import main
+from cfmpa.runs import STORE_NAME
+
+SEED, N, DT = 5, 4, 0.5
+#: Seconds a guarded run may take before the test calls it hung (the runs here take ~5 s).
+LIMIT_S = 15.0
+
+
+@pytest.fixture
+def cluster():
+    """A local cluster of one in-process worker (threads of this process), its own per test."""
+    from dask.distributed import LocalCluster
+
+    c = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, host="127.0.0.1",
+                     dashboard_address=None, silence_logs=logging.CRITICAL)
+    c.extra_workers = []           # workers a test starts (_new_worker), closed with the cluster
+    yield c
+    for w in c.extra_workers:
+        c.sync(functools.partial(w.close, executor_wait=False))
+    c.close()
+
+
+def _close_workers(cluster: Any) -> None:
+    """The cluster's workers closed, not waiting for a task's thread (as a killed worker is)."""
+    for w in list(cluster.workers.values()):
+        cluster.sync(functools.partial(w.close, executor_wait=False))
+
+
+def _new_worker(cluster: Any) -> None:
+    """A fresh in-process worker on ``cluster``'s scheduler (a worker started again)."""
+    from dask.distributed import Worker
+
+    async def start() -> Any:
+        return await Worker(cluster.scheduler_address, nthreads=1)
+
+    cluster.extra_workers.append(cluster.sync(start))
+
+
+class Run:
+    """``main(argv)`` in a thread joined for ``limit`` s: ``hung`` (still running then) and
+    ``code`` (its exit code, or the exception it raised)."""
+
+    def __init__(self, argv: list[str], limit: float = LIMIT_S) -> None:
+        self.got: dict[str, Any] = {}
+        self.thread = threading.Thread(target=self._run, args=(argv,), daemon=True)
+        self.thread.start()
+        self.thread.join(limit)
+        self.hung = self.thread.is_alive()
+
+    def _run(self, argv: list[str]) -> None:
+        try:
+            self.got["code"] = main(argv)
+        except BaseException as exc:      # reported to the test, not lost in the thread
+            self.got["code"] = exc
+
+    @property
+    def code(self) -> Any:
+        return self.got.get("code")
+
+
+def _guarded(argv: list[str], limit: float = LIMIT_S) -> tuple[bool, Any]:
+    """(still running after ``limit`` s, exit code or exception) of ``main(argv)``."""
+    run = Run(argv, limit)
+    return run.hung, run.code
+
+
+def _when(condition: Any, then: Any, limit: float = LIMIT_S) -> threading.Thread:
+    """A thread that calls ``then()`` as soon as ``condition()`` holds (polled every 20 ms)."""
+    def watch() -> None:
+        t0 = time.monotonic()
+        while time.monotonic() - t0 < limit:
+            if condition():
+                then()
+                return
+            time.sleep(0.02)
+
+    t = threading.Thread(target=watch, daemon=True)
+    t.start()
+    return t
+
+
+def _records(out: Path) -> list[bytes]:
+    """The store's record lines (the header left out), [] when there is no store."""
+    path = out / STORE_NAME
+    return path.read_bytes().splitlines()[1:] if path.exists() else []
+
+
+def _lose_the_worker_of_a_campaign(cluster: Any, out: Path, monkeypatch: Any,
+                                   limit: float = LIMIT_S) -> Run:
+    """A campaign of N workcells on ``cluster`` whose worker is closed as soon as the first
+    workcell is recorded (the later ones are slowed by 2 s, so the worker has work then), run
+    for at most ``limit`` s."""
+    monkeypatch.setenv("CFMPA_TEST_FAULTS", '{"1": "sleep:2", "2": "sleep:2", "3": "sleep:2"}')
+    argv = ["compare", "--n", str(N), "--seed", str(SEED), "--dt", str(DT), "--out", str(out),
+            "--scheduler", cluster.scheduler_address, "--worker-timeout", "2"]
+    _when(lambda: len(_records(out)) >= 1, lambda: _close_workers(cluster))
+    run = Run(argv, limit)
+    monkeypatch.delenv("CFMPA_TEST_FAULTS")
+    return run
+
+
+def test_a_campaign_that_loses_its_last_worker_stops_with_the_command_that_resumes(
+        cluster, tmp_path, monkeypatch, capsys):
+    out = tmp_path / "c"
+    t0 = time.monotonic()
+    run = _lose_the_worker_of_a_campaign(cluster, out, monkeypatch)
+    err = capsys.readouterr().err
+    assert not run.hung, "the campaign waited for a worker that never came"
+    assert run.code == 2, err
+    assert time.monotonic() - t0 < LIMIT_S
+    address = cluster.scheduler_address
+    assert f"warning: the Dask cluster {address} has no worker; waiting up to 2 s" in err
+    assert "Traceback" not in err
+    recorded = _records(out)
+    assert 1 <= len(recorded) < N            # what was recorded stays, nothing more
+    assert all(b'"status":"ok"' in line for line in recorded)
+    assert not (out / "compare.json").exists()
+    (last,) = [line for line in err.splitlines() if line.startswith("error: ")]
+    assert "had no worker for 2 s (--worker-timeout)" in last
+    assert f"{len(recorded)} of {N} workcells are recorded in {out / STORE_NAME}" in last
+    command = last.split("resume with: ", 1)[1]
+    assert command == shlex.join(["cfmpa", "compare", "--n", str(N), "--seed", str(SEED),
+                                  "--dt", str(DT), "--out", str(out), "--scheduler", address,
+                                  "--worker-timeout", "2"])
+    # The command resumes: with a worker again, it reuses the records and plans the rest.
+    _new_worker(cluster)
+    hung, code = _guarded(shlex.split(command)[1:])
+    printed = capsys.readouterr().out
+    assert not hung and code == 0, printed
+    assert f"reused {len(recorded)} finished workcell(s), computing {N - len(recorded)}" in printed
+    assert len(_records(out)) == N and (out / "compare.json").exists()
+
+
+def test_seeded_fault_without_the_watchdog_the_campaign_waits_forever(cluster, tmp_path,
+                                                                      monkeypatch, capsys):
+    """The watchdog disabled (it never gives up until the test releases it): the run is still
+    waiting well after --worker-timeout, so the test above would fail."""
+    release = threading.Event()
+
+    class Released(Exception):
+        pass
+
+    def no_watchdog(self: Any, now: float) -> None:
+        if release.is_set():
+            raise Released
+    monkeypatch.setattr(engine_module._WorkerWatch, "idle", no_watchdog)
+    run = _lose_the_worker_of_a_campaign(cluster, tmp_path / "c", monkeypatch, limit=8.0)
+    release.set()
+    run.thread.join(LIMIT_S)                   # the released run closes its client and store
+    assert run.hung, f"the run ended ({run.code!r}) without its watchdog"
+    assert isinstance(run.code, Released)
+    assert "had no worker" not in capsys.readouterr().err
+
+
+def test_a_worker_back_within_the_timeout_lets_the_campaign_go_on(cluster, tmp_path,
+                                                                  monkeypatch, capsys):
+    """Not a false alarm: a cluster without a worker for less than --worker-timeout goes on."""
+    out = tmp_path / "c"
+    monkeypatch.setenv("CFMPA_TEST_FAULTS", '{"1": "sleep:1"}')
+
+    def replace() -> None:
+        _close_workers(cluster)
+        time.sleep(1.0)
+        _new_worker(cluster)
+
+    _when(lambda: len(_records(out)) >= 1, replace)
+    hung, code = _guarded(["compare", "--n", "3", "--seed", str(SEED), "--dt", str(DT),
+                           "--out", str(out), "--scheduler", cluster.scheduler_address,
+                           "--worker-timeout", "8"])
+    err = capsys.readouterr().err
+    assert not hung and code == 0, err
+    assert len(_records(out)) == 3
+
+
+# --- a refused --scheduler writes nothing -------------------------------------------------------
+
+def test_a_scheduler_that_does_not_answer_writes_no_store(tmp_path, capsys):
+    out = tmp_path / "c"
+    hung, code = _guarded(["compare", "--n", "2", "--scheduler", "tcp://127.0.0.1:9",
+                           "--connect-timeout", "1", "--out", str(out)])
+    assert not hung and code == 2
+    assert "error: --scheduler did not answer within 1 s" in capsys.readouterr().err
+    assert not (out / STORE_NAME).exists() and not out.exists()
+
+
+def test_a_scheduler_without_workers_writes_no_store(tmp_path, capsys):
+    from dask.distributed import LocalCluster
+
+    out = tmp_path / "c"
+    with LocalCluster(n_workers=0, processes=False, host="127.0.0.1", dashboard_address=None,
+                      silence_logs=logging.CRITICAL) as empty:
+        hung, code = _guarded(["compare", "--n", "2", "--scheduler", empty.scheduler_address,
+                               "--connect-timeout", "1", "--out", str(out)])
+    assert not hung and code == 2
+    assert "has no worker after 1 s" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_seeded_fault_a_store_opened_before_the_scheduler_is_reached_is_left_behind(
+        tmp_path, monkeypatch, capsys):
+    """The old order (store first, scheduler when the tasks start): the refusal leaves a
+    compare.jsonl, so the tests above would fail."""
+    monkeypatch.setattr(campaign_module, "_connect_first", lambda engine: False)
+    out = tmp_path / "c"
+    hung, code = _guarded(["compare", "--n", "2", "--scheduler", "tcp://127.0.0.1:9",
+                           "--connect-timeout", "1", "--out", str(out)])
+    assert not hung and code == 2
+    capsys.readouterr()
+    assert (out / STORE_NAME).exists()
+
+
+# --- check --batch ------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def plans(tmp_path_factory):
+    """A scenario file and three plan folders of it."""
+    import factory
+    from cfmpa.runs._plan import plan, write_plan
+    from cfmpa.runs._selftest import WORKCELLS
+    from cfmpa.spec import load_scenario
+
+    d = tmp_path_factory.mktemp("batch")
+    (d / "small.toml").write_text(factory.toml(WORKCELLS["small"]))
+    s = load_scenario(d / "small.toml")
+    for name in ("a", "b", "c"):
+        write_plan(plan(s, "modified", contracts="off"), d / "plans" / name)
+    return d
+
+
+def test_a_batch_that_loses_its_last_worker_stops_with_the_command_that_runs_it_again(
+        cluster, plans, tmp_path, monkeypatch, capsys):
+    first_done = threading.Event()
+    real = batch_module.check_plan_folder
+
+    def slow_after_the_first(folder: str, scenario: str | None, rel: str) -> dict[str, Any]:
+        # The worker runs in this process (processes=False): the patched task is the one run.
+        if rel != "a":
+            time.sleep(2)
+        row = real(folder, scenario, rel)
+        first_done.set()
+        return row
+
+    monkeypatch.setattr(batch_module, "check_plan_folder", slow_after_the_first)
+    summary = tmp_path / "summary.json"
+    argv = ["check", "--batch", str(plans / "plans"), str(plans / "small.toml"),
+            "--json", str(summary), "--scheduler", cluster.scheduler_address,
+            "--worker-timeout", "2"]
+    _when(first_done.is_set, lambda: _close_workers(cluster))
+    hung, code = _guarded(argv)
+    err = capsys.readouterr().err
+    assert not hung, "the batch waited for a worker that never came"
+    assert code == 2, err
+    assert f"warning: the Dask cluster {cluster.scheduler_address} has no worker" in err
+    (last,) = [line for line in err.splitlines() if line.startswith("error: ")]
+    assert "had no worker for 2 s" in last and "no summary is written" in last
+    assert last.split("run it again with: ", 1)[1] == shlex.join(["cfmpa", *argv])
+    assert not summary.exists()
