@@ -38,8 +38,9 @@ def cluster():
     """A local cluster of one in-process worker (threads of this process), its own per test."""
     from dask.distributed import LocalCluster
 
-    c = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, host="127.0.0.1",
-                     dashboard_address=None, silence_logs=logging.CRITICAL)
+    c = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp",
+                     host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                     silence_logs=logging.CRITICAL)
     c.extra_workers = []           # workers a test starts (_new_worker), closed with the cluster
     yield c
     for w in c.extra_workers:
@@ -214,8 +215,8 @@ def test_a_scheduler_without_workers_writes_no_store(tmp_path, capsys):
     from dask.distributed import LocalCluster
 
     out = tmp_path / "c"
-    with LocalCluster(n_workers=0, processes=False, host="127.0.0.1", dashboard_address=None,
-                      silence_logs=logging.CRITICAL) as empty:
+    with LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
+                      dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL) as empty:
         hung, code = _guarded(["compare", "--n", "2", "--scheduler", empty.scheduler_address,
                                "--connect-timeout", "1", "--out", str(out)])
     assert not hung and code == 2
@@ -254,31 +255,39 @@ def plans(tmp_path_factory):
     return d
 
 
+#: Set when the first plan's check is done (the batch's task below runs in this process).
+_FIRST_CHECKED = threading.Event()
+
+
+def _slow_after_the_first(folder: str, scenario: str | None, rel: str) -> dict[str, Any]:
+    """check_plan_folder, 2 s slower for every plan but "a" (module level: tasks are pickled,
+    by reference; the in-process worker runs this very function)."""
+    if rel != "a":
+        time.sleep(2)
+    row = _REAL_CHECK(folder, scenario, rel)
+    _FIRST_CHECKED.set()
+    return row
+
+
+_REAL_CHECK = batch_module.check_plan_folder
+
+
 def test_a_batch_that_loses_its_last_worker_stops_with_the_command_that_runs_it_again(
         cluster, plans, tmp_path, monkeypatch, capsys):
-    first_done = threading.Event()
-    real = batch_module.check_plan_folder
-
-    def slow_after_the_first(folder: str, scenario: str | None, rel: str) -> dict[str, Any]:
-        # The worker runs in this process (processes=False): the patched task is the one run.
-        if rel != "a":
-            time.sleep(2)
-        row = real(folder, scenario, rel)
-        first_done.set()
-        return row
-
-    monkeypatch.setattr(batch_module, "check_plan_folder", slow_after_the_first)
+    _FIRST_CHECKED.clear()
+    monkeypatch.setattr(batch_module, "check_plan_folder", _slow_after_the_first)
     summary = tmp_path / "summary.json"
     argv = ["check", "--batch", str(plans / "plans"), str(plans / "small.toml"),
             "--json", str(summary), "--scheduler", cluster.scheduler_address,
             "--worker-timeout", "2"]
-    _when(first_done.is_set, lambda: _close_workers(cluster))
+    _when(_FIRST_CHECKED.is_set, lambda: _close_workers(cluster))
     hung, code = _guarded(argv)
     err = capsys.readouterr().err
     assert not hung, "the batch waited for a worker that never came"
     assert code == 2, err
     assert f"warning: the Dask cluster {cluster.scheduler_address} has no worker" in err
     (last,) = [line for line in err.splitlines() if line.startswith("error: ")]
-    assert "had no worker for 2 s" in last and "no summary is written" in last
+    assert "had no worker for 2 s" in last and "1 of 3 plans were checked" in last
+    assert "no summary is written" in last
     assert last.split("run it again with: ", 1)[1] == shlex.join(["cfmpa", *argv])
     assert not summary.exists()
