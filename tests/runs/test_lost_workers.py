@@ -291,3 +291,51 @@ def test_a_batch_that_loses_its_last_worker_stops_with_the_command_that_runs_it_
     assert "no summary is written" in last
     assert last.split("run it again with: ", 1)[1] == shlex.join(["cfmpa", *argv])
     assert not summary.exists()
+
+
+# --- --worker-timeout's budget ------------------------------------------------------------------
+
+@pytest.mark.parametrize(("value", "said"), [
+    ("1e9", "--worker-timeout must be at most 86400 (a day)"),
+    ("inf", "--worker-timeout must be a finite number"),
+    ("nan", "--worker-timeout must be a finite number"),
+    ("-1", "--worker-timeout must be at least 0"),
+    ("0", "--worker-timeout must be a number of seconds > 0"),
+])
+def test_a_worker_timeout_out_of_its_budget_is_exit_2_before_anything_is_written(
+        value, said, plans, tmp_path, capsys):
+    out = tmp_path / "c"
+    assert main(["compare", "--n", "1", "--workers", "0", "--out", str(out),
+                 "--worker-timeout", value]) == 2
+    assert said in capsys.readouterr().err
+    assert not out.exists()
+    summary = tmp_path / "summary.json"
+    assert main(["check", "--batch", str(plans / "plans"), "--workers", "0",
+                 "--json", str(summary), "--worker-timeout", value]) == 2
+    assert said in capsys.readouterr().err
+    assert not summary.exists()
+
+
+# --- the watchdog alone (a fake cluster, a fake clock) -----------------------------------------
+
+def test_the_watchdog_stops_only_after_the_timeout_without_a_worker(capsys):
+    from cfmpa.errors import WorkersLost, exit_code
+
+    counts = iter([1, 0, 0, 2, None, 0, 0, 0])      # None: the scheduler did not say
+    watch = engine_module._WorkerWatch(lambda: next(counts), 2.0, "tcp://x:1")
+    assert watch.poll_s == 0.5
+    watch.idle(0.0)                                  # 1 worker
+    watch.idle(0.2)                                  # too soon to ask again: nothing asked
+    watch.idle(0.5)                                  # 0: the warning, the clock starts
+    assert "has no worker; waiting up to 2 s" in capsys.readouterr().err
+    watch.idle(2.0)                                  # 0 for 1.5 s: not yet
+    watch.idle(2.5)                                  # 2 workers: back, the clock reset
+    assert "has a worker again" in capsys.readouterr().err
+    watch.idle(3.0)                                  # unknown: as none, the clock starts
+    watch.progress(3.2)                              # a task finished: reset, nothing asked
+    watch.idle(3.7)                                  # 0: the clock starts again at 3.7
+    watch.idle(5.6)                                  # 0 for 1.9 s: not yet
+    watch.idle(5.7)                                  # too soon to ask again
+    with pytest.raises(WorkersLost, match="had no worker for 2 s") as lost:
+        watch.idle(6.1)                              # 0 for 2.4 s
+    assert exit_code(lost.value) == 2
