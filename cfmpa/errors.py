@@ -90,8 +90,9 @@ class CertificateViolation(ContractViolation):
 
 class WorkersLost(CfmpaError):
     """A run on a Dask cluster stopped because the cluster had no worker for ``--worker-timeout``
-    seconds: nothing was concluded about the work, so exit 2 as for input the system refused.
-    The message says what was recorded and the command that resumes."""
+    seconds, or the client lost its scheduler: nothing was concluded about the work left, so
+    exit 2 as for input the system refused. The message says what was recorded and the command
+    that resumes."""
 
     exit_code = 2
 

@@ -20,7 +20,9 @@ A cluster that loses all its workers would leave the tasks waiting forever (the 
 them for a worker that may come back). So while no task completes the client asks the scheduler
 for its workers about once a second: when it has none it warns on stderr, and when it has had
 none for ``worker_timeout`` seconds the run stops with ``WorkersLost`` (exit 2), its pending
-tasks cancelled; whatever the callback recorded stays recorded (docs/model.md §13).
+tasks cancelled; whatever the callback recorded stays recorded (docs/model.md §13). A client
+that loses its scheduler (dask then cancels every future) stops with ``WorkersLost`` too,
+rather than recording each pending task as lost.
 """
 
 from __future__ import annotations
@@ -403,6 +405,12 @@ class Engine:
                     try:
                         result = fut.result()
                     except Exception as exc:   # the task's worker died too often, or it raised
+                        if _scheduler_lost(client, fut, exc):
+                            # Not the task's failure: recorded as one, it would be an error
+                            # record of a workcell that nothing is wrong with.
+                            raise WorkersLost(f"the client lost the connection to the Dask "
+                                              f"scheduler {watch.where}; the run stopped"
+                                              ) from None
                         result = TaskLost(error_message(exc))
                     on_done(i, result)
                     fut.release()
@@ -413,6 +421,14 @@ class Engine:
 
 #: Seconds between looks at the finished tasks while none has finished.
 _IDLE_S = 0.05
+
+
+def _scheduler_lost(client: Any, fut: Any, exc: Exception) -> bool:
+    """Whether ``fut`` failed because the client lost its scheduler: dask then cancels every
+    future (reason ``scheduler-connection-lost``) while it reconnects."""
+    return bool(fut.cancelled()) and (
+        getattr(exc, "reason", None) == "scheduler-connection-lost"
+        or getattr(client, "status", "running") != "running")
 
 
 def _live_workers(client: Any) -> int | None:

@@ -45,7 +45,13 @@ def cluster():
     yield c
     for w in c.extra_workers:
         c.sync(functools.partial(w.close, executor_wait=False))
-    c.close()
+    import dask
+
+    _close_workers(c)
+    # A closed scheduler (the tests that lose it): the cluster's close would try to reach it
+    # for dask's 30 s connect timeout.
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        c.close()
 
 
 def _close_workers(cluster: Any) -> None:
@@ -198,6 +204,45 @@ def test_a_worker_back_within_the_timeout_lets_the_campaign_go_on(cluster, tmp_p
     err = capsys.readouterr().err
     assert not hung and code == 0, err
     assert len(_records(out)) == 3
+
+
+def _lose_the_scheduler_of_a_campaign(cluster: Any, out: Path, monkeypatch: Any) -> Run:
+    """As ``_lose_the_worker_of_a_campaign``, the scheduler closed instead of the worker."""
+    monkeypatch.setenv("CFMPA_TEST_FAULTS", '{"1": "sleep:2", "2": "sleep:2", "3": "sleep:2"}')
+    argv = ["compare", "--n", str(N), "--seed", str(SEED), "--dt", str(DT), "--out", str(out),
+            "--scheduler", cluster.scheduler_address, "--worker-timeout", "2"]
+    _when(lambda: len(_records(out)) >= 1, lambda: cluster.sync(cluster.scheduler.close))
+    run = Run(argv)
+    monkeypatch.delenv("CFMPA_TEST_FAULTS")
+    return run
+
+
+def test_a_campaign_that_loses_its_scheduler_stops_with_the_command_that_resumes(
+        cluster, tmp_path, monkeypatch, capsys):
+    """dask cancels every future when the client loses its scheduler: the run stops (exit 2)
+    with the resume command, and no workcell is recorded as an error for it."""
+    out = tmp_path / "c"
+    run = _lose_the_scheduler_of_a_campaign(cluster, out, monkeypatch)
+    err = capsys.readouterr().err
+    assert not run.hung and run.code == 2, err
+    (last,) = [line for line in err.splitlines() if line.startswith("error: ")]
+    assert f"lost the connection to the Dask scheduler {cluster.scheduler_address}" in last
+    assert f"resume with: cfmpa compare --n {N}" in last
+    recorded = _records(out)
+    assert 1 <= len(recorded) < N and all(b'"status":"ok"' in line for line in recorded)
+    assert not (out / "compare.json").exists()
+
+
+def test_seeded_fault_a_lost_scheduler_taken_for_lost_tasks_records_errors(
+        cluster, tmp_path, monkeypatch, capsys):
+    """Without the check, every pending workcell is recorded as an error and compare.json is
+    written with them (exit 1): the test above would fail."""
+    monkeypatch.setattr(engine_module, "_scheduler_lost", lambda client, fut, exc: False)
+    out = tmp_path / "c"
+    run = _lose_the_scheduler_of_a_campaign(cluster, out, monkeypatch)
+    capsys.readouterr()
+    assert not run.hung and run.code == 1
+    assert any(b'"status":"error"' in line for line in _records(out))
 
 
 # --- a refused --scheduler writes nothing -------------------------------------------------------
