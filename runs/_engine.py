@@ -403,7 +403,10 @@ class Engine:
                 for fut in batch:
                     i = futures[fut]
                     try:
-                        result = fut.result()
+                        result = _fetched(fut, watch.poll_s)
+                        if result is _LOST_AGAIN:
+                            done.add(fut)      # its worker left with the result: computed again
+                            continue
                     except Exception as exc:   # the task's worker died too often, or it raised
                         if _scheduler_lost(client, fut, exc):
                             # Not the task's failure: recorded as one, it would be an error
@@ -421,6 +424,20 @@ class Engine:
 
 #: Seconds between looks at the finished tasks while none has finished.
 _IDLE_S = 0.05
+#: What ``_fetched`` returns for a task whose result was lost before it was fetched.
+_LOST_AGAIN = object()
+
+
+def _fetched(fut: Any, timeout: float) -> Any:
+    """``fut``'s result, or _LOST_AGAIN if the result left with its worker before it reached
+    the client (the scheduler then computes the task again; a plain ``fut.result()`` would wait
+    for that, past the watchdog, forever if no worker comes)."""
+    while True:
+        try:
+            return fut.result(timeout=timeout)
+        except TimeoutError:
+            if fut.status != "finished":
+                return _LOST_AGAIN
 
 
 def _scheduler_lost(client: Any, fut: Any, exc: Exception) -> bool:
