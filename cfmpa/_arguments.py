@@ -140,6 +140,7 @@ def budgets() -> dict[str, Budget]:
         "prove_workers": Budget(None, workers, f"four processes per CPU; this machine has "
                                                f"{cpus()}"),
         "connect_timeout": Budget(0, 86_400, "a day"),
+        "worker_timeout": Budget(0, 86_400, "a day"),
         "workcells": Budget(None, MAX_WORKCELLS, "the campaign's budget"),
         "dt": Budget(None, MAX_DT, "the coarsest campaign time step"),
         "lag": Budget(0, 3600, "an hour"),
@@ -206,7 +207,8 @@ def check_output(option: str, value: Any, kind: str) -> None:
 
 
 def engine_arguments(p: argparse.ArgumentParser) -> None:
-    """--workers, --scheduler, --connect-timeout (cfmpa compare, cfmpa check --batch)."""
+    """--workers, --scheduler, --connect-timeout, --worker-timeout (cfmpa compare, cfmpa check
+    --batch)."""
     b = budgets()
     number(p, "--workers", b["workers"], type=positive, default=None, metavar="K",
            help="worker processes of a local Dask cluster (default: one per CPU; 0: run in "
@@ -216,6 +218,9 @@ def engine_arguments(p: argparse.ArgumentParser) -> None:
                         "scheduler`; its workers need cfmpa installed)")
     number(p, "--connect-timeout", b["connect_timeout"], type=float, default=10.0, metavar="S",
            help="seconds to wait for the scheduler and its first worker (default 10)")
+    number(p, "--worker-timeout", b["worker_timeout"], type=float, default=60.0, metavar="S",
+           help="seconds a run waits while the cluster has no worker, then stops with exit 2 "
+                "and the command that resumes (default 60)")
 
 
 def trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",

@@ -62,7 +62,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         workers, scheduler = _engine(args)
         return run_batch(args.batch, None if args.scenario is None else resolve(args.scenario),
                          json_out=args.json, workers=workers, scheduler=scheduler,
-                         connect_timeout=args.connect_timeout)
+                         connect_timeout=args.connect_timeout,
+                         worker_timeout=args.worker_timeout)
     from .runs import run_check
 
     for flag, value in (("SCENARIO", args.scenario), ("--dr", args.dr), ("--plan", args.plan)):
@@ -133,7 +134,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
     workers, scheduler = _engine(args)
     return run_compare(n=args.n, seed=args.seed, out=args.out, dt=args.dt, workers=workers,
-                       scheduler=scheduler, connect_timeout=args.connect_timeout)
+                       scheduler=scheduler, connect_timeout=args.connect_timeout,
+                       worker_timeout=args.worker_timeout)
 
 
 def cmd_certify(args: argparse.Namespace) -> int:

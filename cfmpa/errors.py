@@ -12,6 +12,7 @@ __all__ = [
     "MISSING",
     "ContractViolation",
     "CertificateViolation",
+    "WorkersLost",
     "INTERRUPTED",
     "USAGE",
     "exit_code",
@@ -85,6 +86,15 @@ class ContractViolation(CfmpaError):
 
 class CertificateViolation(ContractViolation):
     """The continuous-time certificate found the arms' link rectangles in contact."""
+
+
+class WorkersLost(CfmpaError):
+    """A run on a Dask cluster stopped because the cluster had no worker for ``--worker-timeout``
+    seconds, or the client lost its scheduler: nothing was concluded about the work left, so
+    exit 2 as for input the system refused. The message says what was recorded and the command
+    that resumes."""
+
+    exit_code = 2
 
 
 #: Exit code of bad input or usage (argparse's own), and of an interrupted run (128 + SIGINT).

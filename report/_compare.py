@@ -17,7 +17,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..files import dumps_json, write_bytes_atomic
-from ..runs import COMPARE_DT, CONNECT_TIMEOUT_S, Campaign, run_campaign
+from ..runs import COMPARE_DT, CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Campaign, run_campaign
 from ..spec import SearchStatus, Variant
 from ._stats import mcnemar_exact_p, wilson_interval
 
@@ -144,7 +144,8 @@ def format_campaign(doc: dict[str, Any]) -> str:
 
 def run_compare(n: int = 100, seed: int = 0, out: str | None = None, *, dt: float = COMPARE_DT,
                 workers: int = 0, scheduler: str | None = None,
-                connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool | None = None,
+                connect_timeout: float = CONNECT_TIMEOUT_S,
+                worker_timeout: float = WORKER_TIMEOUT_S, progress: bool | None = None,
                 stdout: TextIO | None = None, _faults: Mapping[int, str] | None = None,
                 _after_record: Callable[[int], None] | None = None) -> int:
     """Run a campaign (see ``run_campaign``), print its table on ``stdout`` (default
@@ -155,7 +156,8 @@ def run_compare(n: int = 100, seed: int = 0, out: str | None = None, *, dt: floa
     """
     so = sys.stdout if stdout is None else stdout
     c = run_campaign(n, seed, dt, workers=workers, scheduler=scheduler, out=out,
-                     connect_timeout=connect_timeout, progress=progress, stream=so,
+                     connect_timeout=connect_timeout, worker_timeout=worker_timeout,
+                     progress=progress, stream=so,
                      _faults=_faults, _after_record=_after_record)
     doc = campaign_json(c)
     print(format_campaign(doc), file=so)

@@ -34,8 +34,8 @@ from ._campaign import (COMPARE_DT, CONTACT_NOTE, KERNEL, MAX_DRAWS, MAX_DT, MAX
 from ._store import Store, open_store, read_store
 from ._batch import BATCH_JSON, batch_table, check_plan_folder, find_plan_folders, run_batch
 from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
-from ._engine import (CONNECT_TIMEOUT_S, RETRIES, Engine, ProgressBar, TaskLost,
-                      check_scheduler_address, error_message)
+from ._engine import (CONNECT_TIMEOUT_S, RETRIES, WORKER_TIMEOUT_S, Engine, ProgressBar,
+                      TaskLost, check_scheduler_address, error_message)
 from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json,
                          optimality_failures, violation_json)
 from ._plan import (CERTIFICATE, PlanResult, clearance_line, plan, plan_json, run_dr, run_plan,
@@ -64,7 +64,7 @@ __all__ = [
     # another planner's files
     "CheckReport", "check_outputs", "read_dr", "read_plan", "run_check",
     "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
-    "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost",
+    "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost", "WORKER_TIMEOUT_S",
     "check_scheduler_address", "error_message",
     # the campaign of `cfmpa compare` and its resumable store (docs/model.md §13)
     "COMPARE_DT", "CONTACT_NOTE", "Campaign", "CaseError", "CaseResult", "KERNEL", "MAX_DRAWS",

@@ -10,22 +10,26 @@ atomically, with one row per plan sorted by folder: ``ok``, ``FAIL`` (a check fa
 failed checks are listed) or ``error`` (the plan could not be checked: a file missing or
 unreadable, no scenario of that name; the message says which). Exit 0 when every plan passes, 1
 when any fails or errs; 2 when the batch itself is bad input (DIR missing or without a plan,
-SCENARIO unreadable) -- before any task runs.
+SCENARIO unreadable) -- before any task runs. A cluster without a worker for --worker-timeout
+seconds stops the batch with exit 2 (``WorkersLost``) and the command that runs it again; the
+summary is written only when every plan has its row, so a stopped batch writes nothing.
 """
 
 from __future__ import annotations
 
+import shlex
 import sys
 import time
 from pathlib import Path
 from typing import Any, TextIO
 
-from ..errors import InputError
+from ..errors import InputError, WorkersLost
 from ..files import dumps_json, write_bytes_atomic
 from ..scenarios import BUNDLED_DIR, bundled_names
 from ..spec import load_scenario
 from ._check import _file_sha256, check_outputs, read_dr, read_plan
-from ._engine import CONNECT_TIMEOUT_S, Engine, ProgressBar, TaskLost, error_message
+from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
+                      error_message)
 
 __all__ = ["BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch"]
 
@@ -78,14 +82,17 @@ def _bundled(plan_path: Path) -> Path:
 def run_batch(root: str | Path, scenario: str | Path | None = None, *,
               json_out: str | Path | None = None, workers: int = 0,
               scheduler: str | None = None, connect_timeout: float = CONNECT_TIMEOUT_S,
-              progress: bool | None = None, stream: TextIO | None = None) -> int:
+              worker_timeout: float = WORKER_TIMEOUT_S, progress: bool | None = None,
+              stream: TextIO | None = None) -> int:
     """Check every plan folder under ``root``; print the table, write the JSON summary; return
-    the exit code (0 all pass, 1 any fails or errs; InputError for a bad batch)."""
+    the exit code (0 all pass, 1 any fails or errs; InputError for a bad batch; WorkersLost,
+    naming the command to run again, when the cluster had no worker for ``worker_timeout`` s)."""
     out = sys.stdout if stream is None else stream
     top = Path(root)
     if not top.is_dir():
         raise InputError("--batch", str(root), "must be a folder of plan folders")
-    engine = Engine(workers, scheduler, connect_timeout=connect_timeout, stream=out)
+    engine = Engine(workers, scheduler, connect_timeout=connect_timeout,
+                    worker_timeout=worker_timeout, stream=out)
     scen = None
     if scenario is not None:
         scen = str(Path(scenario).resolve())
@@ -105,9 +112,19 @@ def run_batch(root: str | Path, scenario: str | Path | None = None, *,
 
     t0 = time.perf_counter()
     bar = ProgressBar.for_terminal("check", len(folders), progress=progress)
-    with engine:
-        engine.run(check_plan_folder, [(str(f.resolve()), scen, r) for f, r in zip(folders, rels)],
-                   on_done, name="check-plan", progress=bar)
+    try:
+        with engine:
+            engine.run(check_plan_folder,
+                       [(str(f.resolve()), scen, r) for f, r in zip(folders, rels)],
+                       on_done, name="check-plan", progress=bar)
+    except WorkersLost as exc:
+        checked = sum(r is not None for r in rows)
+        command = ["cfmpa", "check", "--batch", str(root), *([scen] if scen is not None else []),
+                   *(["--json", str(json_out)] if json_out is not None else []),
+                   *engine.options()]
+        raise WorkersLost(f"{exc}. {checked} of {len(rows)} plans were checked; no summary is "
+                          f"written (a batch keeps no partial results); run it again with: "
+                          f"{shlex.join(command)}") from None
     done = [r for r in rows if r is not None]
     assert len(done) == len(rows), "the engine reports every task"
     doc = batch_json(top, scen, done, {"run": time.perf_counter() - t0, **engine.timings_s})

@@ -20,14 +20,20 @@ is appended to DIR/compare.jsonl (``_store``: a header with n, seed and dt, then
 workcell, fsynced) as its task completes, and a rerun of the same settings reuses every
 recorded workcell and computes only the rest (and those whose task raised). compare.json is
 built from the records alone, sorted by index, so it is byte-identical whatever the workers,
-the order, the retries or the interruptions, apart from its ``timings_s`` key.
+the order, the retries or the interruptions, apart from its ``timings_s`` key. On a running
+cluster the scheduler is reached (and has a worker) before the store is opened, so a refused
+``--scheduler`` leaves no compare.jsonl; a cluster left without workers for ``worker_timeout``
+seconds stops the run (``WorkersLost``, exit 2) with the command that resumes it, the records
+made so far kept.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
+import shlex
 import sys
 import time
 from collections.abc import Callable, Mapping
@@ -37,10 +43,11 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..errors import CfmpaError, InputError
+from ..errors import CfmpaError, InputError, WorkersLost
 from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
                     parse_scenario, polygon_distance)
-from ._engine import CONNECT_TIMEOUT_S, Engine, ProgressBar, TaskLost, error_message
+from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
+                      error_message)
 from ._store import Store, open_store, read_store
 
 __all__ = ["COMPARE_DT", "CONTACT_NOTE", "KERNEL", "MAX_DRAWS", "MAX_DT", "MAX_WORKCELLS",
@@ -218,7 +225,8 @@ def _inject(fault: str, index: int) -> None:
 
 def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers: int = 0,
                  scheduler: str | None = None, out: str | os.PathLike[str] | None = None,
-                 connect_timeout: float = CONNECT_TIMEOUT_S, progress: bool | None = None,
+                 connect_timeout: float = CONNECT_TIMEOUT_S,
+                 worker_timeout: float = WORKER_TIMEOUT_S, progress: bool | None = None,
                  stream: TextIO | None = None, _faults: Mapping[int, str] | None = None,
                  _after_record: Callable[[int], None] | None = None) -> Campaign:
     """Plan ``n`` random workcells under original, modified and tight.
@@ -227,8 +235,11 @@ def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers
     ``scheduler`` on a running cluster. With ``out``, every finished workcell is appended to
     ``out``/compare.jsonl and the workcells already recorded there (by a run with the same n,
     seed and dt) are reused, not planned again; records of a workcell whose task raised are
-    planned again. ``stream`` gets the engine's and the store's messages (None: silent); the
-    progress bar is on stderr when it is a terminal (``progress`` forces it on or off).
+    planned again. With ``scheduler``, the scheduler is reached before the store is opened (a
+    refused one: InputError, nothing written); a cluster without a worker for
+    ``worker_timeout`` seconds raises WorkersLost naming the command that resumes. ``stream``
+    gets the engine's and the store's messages (None: silent); the progress bar is on stderr
+    when it is a terminal (``progress`` forces it on or off).
     ``_faults`` (index -> fault of ``workcell_task``; by default the JSON object in the
     environment variable CFMPA_TEST_FAULTS, for tests of the command in a fresh process) and
     ``_after_record`` (called with the number of records written so far in this run) are for
@@ -236,15 +247,21 @@ def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers
     """
     n, seed, dt = _check_settings(n, seed, dt)
     t_start = time.perf_counter()
-    engine = Engine(workers, scheduler, connect_timeout=connect_timeout, stream=stream,
-                    warm=_warm)
+    engine = Engine(workers, scheduler, connect_timeout=connect_timeout,
+                    worker_timeout=worker_timeout, stream=stream, warm=_warm)
     _workcell(seed, 0, dt)           # a dt whose grids the budget refuses: before any work
     store: Store | None = None
     records: dict[int, dict[str, Any]] = {}
-    if out is not None:
-        store = open_store(Path(out) / STORE_NAME, STORE_FORMAT, STORE_VERSION,
-                           {"n": n, "seed": seed, "dt": dt})
+    # A running cluster is reached first: an address that refuses, a scheduler without
+    # workers, workers without cfmpa are exit 2 before the store exists. (A local cluster
+    # starts only when there is work: a finished campaign's rerun starts none.)
+    early = _connect_first(engine)
+    if early:
+        engine.__enter__()
     try:
+        if out is not None:
+            store = open_store(Path(out) / STORE_NAME, STORE_FORMAT, STORE_VERSION,
+                               {"n": n, "seed": seed, "dt": dt})
         if store is not None:
             for k, rec in enumerate(store.records):
                 _check_record(rec, n, store.path, k + 2)
@@ -282,9 +299,16 @@ def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers
 
         if todo:
             bar = ProgressBar.for_terminal("compare", n, start=n - len(todo), progress=progress)
-            with engine:
+            with contextlib.nullcontext() if early else engine:
                 engine.run(workcell_task, [(seed, i, dt, faults.get(i)) for i in todo], on_done,
                            name="workcell", progress=bar)
+    except WorkersLost as exc:
+        done = sum(1 for r in records.values() if r["status"] == "ok")
+        command = ["cfmpa", "compare", "--n", str(n), "--seed", str(seed), "--dt", repr(dt),
+                   *(["--out", str(out)] if out is not None else []), *engine.options()]
+        kept = (f"{done} of {n} workcells are recorded in {store.path} and stay; resume with: "
+                if store is not None else "nothing is kept without --out; run again with: ")
+        raise WorkersLost(f"{exc}. {kept}{shlex.join(command)}") from None
     except KeyboardInterrupt:
         if store is not None:
             done = sum(1 for r in records.values() if r["status"] == "ok")
@@ -294,6 +318,7 @@ def run_campaign(n: int = 100, seed: int = 0, dt: float = COMPARE_DT, *, workers
     finally:
         if store is not None:
             store.close()
+        engine.close()
     missing = [i for i in range(n) if i not in records]
     if missing:   # the engine reports every task; this would be a bug of cfmpa, not of input
         raise CfmpaError(f"campaign ended without a record of workcells {missing[:10]}")
@@ -402,6 +427,12 @@ def _check_record(rec: dict[str, Any], n: int, path: str | Path, line: int) -> N
         raise InputError("record", error_message(exc), "is not a workcell record of this "
                          "version (remove the store to start afresh)", source=str(path),
                          line=line) from None
+
+
+def _connect_first(engine: Engine) -> bool:
+    """Whether the engine starts before the store is opened: a running cluster's (reaching it
+    is the check of --scheduler), not a local one's (started only when there is work)."""
+    return engine.scheduler is not None
 
 
 def _warm() -> None:

@@ -15,6 +15,14 @@ task whose worker dies is rescheduled by the scheduler (up to its ``allowed-fail
 that is lost all the same reaches the callback as a ``TaskLost``, so that it is recorded, never
 dropped. The tasks of cfmpa catch their own exceptions and return an error record, so a
 ``TaskLost`` means the machinery failed, not the workcell.
+
+A cluster that loses all its workers would leave the tasks waiting forever (the scheduler keeps
+them for a worker that may come back). So while no task completes the client asks the scheduler
+for its workers about once a second: when it has none it warns on stderr, and when it has had
+none for ``worker_timeout`` seconds the run stops with ``WorkersLost`` (exit 2), its pending
+tasks cancelled; whatever the callback recorded stays recorded (docs/model.md §13). A client
+that loses its scheduler (dask then cancels every future) stops with ``WorkersLost`` too,
+rather than recording each pending task as lost.
 """
 
 from __future__ import annotations
@@ -31,14 +39,16 @@ from types import TracebackType
 from typing import Any, TextIO
 from urllib.parse import urlsplit
 
-from ..errors import CfmpaError, InputError
+from ..errors import CfmpaError, InputError, WorkersLost
 from ..impl import progress_default
 
-__all__ = ["CONNECT_TIMEOUT_S", "RETRIES", "SCHEMES", "Engine", "ProgressBar", "TaskLost",
-           "check_scheduler_address", "error_message"]
+__all__ = ["CONNECT_TIMEOUT_S", "RETRIES", "SCHEMES", "WORKER_TIMEOUT_S", "Engine", "ProgressBar",
+           "TaskLost", "check_scheduler_address", "error_message"]
 
 #: Seconds to wait for a scheduler (and then for its first worker) before giving up.
 CONNECT_TIMEOUT_S = 10.0
+#: Seconds a run waits while its cluster has no worker before it stops (--worker-timeout).
+WORKER_TIMEOUT_S = 60.0
 #: Retries of a task that raises on a worker (dask's ``retries=``).
 RETRIES = 2
 #: Address schemes of dask.distributed's communication layers that cfmpa accepts.
@@ -215,16 +225,20 @@ class Engine:
     ``timings_s["tasks"]`` measures the tasks, not the workers' first loads."""
 
     def __init__(self, workers: int = 0, scheduler: str | None = None, *,
-                 connect_timeout: float = CONNECT_TIMEOUT_S, stream: TextIO | None = None,
+                 connect_timeout: float = CONNECT_TIMEOUT_S,
+                 worker_timeout: float = WORKER_TIMEOUT_S, stream: TextIO | None = None,
                  warm: Callable[[], Any] | None = None) -> None:
         if isinstance(workers, bool) or not isinstance(workers, int) or workers < 0:
             raise InputError("--workers", workers, "must be an integer >= 0 (0: in this process)")
-        if not (isinstance(connect_timeout, (int, float)) and not isinstance(connect_timeout, bool)
-                and math.isfinite(connect_timeout) and connect_timeout > 0):
-            raise InputError("--connect-timeout", connect_timeout, "must be a number of seconds > 0")
+        for option, value in (("--connect-timeout", connect_timeout),
+                              ("--worker-timeout", worker_timeout)):
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool)
+                    and math.isfinite(value) and value > 0):
+                raise InputError(option, value, "must be a number of seconds > 0")
         self.workers = workers
         self.scheduler = None if scheduler is None else check_scheduler_address(scheduler)
         self.connect_timeout = float(connect_timeout)
+        self.worker_timeout = float(worker_timeout)
         self.stream = stream
         self.warm = warm
         self.info = "in this process, one task after the other"
@@ -237,6 +251,17 @@ class Engine:
     @property
     def serial(self) -> bool:
         return self.scheduler is None and self.workers == 0
+
+    def options(self) -> list[str]:
+        """This engine's settings as the command line's options (for a command that resumes)."""
+        where = (["--scheduler", self.scheduler] if self.scheduler is not None
+                 else ["--workers", str(self.workers)])
+        for option, value, default in (
+                ("--connect-timeout", self.connect_timeout, CONNECT_TIMEOUT_S),
+                ("--worker-timeout", self.worker_timeout, WORKER_TIMEOUT_S)):
+            if value != default:
+                where += [option, f"{value:g}"]
+        return where
 
     def __enter__(self) -> Engine:
         t0 = time.perf_counter()
@@ -363,16 +388,113 @@ class Engine:
         run_id = uuid.uuid4().hex[:8]   # keys unique per run: another run's results never mix
         futures = {client.submit(fn, *args, key=f"{name}-{run_id}-{i}", retries=retries,
                                  pure=False): i for i, args in enumerate(argsets)}
+        watch = _WorkerWatch(lambda: _live_workers(client), self.worker_timeout,
+                             self.scheduler or "of this run")
         try:
-            for fut in as_completed(futures, loop=client.loop):
-                i = futures[fut]
-                try:
-                    result = fut.result()
-                except Exception as exc:   # the task's worker died too often, or it raised
-                    result = TaskLost(error_message(exc))
-                on_done(i, result)
-                fut.release()
-                bar.advance()
+            done = as_completed(futures, loop=client.loop)
+            while not done.is_empty():
+                batch = done.next_batch(block=False)
+                if not batch:
+                    # Nothing finished: a cluster without workers would wait forever here.
+                    watch.idle(time.monotonic())
+                    time.sleep(_IDLE_S)
+                    continue
+                watch.progress(time.monotonic())
+                for fut in batch:
+                    i = futures[fut]
+                    try:
+                        result = _fetched(fut, watch.poll_s)
+                        if result is _LOST_AGAIN:
+                            done.add(fut)      # its worker left with the result: computed again
+                            continue
+                    except Exception as exc:   # the task's worker died too often, or it raised
+                        if _scheduler_lost(client, fut, exc):
+                            # Not the task's failure: recorded as one, it would be an error
+                            # record of a workcell that nothing is wrong with.
+                            raise WorkersLost(f"the client lost the connection to the Dask "
+                                              f"scheduler {watch.where}; the run stopped"
+                                              ) from None
+                        result = TaskLost(error_message(exc))
+                    on_done(i, result)
+                    fut.release()
+                    bar.advance()
         finally:
             client.cancel([f for f in futures if not f.done()])
+
+
+#: Seconds between looks at the finished tasks while none has finished.
+_IDLE_S = 0.05
+#: What ``_fetched`` returns for a task whose result was lost before it was fetched.
+_LOST_AGAIN = object()
+
+
+def _fetched(fut: Any, timeout: float) -> Any:
+    """``fut``'s result, or _LOST_AGAIN if the result left with its worker before it reached
+    the client (the scheduler then computes the task again; a plain ``fut.result()`` would wait
+    for that, past the watchdog, forever if no worker comes)."""
+    while True:
+        try:
+            return fut.result(timeout=timeout)
+        except TimeoutError:
+            if fut.status != "finished":
+                return _LOST_AGAIN
+
+
+def _scheduler_lost(client: Any, fut: Any, exc: Exception) -> bool:
+    """Whether ``fut`` failed because the client lost its scheduler: dask then cancels every
+    future (reason ``scheduler-connection-lost``) while it reconnects."""
+    return bool(fut.cancelled()) and (
+        getattr(exc, "reason", None) == "scheduler-connection-lost"
+        or getattr(client, "status", "running") != "running")
+
+
+def _live_workers(client: Any) -> int | None:
+    """The scheduler's workers that are not closing, or None when the scheduler did not say."""
+    try:
+        workers = client.scheduler_info()["workers"]
+    except Exception:      # the scheduler gone too: no worker the run can count on
+        return None
+    return sum(1 for w in workers.values()
+               if str(w.get("status", "running")) not in ("closing", "closing_gracefully",
+                                                          "closed"))
+
+
+class _WorkerWatch:
+    """The watchdog of a run on a cluster: ``idle(now)`` while no task finishes asks ``count``
+    (the cluster's workers) at most every ``poll_s`` seconds; the first time it is 0 (or
+    unknown) it warns on stderr; when it has been so for ``timeout`` seconds it raises
+    WorkersLost. A worker seen again, or a task finished, resets it."""
+
+    def __init__(self, count: Callable[[], int | None], timeout: float, where: str) -> None:
+        self.count, self.timeout, self.where = count, timeout, where
+        self.poll_s = min(1.0, timeout / 4)
+        self._asked = -math.inf
+        self._empty_since: float | None = None
+
+    def progress(self, now: float) -> None:
+        self._asked = now              # a task finished: there was a worker a moment ago
+        self._back()
+
+    def idle(self, now: float) -> None:
+        if now - self._asked < self.poll_s:
+            return
+        self._asked = now
+        n = self.count()
+        if n:
+            self._back()
+            return
+        if self._empty_since is None:
+            self._empty_since = now
+            print(f"warning: the Dask cluster {self.where} has no worker; waiting up to "
+                  f"{self.timeout:g} s (--worker-timeout) for one, then stopping",
+                  file=sys.stderr, flush=True)
+        elif now - self._empty_since >= self.timeout:
+            raise WorkersLost(f"the Dask cluster {self.where} had no worker for "
+                              f"{self.timeout:g} s (--worker-timeout); the run stopped")
+
+    def _back(self) -> None:
+        if self._empty_since is not None:
+            self._empty_since = None
+            print(f"warning: the Dask cluster {self.where} has a worker again; going on",
+                  file=sys.stderr, flush=True)
 
