@@ -41,8 +41,8 @@ from . import _figures as F
 from ._compare import campaign_json, format_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
-from ._obligations import (ProofData, card_groups, load_proofs, load_selftest, read_results,
-                           summary_table)
+from ._obligations import (ProofData, card_groups, control_summary, load_proofs, load_selftest,
+                           read_results, summary_table)
 from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
@@ -238,11 +238,51 @@ def _proof_sections(proofs: ProofData) -> dict[str, Any]:
             "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
                                 and not proofs.unexpected_ids) if proofs.available else None,
             "run": proofs.run, "not_run": list(proofs.not_run),
+            "depth": {"measures": proofs.depth_measures or DEPTH_MEASURES,
+                      "nonlinear_vcs": sum(v.nonlinear for r in proofs.rows for v in r.vcs),
+                      "vcs": sum(len(r.vcs) for r in proofs.rows)},
         },
+        "controls": _controls_part(proofs),
         "assumptions": {"available": proofs.ledger_available,
                         "source": proofs.source if proofs.ledger_available else
                         "not available in this run", "entries": list(proofs.ledger)},
     }
+
+
+#: What an obligation's depth measures, when results.json does not say (an older file).
+DEPTH_MEASURES = ("quantifier instantiation: the weakest reasoning that proves a VC, "
+                  "propositional, ground or full; nonlinear arithmetic is flagged apart")
+
+
+def _controls_part(proofs: ProofData) -> dict[str, Any]:
+    """The negative controls of the prove run (docs/model.md §10.3): seeded wrong inputs each
+    checker must reject, and each Safety composition without one of its premises, which must
+    not be proved. ``available`` False: none in this data (the note says why)."""
+    rows = proofs.controls
+    return {"available": bool(rows), "note": proofs.controls_note,
+            "summary": control_summary(rows or ()),
+            "items": [r.as_json() for r in rows or ()],
+            "missing_ids": list(proofs.missing_controls)}
+
+
+def _controls_item(doc: dict[str, Any]) -> dict[str, Any]:
+    """The verdict's check of the negative controls: every one ended as it expects, and none
+    that a whole prove run has is missing; None when the data has none (a fresh run)."""
+    c = doc["controls"]
+    check = "negative controls as expected"
+    missing = c["missing_ids"]
+    if not c["available"] and not missing:
+        return _item(check, None, c["note"])
+    bad = [f"{i['id']} ({i['outcome']}, expected {' or '.join(i['expected'])})"
+           for i in c["items"] if not i["ok"]]
+    outcomes = ", ".join(f"{k} {v}" for k, v in c["summary"].items()
+                         if k not in ("total", "as_expected"))
+    return _item(check, not bad and not missing,
+                 f"{c['summary']['as_expected']} of {c['summary']['total']}"
+                 + (f" ({outcomes})" if outcomes else "")
+                 + (f"; not as expected: {', '.join(bad)}" if bad else "")
+                 + (f"; missing: {len(missing)} of the prove run's controls (e.g. {missing[0]})"
+                    if missing else ""))
 
 
 def _relate(findings: list[dict[str, Any]], proofs: ProofData) -> None:
@@ -794,6 +834,7 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
                               if ob["unexpected_ids"] else "")))
     else:
         items.append(_item("obligations as expected", None, ob["source"]))
+    items.append(_controls_item(doc))
     items.append(_proofs_of_this_tree(ob, doc["provenance"]))
     fnd = [f for f in doc["findings"] if f["available"]]
     missing = [f["id"] for f in doc["findings"] if not f["available"]]
