@@ -50,8 +50,10 @@ ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
 SCHEMA = ROOT / "report" / "schema.json"
 CHROMIUM = Path("/usr/bin/chromium")
-#: A subset of obligations that discharges in a few seconds, across several groups and verdicts.
-OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival"]
+#: A subset of obligations that discharges in a few seconds, across several groups and verdicts,
+#: and the negative controls of three checkers (a second in all).
+OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival",
+               "Control.witness", "Control.dr", "Control.path"]
 #: The ids that subset must produce, picked the way `cfmpa prove --only` picks them.
 EXPECTED = [i for i in expected_ids(ROOT / "scenarios") if selected(i, OBLIGATIONS)]
 
@@ -513,6 +515,110 @@ def test_ids_of_a_doctored_results_json_are_checked_not_copied(report, tmp_path)
     assert set(partial.missing_ids) == set(expected_ids(ROOT / "scenarios")) - set(EXPECTED)
 
 
+def test_negative_controls_are_shown_from_results_json(report):
+    doc, html = report["doc"], report["html"]
+    recorded = json.loads(_results(report)["text"])["controls"]
+    assert len(recorded) == 4, [c["id"] for c in recorded]   # witness x2, dr, path
+    ctl = doc["controls"]
+    assert ctl["available"] and not ctl["missing_ids"]
+    assert [(c["id"], c["outcome"], c["expected"], c["what"]) for c in ctl["items"]] == [
+        (c["id"], c["outcome"], c["expected"], c["what"]) for c in recorded]
+    assert ctl["summary"] == {"total": 4, "as_expected": 4, "rejected": 4}
+    table = html[html.index('id="controls"'):]
+    table = table[:table.index("</table>")]
+    for c in recorded:
+        row = table[table.index(f'id="control-{c["id"].replace(".", "-").replace("_", "-").lower()}"'):]
+        row = row[:row.index("</tr>")]
+        assert c["id"] in row and str(escape(c["what"])) in row and ">rejected<" in row
+        assert "as expected" in row and "FAILED" not in row
+    assert "4 of 4 as expected: rejected 4." in table
+    item = _check(doc, "negative controls as expected")
+    assert item["ok"] is True and item["detail"] == "4 of 4 (rejected 4)"
+
+
+def test_a_control_not_as_expected_fails_the_verdict(report, tmp_path):
+    # A checker that accepted its forged input; the file still claims ok.
+    doc = json.loads(_results(report)["text"])
+    doc["controls"][0].update(outcome="accepted", ok=True)
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
+    audit["verdict"] = _verdict(audit)
+    item = _check(audit, "negative controls as expected")
+    assert audit["verdict"]["ok"] is False and item["ok"] is False
+    cid = doc["controls"][0]["id"]
+    assert f"not as expected: {cid} (accepted, expected rejected)" in item["detail"]
+    assert audit["controls"]["summary"]["as_expected"] == 3
+    text = render_html(AuditResult(audit, report["result"].figures))
+    row = text[text.index(f'id="control-{cid.replace(".", "-").replace("_", "-").lower()}"'):]
+    assert "FAILED" in row[:row.index("</tr>")]
+    # A control whose outcome is expected but whose record says not ok is not ok either.
+    doc["controls"][0].update(outcome="rejected", ok=False)
+    bad.write_text(json.dumps(doc))
+    again = load_proofs(str(bad), ROOT / "scenarios", EXPECTED)
+    assert [c.ok for c in again.controls] == [False, True, True, True]
+
+
+def test_a_whole_run_without_its_controls_fails_the_verdict(report, tmp_path):
+    # Controls deleted from a results.json that must be a whole run: not "not available".
+    from cfmpa.proofs import collect_controls
+
+    doc = json.loads(_results(report)["text"])
+    del doc["controls"]
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios")))
+    assert audit["controls"]["available"] is False
+    assert audit["controls"]["missing_ids"] == [c.id for c in collect_controls()]
+    assert _check({"verdict": _verdict(audit)}, "negative controls as expected")["ok"] is False
+    # The same file read for a subset of obligations: nothing to show, not counted either way.
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
+    item = _check({"verdict": _verdict(audit)}, "negative controls as expected")
+    assert item["ok"] is None and "records no negative controls" in item["detail"]
+    assert "Not available in this run" in render_html(AuditResult(audit,
+                                                                  report["result"].figures))
+
+
+def test_definitional_obligations_are_counted_apart_and_labelled(report):
+    from cfmpa.proofs import DEFINITIONAL
+
+    doc, html = report["doc"], report["html"]
+    ob = doc["obligations"]
+    recorded = {o["id"]: o for o in json.loads(_results(report)["text"])["obligations"]}
+    defs = [i["id"] for i in ob["items"] if i["kind"] == "definitional"]
+    assert defs and set(defs) == set(DEFINITIONAL) & set(recorded)
+    assert all(i["kind"] == recorded[i["id"]]["kind"] for i in ob["items"])
+    kinds = ob["summary"]["kinds"]
+    assert kinds == {"theorem": len(ob["items"]) - len(defs), "definitional": len(defs)}
+    assert (f"{len(ob['items'])} obligations: {kinds['theorem']} theorems, "
+            f"{kinds['definitional']} definitional.") in html
+    for i in ob["items"]:
+        card = html[html.index(f'id="ob-{i["id"].replace(".", "-").replace("_", "-").lower()}"'):]
+        card = card[:card.index('<div class="obligation"', 10) if '<div class="obligation"' in
+                    card[10:] else card.index('<h2 id="assumptions">')]
+        head = card[:card.index('<p class="summary">')]
+        assert ("definitional</span>" in head) is (i["kind"] == "definitional"), i["id"]
+        # Each VC is listed in the folded details with its nonlinear flag.
+        rows = re.findall(r'<tr><td class="mono">([^<]*)</td>.*?<td>(?:<span class="badge na">'
+                          r'(nonlinear)</span>|linear)</td></tr>', card)
+        assert [(n, f == "nonlinear") for n, f in rows] == [
+            (str(escape(v["name"])), v["nonlinear"]) for v in recorded[i["id"]]["vcs"]], i["id"]
+    nl = sum(v["nonlinear"] for o in recorded.values() for v in o["vcs"])
+    assert ob["depth"]["nonlinear_vcs"] == nl and ob["depth"]["measures"].startswith("quantifier")
+
+
+def test_a_fresh_run_shows_no_controls_and_does_not_count_them():
+    from cfmpa.report._obligations import ProofData
+
+    fresh = ProofData(available=True, source="fresh", note="", rows=(), ledger=(),
+                      ledger_available=True, controls_note="not run for this report")
+    part = _proof_sections(fresh)["controls"]
+    assert part == {"available": False, "note": "not run for this report",
+                    "summary": {"total": 0, "as_expected": 0}, "items": [], "missing_ids": []}
+
+
 def _check(audit, name):
     return next(i for i in audit["verdict"]["items"] if i["check"] == name)
 
@@ -687,7 +793,8 @@ def _golden(name: str, text: str) -> None:
 _OPEN = ("findings[].data", "scenarios[].variants[].contracts", "scenarios[].variants[].clearance",
          "scenarios[].variants[].kernel", "provenance.git.paths",
          "scenarios[].variants[].timings_s", "selftest.rows[]", "provenance.versions",
-         "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks")
+         "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks",
+         "controls.summary")
 
 
 def _keys(x, prefix: str = "") -> set[str]:
