@@ -825,8 +825,10 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     if ob["available"]:
         bad = [r["id"] for r in ob["items"] if not r["as_expected"]]
         gaps = ob["missing_ids"] + ob["unexpected_ids"]
+        kinds = ob["summary"]["kinds"]
         items.append(_item("obligations as expected", not bad and not gaps,
-                           f"{len(ob['items']) - len(bad)} of {len(ob['items'])}"
+                           f"{len(ob['items']) - len(bad)} of {len(ob['items'])} ("
+                           f"{kinds['theorem']} theorems, {kinds['definitional']} definitional)"
                            + (f"; not as expected: {', '.join(bad)}" if bad else "")
                            + (f"; missing ids: {', '.join(ob['missing_ids'])}"
                               if ob["missing_ids"] else "")

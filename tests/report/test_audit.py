@@ -76,16 +76,71 @@ def results_json(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def report(tiny_file, results_json, tmp_path_factory):
+    import cfmpa.report._figures as figures
+
     out = tmp_path_factory.mktemp("audit")
     argv = ["cfmpa", "audit", str(tiny_file), "--out", str(out)]
     progress = io.StringIO()
-    result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
-                         compare_n=4, compare_seed=3, expected_ids=EXPECTED, progress=progress)
+    layout: dict[str, list[str]] = {}   # figure id -> its legends over axis or tick labels
+    save = figures._save
+
+    def saved(fig, fid, caption, alt):
+        layout[fid] = figures.legend_overlaps(fig)
+        return save(fig, fid, caption, alt)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(figures, "_save", saved)
+        result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
+                             compare_n=4, compare_seed=3, expected_ids=EXPECTED,
+                             progress=progress)
     write_report(result, out)
     doc = json.loads((out / "report.json").read_text())
     html = (out / "report.html").read_text()
     return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv,
-            "progress": progress.getvalue()}
+            "progress": progress.getvalue(), "layout": layout}
+
+
+def test_no_legend_covers_an_axis_label(report):
+    # Every picture of the report, the workcell figure (whose legend covered "x (m)") included.
+    layout = report["layout"]
+    assert set(layout) == set(report["result"].figures)
+    assert any(fid.endswith("-workcell") for fid in layout)
+    assert {fid: bad for fid, bad in layout.items() if bad} == {}
+
+
+def test_a_six_panel_workcell_figure_keeps_its_legend_off_the_labels(tiny_file, monkeypatch):
+    # Six instants fill the 2 x 3 panels, so the legend goes under them (the default workcell's
+    # case, where it covered the bottom row's "x (m)"); the fixture's tiny plan has five.
+    import cfmpa.report._figures as figures
+    from cfmpa.spec import Variant, load_scenario, make_grid
+
+    s = load_scenario(tiny_file)
+    g = make_grid(s)
+    path = [s.right.start_cell] * (g.N + 8)           # still after Tf: t_end past the principal
+    t_end = (len(path) - 1) * s.dt
+    t_min = (g.Tf + t_end) / 2
+    assert len(workcell_instants(g.Tf, t_end, s.dt, t_min)) == 6
+    seen = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, fid, *a: seen.setdefault(
+        fid, figures.legend_overlaps(fig)))
+    figures.workcell_figure("w", s, g, path, Variant.MODIFIED, t_min, 0.01)
+    assert seen == {"w": []}
+
+
+def test_the_layout_check_sees_a_legend_over_an_axis_label():
+    import matplotlib.pyplot as plt
+    from cfmpa.report._figures import legend_overlaps
+
+    fig, ax = plt.subplots(figsize=(4, 3))
+    ax.plot([0, 1], [0, 1], label="a line with a long legend entry")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    fig.tight_layout()
+    assert legend_overlaps(fig) == []
+    # The seeded fault: a figure legend at the figure's foot, where the x label is.
+    fig.legend(loc="lower center", frameon=False)
+    bad = legend_overlaps(fig)
+    plt.close(fig)
+    assert any("x label 'x (m)'" in b for b in bad), bad
 
 
 def test_the_audit_prints_a_line_per_stage_with_its_time(report):
