@@ -818,6 +818,80 @@ def test_report_renders_in_headless_chromium(report, tmp_path):
     assert result["count"] == len(_figure_refs(report["doc"])) and result["bad"] == [], result
 
 
+#: Appended to a scratch copy of the page: after load, where section 1 is in the window and
+#: each obligation card's short summary, read from the DOM as the browser laid it out.
+_FIRST_SCREEN_PROBE = """<script>
+window.addEventListener("load", () => {
+  const s1 = document.getElementById("workcells");
+  const box = s1 ? s1.getBoundingClientRect() : null;
+  const table = s1 ? s1.querySelector("table") : null;
+  const cards = Array.from(document.querySelectorAll("div.obligation")).map(c => {
+    const p = c.querySelector(":scope > p.summary");
+    return {id: c.querySelector(".id").textContent,
+            summary: p ? p.textContent.trim() : null,
+            placeholder: p ? p.querySelector("em") !== null : true};
+  });
+  const out = document.createElement("pre");
+  out.id = "screen-probe";
+  out.textContent = JSON.stringify({
+    width: window.innerWidth, height: window.innerHeight,
+    top: box && box.top, table_top: table && table.getBoundingClientRect().top,
+    heading: s1 && s1.querySelector("h2").textContent, cards: cards});
+  document.body.appendChild(out);
+});
+</script>"""
+
+
+def _first_screen(tmp_path, html, name):
+    """The probe's reading of ``html`` in a 1400 x 900 headless Chromium window."""
+    probe = tmp_path / f"{name}.html"
+    probe.write_text(html.replace("</body>", _FIRST_SCREEN_PROBE + "\n</body>"))
+    dom = _chromium(tmp_path, "--window-size=1400,900", "--dump-dom",
+                    "--virtual-time-budget=10000", probe.as_uri())
+    assert dom.returncode == 0, dom.stderr[-2000:]
+    found = re.search(r'<pre id="screen-probe">(.*?)</pre>', dom.stdout, re.S)
+    assert found, "the probe did not run: " + dom.stderr[-1000:]
+    return json.loads(html_lib.unescape(found.group(1)))
+
+
+def _screen_problems(got, doc):
+    """What the first-screen reading shows wrong: section 1 not within the first 900 pixels,
+    a card missing, or a card without its short summary."""
+    out = []
+    if got["heading"] != "1. Verdict per workcell" or not (0 <= got["top"] < 900):
+        out.append(f"section 1 ({got['heading']!r}) starts at {got['top']} px")
+    if got["table_top"] is None or not (0 <= got["table_top"] < 900):
+        out.append(f"section 1's table starts at {got['table_top']} px")
+    summaries = {i["id"]: i["summary"] for i in doc["obligations"]["items"]}
+    if sorted(c["id"] for c in got["cards"]) != sorted(summaries):
+        out.append("the cards are not the obligations")
+    out += [f"{c['id']}: no short summary" for c in got["cards"]
+            if c["placeholder"] or c["summary"] != summaries.get(c["id"])]
+    return out
+
+
+@pytest.mark.browser
+def test_section_one_is_on_the_first_screen_and_every_card_has_its_summary(report, tmp_path):
+    if not CHROMIUM.exists():
+        pytest.skip("/usr/bin/chromium is absent (Debian package 'chromium'; .ci/run installs it)")
+    got = _first_screen(tmp_path, report["html"], "screen")
+    # Chromium's headless window of 1400 x 900 gives the page 1400 pixels' width and, with its
+    # window frame taken off, a little less height: section 1 must start within both.
+    assert got["width"] == 1400 and 0 < got["height"] <= 900, got
+    assert got["table_top"] < got["height"], got
+    assert _screen_problems(got, report["doc"]) == []
+    # Seeded faults: a block that pushes section 1 below the first screen, a card without its
+    # summary (rendered from a doc whose first obligation has none).
+    doc = copy.deepcopy(report["result"].doc)
+    first = doc["obligations"]["items"][0]
+    first["summary"] = None
+    html = render_html(AuditResult(doc, report["result"].figures)).replace(
+        '<section id="workcells">', '<div style="height: 1000px"></div><section id="workcells">')
+    bad = _screen_problems(_first_screen(tmp_path, html, "seeded"), report["doc"])
+    assert any(b.startswith("section 1 (") for b in bad), bad
+    assert f"{first['id']}: no short summary" in bad, bad
+
+
 # --- helpers --------------------------------------------------------------------------------------
 
 def _results(report):
