@@ -1,6 +1,8 @@
 """`cfmpa audit`: one self-contained HTML report for a safety reviewer, and its JSON twin.
 
-Content, in order (docs/model.md §8): provenance; the obligations' summary table and each obligation;
+Content, in order (docs/model.md §8): the verdict per workcell; provenance; the obligations'
+summary table (theorems and definitional ones counted apart) with the prove run's negative
+controls, and each obligation;
 the assumptions ledger; the findings about the paper, drawn; the mutation self-check; per
 scenario the plans of the three variants with contracts, certificate, each found plan's
 tolerance tube (docs/model.md §12) and pictures; one monitored simulated run of the default
