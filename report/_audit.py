@@ -224,8 +224,12 @@ def render_html(result: AuditResult) -> str:
     ob = result.doc["obligations"]
     by_id = {r["id"]: r for r in ob["items"]}
     cards = [{**g, "rows": [by_id[i] for i in g["ids"]]} for g in ob["cards"]]
+    # The checkers' controls in a table; the compositions' (a premise left out each) folded.
+    ctl = result.doc["controls"]["items"]
+    premise = [c for c in ctl if c["checker"].startswith("Safety.")]
+    groups = ([c for c in ctl if not c["checker"].startswith("Safety.")], premise)
     return env.from_string(text).render(doc=result.doc, figures=result.figures, cards=cards,
-                                        columns=ob["summary"]["columns"])
+                                        columns=ob["summary"]["columns"], control_groups=groups)
 
 
 def _proof_sections(proofs: ProofData) -> dict[str, Any]:

@@ -40,7 +40,8 @@ from cfmpa.errors import InputError
 from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
-from cfmpa.report._audit import _proof_sections, _verdict, contract_rows, workcell_summary
+from cfmpa.report._audit import (_controls_item, _proof_sections, _verdict, contract_rows,
+                                 workcell_summary)
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
 from cfmpa.gitstate import MAX_PATHS, git_state
@@ -613,6 +614,30 @@ def test_a_control_not_as_expected_fails_the_verdict(report, tmp_path):
     bad.write_text(json.dumps(doc))
     again = load_proofs(str(bad), ROOT / "scenarios", EXPECTED)
     assert [c.ok for c in again.controls] == [False, True, True, True]
+
+
+def test_premise_controls_are_folded_unless_one_fails(report):
+    audit = copy.deepcopy(report["result"].doc)
+
+    def premise(i, outcome):
+        return {"id": f"Control.Safety.tight.composition.without[{i}]",
+                "checker": "Safety.tight.composition", "what": f"without: premise {i}",
+                "expected": ["refuted", "unknown"], "outcome": outcome,
+                "ok": outcome in ("refuted", "unknown"), "detail": "", "seconds": 1.0}
+    audit["controls"]["items"] += [premise(0, "refuted"), premise(1, "unknown")]
+    text = render_html(AuditResult(audit, report["result"].figures))
+    fold = text[text.index('<details class="group" id="controls-premises">'):]
+    fold = fold[:fold.index("</details>")]
+    assert "2 controls, 2 as expected" in fold and "without: premise 1" in fold
+    assert "as expected (undecided)" in fold        # unknown: weaker evidence, said so
+    checkers = text[text.index('id="controls"'):text.index('id="controls-premises"')]
+    assert "without: premise" not in checkers and "Control.witness.forged" in checkers
+    # A composition proved without its premise: the fold opens and says how many failed.
+    audit["controls"]["items"].append(premise(2, "proved"))
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert '<details class="group" id="controls-premises" open>' in text
+    assert "3 controls, 2 as expected" in text and ">1 FAILED</span>" in text
+    assert _controls_item(audit)["ok"] is False
 
 
 def test_a_whole_run_without_its_controls_fails_the_verdict(report, tmp_path):
