@@ -20,18 +20,20 @@ from ._obl_scenario import scenario_check_id, scenario_files, scenario_obligatio
 from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proof, VCResult,
                           Verdict, Z3Query, discharge)
 from ._summaries import obligation_summary, summary_problems
-from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, EXPECTED_VERDICTS, FIXED_IDS, ProveRun,
+from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, DEFINITIONAL, EXPECTED_VERDICTS,
+                      FIXED_IDS, ProveRun,
                       collect_obligations, compare_ids, default_workers, expected_ids, is_bundled,
-                      pinned_verdict, render_report, run_obligations, run_record, scenarios_note,
-                      selected)
+                      kind_of, pinned_verdict, render_report, run_obligations, run_record,
+                      scenarios_note, selected)
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",
     "Control", "ControlResult", "collect_controls",
     "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
-    "CheckQuery", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation", "Proof", "ProveRun",
+    "CheckQuery", "DEFINITIONAL", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation",
+    "Proof", "ProveRun",
     "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "default_workers",
-    "discharge", "expected_ids", "is_bundled", "obligation_summary", "pinned_verdict",
+    "discharge", "expected_ids", "is_bundled", "kind_of", "obligation_summary", "pinned_verdict",
     "render_report", "summary_problems",
     "run_obligations", "run_prove", "run_record", "scenarios_note", "selected",
 ]

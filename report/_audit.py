@@ -1,6 +1,8 @@
 """`cfmpa audit`: one self-contained HTML report for a safety reviewer, and its JSON twin.
 
-Content, in order (docs/model.md §8): provenance; the obligations' summary table and each obligation;
+Content, in order (docs/model.md §8): the verdict per workcell; provenance; the obligations'
+summary table (theorems and definitional ones counted apart) with the prove run's negative
+controls, and each obligation;
 the assumptions ledger; the findings about the paper, drawn; the mutation self-check; per
 scenario the plans of the three variants with contracts, certificate, each found plan's
 tolerance tube (docs/model.md §12) and pictures; per audited workcell one monitored simulated
@@ -41,8 +43,8 @@ from . import _figures as F
 from ._compare import campaign_json, format_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
                         prop8_finding, sample_clearance)
-from ._obligations import (ProofData, card_groups, load_proofs, load_selftest, read_results,
-                           summary_table)
+from ._obligations import (ProofData, card_groups, control_summary, load_proofs, load_selftest,
+                           read_results, summary_table)
 from ._provenance import provenance
 
 __all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
@@ -225,8 +227,12 @@ def render_html(result: AuditResult) -> str:
     ob = result.doc["obligations"]
     by_id = {r["id"]: r for r in ob["items"]}
     cards = [{**g, "rows": [by_id[i] for i in g["ids"]]} for g in ob["cards"]]
+    # The checkers' controls in a table; the compositions' (a premise left out each) folded.
+    ctl = result.doc["controls"]["items"]
+    premise = [c for c in ctl if c["checker"].startswith("Safety.")]
+    groups = ([c for c in ctl if not c["checker"].startswith("Safety.")], premise)
     return env.from_string(text).render(doc=result.doc, figures=result.figures, cards=cards,
-                                        columns=ob["summary"]["columns"])
+                                        columns=ob["summary"]["columns"], control_groups=groups)
 
 
 def _proof_sections(proofs: ProofData) -> dict[str, Any]:
@@ -241,11 +247,51 @@ def _proof_sections(proofs: ProofData) -> dict[str, Any]:
             "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
                                 and not proofs.unexpected_ids) if proofs.available else None,
             "run": proofs.run, "not_run": list(proofs.not_run),
+            "depth": {"measures": proofs.depth_measures or DEPTH_MEASURES,
+                      "nonlinear_vcs": sum(v.nonlinear for r in proofs.rows for v in r.vcs),
+                      "vcs": sum(len(r.vcs) for r in proofs.rows)},
         },
+        "controls": _controls_part(proofs),
         "assumptions": {"available": proofs.ledger_available,
                         "source": proofs.source if proofs.ledger_available else
                         "not available in this run", "entries": list(proofs.ledger)},
     }
+
+
+#: What an obligation's depth measures, when results.json does not say (an older file).
+DEPTH_MEASURES = ("quantifier instantiation: the weakest reasoning that proves a VC, "
+                  "propositional, ground or full; nonlinear arithmetic is flagged apart")
+
+
+def _controls_part(proofs: ProofData) -> dict[str, Any]:
+    """The negative controls of the prove run (docs/model.md §10.3): seeded wrong inputs each
+    checker must reject, and each Safety composition without one of its premises, which must
+    not be proved. ``available`` False: none in this data (the note says why)."""
+    rows = proofs.controls
+    return {"available": bool(rows), "note": proofs.controls_note,
+            "summary": control_summary(rows or ()),
+            "items": [r.as_json() for r in rows or ()],
+            "missing_ids": list(proofs.missing_controls)}
+
+
+def _controls_item(doc: dict[str, Any]) -> dict[str, Any]:
+    """The verdict's check of the negative controls: every one ended as it expects, and none
+    that a whole prove run has is missing; None when the data has none (a fresh run)."""
+    c = doc["controls"]
+    check = "negative controls as expected"
+    missing = c["missing_ids"]
+    if not c["available"] and not missing:
+        return _item(check, None, c["note"])
+    bad = [f"{i['id']} ({i['outcome']}, expected {' or '.join(i['expected'])})"
+           for i in c["items"] if not i["ok"]]
+    outcomes = ", ".join(f"{k} {v}" for k, v in c["summary"].items()
+                         if k not in ("total", "as_expected"))
+    return _item(check, not bad and not missing,
+                 f"{c['summary']['as_expected']} of {c['summary']['total']}"
+                 + (f" ({outcomes})" if outcomes else "")
+                 + (f"; not as expected: {', '.join(bad)}" if bad else "")
+                 + (f"; missing: {len(missing)} of the prove run's controls (e.g. {missing[0]})"
+                    if missing else ""))
 
 
 def _relate(findings: list[dict[str, Any]], proofs: ProofData) -> None:
@@ -835,8 +881,10 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
     if ob["available"]:
         bad = [r["id"] for r in ob["items"] if not r["as_expected"]]
         gaps = ob["missing_ids"] + ob["unexpected_ids"]
+        kinds = ob["summary"]["kinds"]
         items.append(_item("obligations as expected", not bad and not gaps,
-                           f"{len(ob['items']) - len(bad)} of {len(ob['items'])}"
+                           f"{len(ob['items']) - len(bad)} of {len(ob['items'])} ("
+                           f"{kinds['theorem']} theorems, {kinds['definitional']} definitional)"
                            + (f"; not as expected: {', '.join(bad)}" if bad else "")
                            + (f"; missing ids: {', '.join(ob['missing_ids'])}"
                               if ob["missing_ids"] else "")
@@ -844,6 +892,7 @@ def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
                               if ob["unexpected_ids"] else "")))
     else:
         items.append(_item("obligations as expected", None, ob["source"]))
+    items.append(_controls_item(doc))
     items.append(_proofs_of_this_tree(ob, doc["provenance"]))
     fnd = [f for f in doc["findings"] if f["available"]]
     missing = [f["id"] for f in doc["findings"] if not f["available"]]

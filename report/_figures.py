@@ -34,6 +34,7 @@ from ._stats import wilson_interval  # noqa: E402
 
 __all__ = [
     "Figure",
+    "legend_overlaps",
     "workcell_figure",
     "workcell_instants",
     "cspace_figure",
@@ -98,6 +99,31 @@ def _save(fig: Any, fid: str, caption: str, alt: str) -> Figure:
     out = io.BytesIO()
     img.save(out, format="PNG", optimize=True)
     return Figure(fid, caption, alt, out.getvalue())
+
+
+def legend_overlaps(fig: Any) -> list[str]:
+    """Where a legend of ``fig`` covers an axis label or a tick label, as "legend k over
+    <what>" (empty: none). Drawn with matplotlib's renderer: the window extents are those
+    of the figure as it is saved (bbox_inches="tight" only crops around them)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
+    texts: list[tuple[str, Any]] = []
+    for n, ax in enumerate(fig.axes):
+        if not ax.axison:
+            continue
+        for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            if axis.label.get_visible() and axis.label.get_text():
+                texts.append((f"axes {n}'s {name} label {axis.label.get_text()!r}", axis.label))
+            texts += [(f"axes {n}'s {name} tick label {t.get_text()!r}", t)
+                      for t in axis.get_ticklabels() if t.get_visible() and t.get_text()]
+    out = []
+    for k, leg in enumerate(legends):
+        box = leg.get_window_extent(renderer)
+        for what, t in texts:
+            if box.overlaps(t.get_window_extent(renderer)):
+                out.append(f"legend {k} over {what}")
+    return out
 
 
 # --- drawing helpers ----------------------------------------------------------------------------
@@ -256,8 +282,11 @@ def workcell_figure(fid: str, s: Scenario, g: Grid, path: Sequence[Sequence[int]
             flat[len(times)].legend(handles, labels, loc="center", frameon=False)
             fig.tight_layout()
         else:
-            fig.tight_layout(rect=(0, 0.06 / rows, 1, 1))
-            fig.legend(handles, labels, loc="lower center", ncol=3, frameon=False)
+            # Under the panels, outside the figure (the saved picture grows to hold it): at
+            # the figure's foot it covered the bottom row's "x (m)".
+            fig.tight_layout()
+            fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=3,
+                       frameon=False)
     what = "the planned motion" if path else "the principal's motion (no path was found)"
     return _save(fig, fid, f"{s.name}: both arms at {len(times)} instants of {what} "
                  f"({variant.value} variant): four spread over the principal's motion up to "

@@ -27,12 +27,16 @@ from typing import Any
 from ..errors import InputError
 
 __all__ = [
+    "ControlRow",
     "ObligationRow",
     "ProofData",
+    "VCRow",
     "SUMMARY_COLUMNS",
     "CARD_GROUPS",
     "audited_ids",
     "card_groups",
+    "control_summary",
+    "kind_counts",
     "check_ids",
     "load_proofs",
     "read_results",
@@ -52,6 +56,21 @@ SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
 )
 
 _VERDICTS = ("proved", "refuted as expected", "unknown", "failed")
+_KINDS = ("theorem", "definitional")
+
+
+@dataclass(frozen=True)
+class VCRow:
+    """One verification condition of an obligation, as its folded details list it."""
+
+    name: str
+    depth: str | None             # propositional | ground | full (None: not measured)
+    solvers: tuple[str, ...]      # the solvers that confirm it
+    nonlinear: bool               # it holds nonlinear real arithmetic
+
+    def as_json(self) -> dict[str, Any]:
+        return {"name": self.name, "depth": self.depth, "solvers": list(self.solvers),
+                "nonlinear": self.nonlinear}
 
 
 @dataclass(frozen=True)
@@ -75,6 +94,9 @@ class ObligationRow:
     label: str = ""                # what the proof does not cover, in a few words
     z3_only: tuple[str, ...] = ()  # "VC: why" for each VC only Z3 confirms
     summary: str | None = None     # one plain sentence (cfmpa.proofs.obligation_summary)
+    kind: str = "theorem"          # theorem | definitional (cfmpa.proofs.kind_of)
+    kind_why: str = ""             # why a definitional one is (results.json's kind_why)
+    vcs: tuple[VCRow, ...] = ()
 
     @property
     def as_expected(self) -> bool:
@@ -87,7 +109,34 @@ class ObligationRow:
                 "seconds": self.seconds, "counterexample": self.counterexample,
                 "reason": self.reason, "sha256": self.sha256, "change": self.change,
                 "depth": self.depth, "solvers": list(self.solvers), "label": self.label,
-                "z3_only": list(self.z3_only), "summary": self.summary}
+                "z3_only": list(self.z3_only), "summary": self.summary, "kind": self.kind,
+                "kind_why": self.kind_why, "vcs": [v.as_json() for v in self.vcs]}
+
+
+@dataclass(frozen=True)
+class ControlRow:
+    """A negative control of ``cfmpa prove`` (docs/model.md §10.3) as results.json recorded it.
+
+    ``ok`` is the report's own reading: the outcome is one the control expects, and the file
+    does not say otherwise; a recorded ``ok`` is not taken on trust."""
+
+    id: str
+    checker: str
+    what: str
+    expected: tuple[str, ...]
+    outcome: str
+    detail: str
+    seconds: float | None
+    recorded_ok: bool | None
+
+    @property
+    def ok(self) -> bool:
+        return self.outcome in self.expected and self.recorded_ok is not False
+
+    def as_json(self) -> dict[str, Any]:
+        return {"id": self.id, "checker": self.checker, "what": self.what,
+                "expected": list(self.expected), "outcome": self.outcome, "ok": self.ok,
+                "detail": self.detail, "seconds": self.seconds}
 
 
 @dataclass(frozen=True)
@@ -104,6 +153,12 @@ class ProofData:
     unexpected_ids: tuple[str, ...] = ()   # in the data, not expected
     run: dict[str, Any] | None = None      # results.json's "run" record (None: fresh, or absent)
     not_run: tuple[str, ...] = ()          # ids results.json carried over from an earlier run
+    #: The negative controls; None: none in this data (a fresh run, or a results.json without
+    #: them), said in ``controls_note``.
+    controls: tuple[ControlRow, ...] | None = None
+    controls_note: str = ""
+    missing_controls: tuple[str, ...] = ()  # expected of a whole prove run, not in the data
+    depth_measures: str = ""                # what results.json says ``depth`` measures
 
 
 def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
@@ -178,7 +233,27 @@ def summary_table(rows: Iterable[ObligationRow]) -> dict[str, Any]:
             bucket[key] += 1
     return {"columns": [{"key": k, "heading": h} for k, h in SUMMARY_COLUMNS],
             "rows": [{"group": name, **counts} for name, counts in groups.items()],
-            "total": total}
+            "total": total, "kinds": kind_counts(rows)}
+
+
+def kind_counts(rows: Iterable[ObligationRow]) -> dict[str, int]:
+    """How many obligations are theorems and how many definitional (the headline's counts):
+    a definitional one is true by a definition's own clauses, a termination measure or a named
+    choice instance (docs/model.md §10), and is not counted among the theorems."""
+    out = dict.fromkeys(_KINDS, 0)
+    for r in rows:
+        out[r.kind] += 1
+    return out
+
+
+def control_summary(rows: Iterable[ControlRow]) -> dict[str, int]:
+    """How the negative controls ended, by the report's reading: in all, as expected, and per
+    outcome (rejected, refuted, unknown, accepted, proved, error)."""
+    rows = list(rows)
+    out = {"total": len(rows), "as_expected": sum(r.ok for r in rows)}
+    for r in rows:
+        out[r.outcome] = out.get(r.outcome, 0) + 1
+    return out
 
 
 @dataclass(frozen=True)
@@ -270,13 +345,59 @@ def _from_file(path: Path, expected: Sequence[str], keep: set[str] | None = None
     ledger = _ledger_entries(ledger_doc) if isinstance(ledger_doc, list) else ()
     missing, unexpected = check_ids([r.id for r in rows], expected)
     run = doc.get("run") if isinstance(doc.get("run"), dict) else None
+    controls, controls_note, missing_controls = _controls_from_json(doc, path, expected)
+    depth = doc.get("depth") if isinstance(doc.get("depth"), dict) else {}
     return ProofData(available=True, source=f"read from {path}",
                      note="the results the prove run recorded, not re-run for this report"
                      + (f"; left out, as not the workcells reported on: the checks of "
                         f"{', '.join(left_out)}" if left_out else ""),
                      rows=rows, ledger=ledger, ledger_available=isinstance(ledger_doc, list),
                      missing_ids=missing, unexpected_ids=unexpected, run=run,
-                     not_run=tuple(r.id for r in rows if r.change == "not run"))
+                     not_run=tuple(r.id for r in rows if r.change == "not run"),
+                     controls=controls, controls_note=controls_note,
+                     missing_controls=missing_controls,
+                     depth_measures=str(depth.get("measures") or ""))
+
+
+def _controls_from_json(doc: dict[str, Any], path: Path, expected: Sequence[str]
+                        ) -> tuple[tuple[ControlRow, ...] | None, str, tuple[str, ...]]:
+    """(controls, note, missing control ids) of a results.json. When the report expects every
+    scenario-independent obligation (a whole prove run), it expects every control of
+    ``cfmpa.proofs.collect_controls()`` too: a results.json with controls left out (or none)
+    does not pass for a complete one."""
+    from ..proofs import FIXED_IDS, collect_controls
+
+    items = doc.get("controls")
+    if items is not None and not isinstance(items, list):
+        raise InputError("controls", items, f"in {path} must be a list")
+    rows = None if items is None else tuple(_control_from_json(c, k, path)
+                                            for k, c in enumerate(items))
+    missing: tuple[str, ...] = ()
+    if set(FIXED_IDS) <= set(expected):
+        have = {r.id for r in rows or ()}
+        missing = tuple(c.id for c in collect_controls() if c.id not in have)
+    if rows is None:
+        return None, (f"{path} records no negative controls (a results.json of an older "
+                      "cfmpa prove)"), missing
+    if not rows:
+        return rows, "the prove run selected no negative control (cfmpa prove --only)", missing
+    return rows, f"read from {path}, as the prove run recorded them", missing
+
+
+def _control_from_json(item: Any, k: int, path: Path) -> ControlRow:
+    field = f"controls[{k}]"
+    if not isinstance(item, dict) or not isinstance(item.get("id"), str):
+        raise InputError(field, item, f"in {path} must be an object with an 'id'")
+    expected = item.get("expected")
+    if not isinstance(expected, list) or not all(isinstance(e, str) for e in expected):
+        raise InputError(f"{field}.expected", expected, f"in {path} must be a list of outcomes")
+    seconds = item.get("seconds")
+    ok = item.get("ok")
+    return ControlRow(id=item["id"], checker=str(item.get("checker") or ""),
+                      what=str(item.get("what") or ""), expected=tuple(expected),
+                      outcome=str(item.get("outcome") or ""), detail=str(item.get("detail") or ""),
+                      seconds=float(seconds) if isinstance(seconds, (int, float)) else None,
+                      recorded_ok=ok if isinstance(ok, bool) else None)
 
 
 def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
@@ -300,7 +421,27 @@ def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
         depth=item.get("depth") if isinstance(item.get("depth"), str) else None,
         solvers=tuple(str(s) for s in item.get("solvers") or ()),
         label=str(item.get("label") or ""), z3_only=_z3_only(item.get("vcs")),
-        summary=obligation_summary(item["id"]))
+        summary=obligation_summary(item["id"]), kind=_kind(item, k, path),
+        kind_why=str(item.get("kind_why") or ""), vcs=_vc_rows(item.get("vcs")))
+
+
+def _kind(item: dict[str, Any], k: int, path: Path) -> str:
+    """results.json's kind; an older file without one: the prove machinery's (kind_of)."""
+    from ..proofs import kind_of
+
+    kind = item.get("kind", kind_of(item["id"]))
+    if kind not in _KINDS:
+        raise InputError(f"obligations[{k}].kind", kind,
+                         f"in {path} must be one of {', '.join(_KINDS)}")
+    return str(kind)
+
+
+def _vc_rows(vcs: Any) -> tuple[VCRow, ...]:
+    return tuple(VCRow(name=str(v.get("name")), depth=v.get("depth") if isinstance(
+                     v.get("depth"), str) else None,
+                     solvers=tuple(str(x) for x in v.get("solvers") or ()),
+                     nonlinear=v.get("nonlinear") is True)
+                 for v in (vcs if isinstance(vcs, list) else ()) if isinstance(v, dict))
 
 
 def _z3_only(vcs: Any) -> tuple[str, ...]:
@@ -315,7 +456,7 @@ def _z3_only(vcs: Any) -> tuple[str, ...]:
 # --- a fresh run --------------------------------------------------------------------------------
 
 def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
-    from ..proofs import ASSUMPTIONS, discharge, obligation_summary
+    from ..proofs import ASSUMPTIONS, DEFINITIONAL, discharge, kind_of, obligation_summary
 
     rows = []
     for ob in obligations:
@@ -327,14 +468,19 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
             sha256=p.sha256, depth=p.depth, solvers=p.solvers, label=p.label,
             z3_only=tuple(f"{v.name}: {v.note or 'no second solver confirmed it'}"
                           for v in p.vcs if v.solvers == ("z3",)),
-            summary=obligation_summary(ob.id)))
+            summary=obligation_summary(ob.id), kind=kind_of(ob.id),
+            kind_why=DEFINITIONAL.get(ob.id, ""),
+            vcs=tuple(VCRow(v.name, v.depth, tuple(v.solvers), bool(v.nonlinear))
+                      for v in p.vcs)))
     missing, unexpected = check_ids([r.id for r in rows], expected)
     return ProofData(available=True, source="a fresh run of the prove machinery for this report",
                      note=f"{len(rows)} obligations discharged in this process, "
                      f"{sum(r.seconds or 0.0 for r in rows):.1f} s in all; nothing written under "
                      "build/proofs",
                      rows=tuple(rows), ledger=_ledger_entries(ASSUMPTIONS), ledger_available=True,
-                     missing_ids=missing, unexpected_ids=unexpected)
+                     missing_ids=missing, unexpected_ids=unexpected,
+                     controls_note="not run for this report: cfmpa prove runs the negative "
+                     "controls; give its results.json (cfmpa audit --proofs) to show them")
 
 
 def _ledger_entries(entries: Iterable[Any]) -> tuple[dict[str, str], ...]:

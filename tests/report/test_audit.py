@@ -40,7 +40,8 @@ from cfmpa.errors import InputError
 from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
-from cfmpa.report._audit import _proof_sections, _verdict, contract_rows, workcell_summary
+from cfmpa.report._audit import (_controls_item, _proof_sections, _verdict, contract_rows,
+                                 workcell_summary)
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
 from cfmpa.gitstate import MAX_PATHS, git_state
@@ -50,8 +51,10 @@ ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
 SCHEMA = ROOT / "report" / "schema.json"
 CHROMIUM = Path("/usr/bin/chromium")
-#: A subset of obligations that discharges in a few seconds, across several groups and verdicts.
-OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival"]
+#: A subset of obligations that discharges in a few seconds, across several groups and verdicts,
+#: and the negative controls of three checkers (a second in all).
+OBLIGATIONS = ["Def1", "Lemma1", "Prop8", "Def4", "Margin.naive_hull", "Scenario.early-arrival",
+               "Control.witness", "Control.dr", "Control.path"]
 #: The ids that subset must produce, picked the way `cfmpa prove --only` picks them.
 EXPECTED = [i for i in expected_ids(ROOT / "scenarios") if selected(i, OBLIGATIONS)]
 
@@ -74,16 +77,71 @@ def results_json(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def report(tiny_file, results_json, tmp_path_factory):
+    import cfmpa.report._figures as figures
+
     out = tmp_path_factory.mktemp("audit")
     argv = ["cfmpa", "audit", str(tiny_file), "--out", str(out)]
     progress = io.StringIO()
-    result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
-                         compare_n=4, compare_seed=3, expected_ids=EXPECTED, progress=progress)
+    layout: dict[str, list[str]] = {}   # figure id -> its legends over axis or tick labels
+    save = figures._save
+
+    def saved(fig, fid, caption, alt):
+        layout[fid] = figures.legend_overlaps(fig)
+        return save(fig, fid, caption, alt)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(figures, "_save", saved)
+        result = build_audit([str(tiny_file)], argv=argv, proofs_json=str(results_json),
+                             compare_n=4, compare_seed=3, expected_ids=EXPECTED,
+                             progress=progress)
     write_report(result, out)
     doc = json.loads((out / "report.json").read_text())
     html = (out / "report.html").read_text()
     return {"result": result, "out": out, "doc": doc, "html": html, "argv": argv,
-            "progress": progress.getvalue()}
+            "progress": progress.getvalue(), "layout": layout}
+
+
+def test_no_legend_covers_an_axis_label(report):
+    # Every picture of the report, the workcell figure (whose legend covered "x (m)") included.
+    layout = report["layout"]
+    assert set(layout) == set(report["result"].figures)
+    assert any(fid.endswith("-workcell") for fid in layout)
+    assert {fid: bad for fid, bad in layout.items() if bad} == {}
+
+
+def test_a_six_panel_workcell_figure_keeps_its_legend_off_the_labels(tiny_file, monkeypatch):
+    # Six instants fill the 2 x 3 panels, so the legend goes under them (the default workcell's
+    # case, where it covered the bottom row's "x (m)"); the fixture's tiny plan has five.
+    import cfmpa.report._figures as figures
+    from cfmpa.spec import Variant, load_scenario, make_grid
+
+    s = load_scenario(tiny_file)
+    g = make_grid(s)
+    path = [s.right.start_cell] * (g.N + 8)           # still after Tf: t_end past the principal
+    t_end = (len(path) - 1) * s.dt
+    t_min = (g.Tf + t_end) / 2
+    assert len(workcell_instants(g.Tf, t_end, s.dt, t_min)) == 6
+    seen = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, fid, *a: seen.setdefault(
+        fid, figures.legend_overlaps(fig)))
+    figures.workcell_figure("w", s, g, path, Variant.MODIFIED, t_min, 0.01)
+    assert seen == {"w": []}
+
+
+def test_the_layout_check_sees_a_legend_over_an_axis_label():
+    import matplotlib.pyplot as plt
+    from cfmpa.report._figures import legend_overlaps
+
+    fig, ax = plt.subplots(figsize=(4, 3))
+    ax.plot([0, 1], [0, 1], label="a line with a long legend entry")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    fig.tight_layout()
+    assert legend_overlaps(fig) == []
+    # The seeded fault: a figure legend at the figure's foot, where the x label is.
+    fig.legend(loc="lower center", frameon=False)
+    bad = legend_overlaps(fig)
+    plt.close(fig)
+    assert any("x label 'x (m)'" in b for b in bad), bad
 
 
 def test_the_audit_prints_a_line_per_stage_with_its_time(report):
@@ -513,6 +571,134 @@ def test_ids_of_a_doctored_results_json_are_checked_not_copied(report, tmp_path)
     assert set(partial.missing_ids) == set(expected_ids(ROOT / "scenarios")) - set(EXPECTED)
 
 
+def test_negative_controls_are_shown_from_results_json(report):
+    doc, html = report["doc"], report["html"]
+    recorded = json.loads(_results(report)["text"])["controls"]
+    assert len(recorded) == 4, [c["id"] for c in recorded]   # witness x2, dr, path
+    ctl = doc["controls"]
+    assert ctl["available"] and not ctl["missing_ids"]
+    assert [(c["id"], c["outcome"], c["expected"], c["what"]) for c in ctl["items"]] == [
+        (c["id"], c["outcome"], c["expected"], c["what"]) for c in recorded]
+    assert ctl["summary"] == {"total": 4, "as_expected": 4, "rejected": 4}
+    table = html[html.index('id="controls"'):]
+    table = table[:table.index("</table>")]
+    for c in recorded:
+        row = table[table.index(f'id="control-{c["id"].replace(".", "-").replace("_", "-").lower()}"'):]
+        row = row[:row.index("</tr>")]
+        assert c["id"] in row and str(escape(c["what"])) in row and ">rejected<" in row
+        assert "as expected" in row and "FAILED" not in row
+    assert "4 of 4 as expected: rejected 4." in table
+    item = _check(doc, "negative controls as expected")
+    assert item["ok"] is True and item["detail"] == "4 of 4 (rejected 4)"
+
+
+def test_a_control_not_as_expected_fails_the_verdict(report, tmp_path):
+    # A checker that accepted its forged input; the file still claims ok.
+    doc = json.loads(_results(report)["text"])
+    doc["controls"][0].update(outcome="accepted", ok=True)
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
+    audit["verdict"] = _verdict(audit)
+    item = _check(audit, "negative controls as expected")
+    assert audit["verdict"]["ok"] is False and item["ok"] is False
+    cid = doc["controls"][0]["id"]
+    assert f"not as expected: {cid} (accepted, expected rejected)" in item["detail"]
+    assert audit["controls"]["summary"]["as_expected"] == 3
+    text = render_html(AuditResult(audit, report["result"].figures))
+    row = text[text.index(f'id="control-{cid.replace(".", "-").replace("_", "-").lower()}"'):]
+    assert "FAILED" in row[:row.index("</tr>")]
+    # A control whose outcome is expected but whose record says not ok is not ok either.
+    doc["controls"][0].update(outcome="rejected", ok=False)
+    bad.write_text(json.dumps(doc))
+    again = load_proofs(str(bad), ROOT / "scenarios", EXPECTED)
+    assert [c.ok for c in again.controls] == [False, True, True, True]
+
+
+def test_premise_controls_are_folded_unless_one_fails(report):
+    audit = copy.deepcopy(report["result"].doc)
+
+    def premise(i, outcome):
+        return {"id": f"Control.Safety.tight.composition.without[{i}]",
+                "checker": "Safety.tight.composition", "what": f"without: premise {i}",
+                "expected": ["refuted", "unknown"], "outcome": outcome,
+                "ok": outcome in ("refuted", "unknown"), "detail": "", "seconds": 1.0}
+    audit["controls"]["items"] += [premise(0, "refuted"), premise(1, "unknown")]
+    text = render_html(AuditResult(audit, report["result"].figures))
+    fold = text[text.index('<details class="group" id="controls-premises">'):]
+    fold = fold[:fold.index("</details>")]
+    assert "2 controls, 2 as expected" in fold and "without: premise 1" in fold
+    assert "as expected (undecided)" in fold        # unknown: weaker evidence, said so
+    checkers = text[text.index('id="controls"'):text.index('id="controls-premises"')]
+    assert "without: premise" not in checkers and "Control.witness.forged" in checkers
+    # A composition proved without its premise: the fold opens and says how many failed.
+    audit["controls"]["items"].append(premise(2, "proved"))
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert '<details class="group" id="controls-premises" open>' in text
+    assert "3 controls, 2 as expected" in text and ">1 FAILED</span>" in text
+    assert _controls_item(audit)["ok"] is False
+
+
+def test_a_whole_run_without_its_controls_fails_the_verdict(report, tmp_path):
+    # Controls deleted from a results.json that must be a whole run: not "not available".
+    from cfmpa.proofs import collect_controls
+
+    doc = json.loads(_results(report)["text"])
+    del doc["controls"]
+    bad = tmp_path / "results.json"
+    bad.write_text(json.dumps(doc))
+    audit = copy.deepcopy(report["result"].doc)
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios")))
+    assert audit["controls"]["available"] is False
+    assert audit["controls"]["missing_ids"] == [c.id for c in collect_controls()]
+    assert _check({"verdict": _verdict(audit)}, "negative controls as expected")["ok"] is False
+    # The same file read for a subset of obligations: nothing to show, not counted either way.
+    audit.update(_proof_sections(load_proofs(str(bad), ROOT / "scenarios", EXPECTED)))
+    item = _check({"verdict": _verdict(audit)}, "negative controls as expected")
+    assert item["ok"] is None and "records no negative controls" in item["detail"]
+    assert "Not available in this run" in render_html(AuditResult(audit,
+                                                                  report["result"].figures))
+
+
+def test_definitional_obligations_are_counted_apart_and_labelled(report):
+    from cfmpa.proofs import DEFINITIONAL
+
+    doc, html = report["doc"], report["html"]
+    ob = doc["obligations"]
+    recorded = {o["id"]: o for o in json.loads(_results(report)["text"])["obligations"]}
+    defs = [i["id"] for i in ob["items"] if i["kind"] == "definitional"]
+    assert defs and set(defs) == set(DEFINITIONAL) & set(recorded)
+    assert all(i["kind"] == recorded[i["id"]]["kind"] for i in ob["items"])
+    kinds = ob["summary"]["kinds"]
+    assert kinds == {"theorem": len(ob["items"]) - len(defs), "definitional": len(defs)}
+    assert (f"{len(ob['items'])} obligations: {kinds['theorem']} theorems, "
+            f"{kinds['definitional']} definitional.") in html
+    for i in ob["items"]:
+        card = html[html.index(f'id="ob-{i["id"].replace(".", "-").replace("_", "-").lower()}"'):]
+        card = card[:card.index('<div class="obligation"', 10) if '<div class="obligation"' in
+                    card[10:] else card.index('<h2 id="assumptions">')]
+        head = card[:card.index('<p class="summary">')]
+        assert ("definitional</span>" in head) is (i["kind"] == "definitional"), i["id"]
+        # Each VC is listed in the folded details with its nonlinear flag.
+        rows = re.findall(r'<tr><td class="mono">([^<]*)</td>.*?<td>(?:<span class="badge na">'
+                          r'(nonlinear)</span>|linear)</td></tr>', card)
+        assert [(n, f == "nonlinear") for n, f in rows] == [
+            (str(escape(v["name"])), v["nonlinear"]) for v in recorded[i["id"]]["vcs"]], i["id"]
+    nl = sum(v["nonlinear"] for o in recorded.values() for v in o["vcs"])
+    assert ob["depth"]["nonlinear_vcs"] == nl and ob["depth"]["measures"].startswith("quantifier")
+
+
+def test_a_fresh_run_shows_no_controls_and_does_not_count_them():
+    from cfmpa.report._obligations import ProofData
+
+    fresh = ProofData(available=True, source="fresh", note="", rows=(), ledger=(),
+                      ledger_available=True, controls_note="not run for this report")
+    part = _proof_sections(fresh)["controls"]
+    assert part == {"available": False, "note": "not run for this report",
+                    "summary": {"total": 0, "as_expected": 0}, "items": [], "missing_ids": []}
+
+
 def _check(audit, name):
     return next(i for i in audit["verdict"]["items"] if i["check"] == name)
 
@@ -657,6 +843,80 @@ def test_report_renders_in_headless_chromium(report, tmp_path):
     assert result["count"] == len(_figure_refs(report["doc"])) and result["bad"] == [], result
 
 
+#: Appended to a scratch copy of the page: after load, where section 1 is in the window and
+#: each obligation card's short summary, read from the DOM as the browser laid it out.
+_FIRST_SCREEN_PROBE = """<script>
+window.addEventListener("load", () => {
+  const s1 = document.getElementById("workcells");
+  const box = s1 ? s1.getBoundingClientRect() : null;
+  const table = s1 ? s1.querySelector("table") : null;
+  const cards = Array.from(document.querySelectorAll("div.obligation")).map(c => {
+    const p = c.querySelector(":scope > p.summary");
+    return {id: c.querySelector(".id").textContent,
+            summary: p ? p.textContent.trim() : null,
+            placeholder: p ? p.querySelector("em") !== null : true};
+  });
+  const out = document.createElement("pre");
+  out.id = "screen-probe";
+  out.textContent = JSON.stringify({
+    width: window.innerWidth, height: window.innerHeight,
+    top: box && box.top, table_top: table && table.getBoundingClientRect().top,
+    heading: s1 && s1.querySelector("h2").textContent, cards: cards});
+  document.body.appendChild(out);
+});
+</script>"""
+
+
+def _first_screen(tmp_path, html, name):
+    """The probe's reading of ``html`` in a 1400 x 900 headless Chromium window."""
+    probe = tmp_path / f"{name}.html"
+    probe.write_text(html.replace("</body>", _FIRST_SCREEN_PROBE + "\n</body>"))
+    dom = _chromium(tmp_path, "--window-size=1400,900", "--dump-dom",
+                    "--virtual-time-budget=10000", probe.as_uri())
+    assert dom.returncode == 0, dom.stderr[-2000:]
+    found = re.search(r'<pre id="screen-probe">(.*?)</pre>', dom.stdout, re.S)
+    assert found, "the probe did not run: " + dom.stderr[-1000:]
+    return json.loads(html_lib.unescape(found.group(1)))
+
+
+def _screen_problems(got, doc):
+    """What the first-screen reading shows wrong: section 1 not within the first 900 pixels,
+    a card missing, or a card without its short summary."""
+    out = []
+    if got["heading"] != "1. Verdict per workcell" or not (0 <= got["top"] < 900):
+        out.append(f"section 1 ({got['heading']!r}) starts at {got['top']} px")
+    if got["table_top"] is None or not (0 <= got["table_top"] < 900):
+        out.append(f"section 1's table starts at {got['table_top']} px")
+    summaries = {i["id"]: i["summary"] for i in doc["obligations"]["items"]}
+    if sorted(c["id"] for c in got["cards"]) != sorted(summaries):
+        out.append("the cards are not the obligations")
+    out += [f"{c['id']}: no short summary" for c in got["cards"]
+            if c["placeholder"] or c["summary"] != summaries.get(c["id"])]
+    return out
+
+
+@pytest.mark.browser
+def test_section_one_is_on_the_first_screen_and_every_card_has_its_summary(report, tmp_path):
+    if not CHROMIUM.exists():
+        pytest.skip("/usr/bin/chromium is absent (Debian package 'chromium'; .ci/run installs it)")
+    got = _first_screen(tmp_path, report["html"], "screen")
+    # Chromium's headless window of 1400 x 900 gives the page 1400 pixels' width and, with its
+    # window frame taken off, a little less height: section 1 must start within both.
+    assert got["width"] == 1400 and 0 < got["height"] <= 900, got
+    assert got["table_top"] < got["height"], got
+    assert _screen_problems(got, report["doc"]) == []
+    # Seeded faults: a block that pushes section 1 below the first screen, a card without its
+    # summary (rendered from a doc whose first obligation has none).
+    doc = copy.deepcopy(report["result"].doc)
+    first = doc["obligations"]["items"][0]
+    first["summary"] = None
+    html = render_html(AuditResult(doc, report["result"].figures)).replace(
+        '<section id="workcells">', '<div style="height: 1000px"></div><section id="workcells">')
+    bad = _screen_problems(_first_screen(tmp_path, html, "seeded"), report["doc"])
+    assert any(b.startswith("section 1 (") for b in bad), bad
+    assert f"{first['id']}: no short summary" in bad, bad
+
+
 # --- helpers --------------------------------------------------------------------------------------
 
 def _results(report):
@@ -687,7 +947,8 @@ def _golden(name: str, text: str) -> None:
 _OPEN = ("findings[].data", "scenarios[].variants[].contracts", "scenarios[].variants[].clearance",
          "scenarios[].variants[].kernel", "provenance.git.paths",
          "scenarios[].variants[].timings_s", "selftest.rows[]", "provenance.versions",
-         "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks")
+         "compare.cases[].outcomes", "compare.table[].no_path_reasons", "compare.checks",
+         "controls.summary")
 
 
 def _keys(x, prefix: str = "") -> set[str]:
