@@ -11,7 +11,8 @@ from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Var
 from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
                            contact_links_text, require_clear)
 from ._exact import ExactCell, ExactGaps, exact_path_gaps
-from ._trajectory import (ReferenceSpeeds, Trajectory, between_samples_bound, certify_trajectory,
+from ._trajectory import (CHUNK_ROWS, ReferenceSpeeds, Trajectory, TrajectorySummary,
+                          between_samples_bound, certify_trajectory, certify_trajectory_file,
                           csv_column_order, executed_trajectory,
                           load_trajectory, parse_trajectory_csv, parse_trajectory_json,
                           tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
@@ -68,6 +69,7 @@ __all__ = [
     "ExactCell", "ExactGaps", "exact_path_gaps",
     # trajectories and the tolerance tube (docs/model.md §12)
     "TRAJECTORY_COLUMNS", "Trajectory", "certify_trajectory", "csv_column_order",
+    "CHUNK_ROWS", "TrajectorySummary", "certify_trajectory_file",
     "executed_trajectory", "load_trajectory", "parse_trajectory_csv", "parse_trajectory_json",
     "tolerance_rad", "trajectory_csv", "trajectory_distances", "tube_lipschitz",
     # the monitor between samples (docs/model.md §12; proofs/_obl_monitor.py)
