@@ -1,17 +1,56 @@
 """The reference planner: kinematics, swept regions, BuiltDR, searchoptpath (clear first)."""
 
-from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
-                       contained_exactly, containment_slack, left_regions, left_spacing,
-                       right_regions)
-from ._builtdr_loops import build_dr_loops, builtdr_loop_nest
-from ._fast_builtdr import build_dr_fast
-from ._fast_search import search_opt_path_fast
-from ._kernels import KERNELS, kernel_name, kernels
-from ._kinematics import link_reach, link_rectangles
-from ._progress import progress_default, progress_silenced
-from ._search import search_opt_path
-from ._threads import kernel_threads, set_kernel_threads
-from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:     # the names as the type checker sees them; at run time _LAZY
+    from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
+                           contained_exactly, containment_slack, left_regions, left_spacing,
+                           right_regions)
+    from ._builtdr_loops import build_dr_loops, builtdr_loop_nest
+    from ._fast_builtdr import build_dr_fast
+    from ._fast_search import search_opt_path_fast
+    from ._kernels import KERNELS, kernel_name, kernels
+    from ._kinematics import link_reach, link_rectangles
+    from ._progress import progress_default, progress_silenced
+    from ._search import search_opt_path
+    from ._threads import kernel_threads, set_kernel_threads
+    from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
+
+#: Each public name -> (its module, its name there), imported on first use (PEP 562): a
+#: command loads only what it needs (the parser's --kernel choices load no numba, issue 24.6).
+_LAZY: dict[str, tuple[str, str]] = {
+    "ContainmentReport": ("._builtdr", "ContainmentReport"),
+    "LeftRegions": ("._builtdr", "LeftRegions"),
+    "RightRegions": ("._builtdr", "RightRegions"),
+    "build_dr": ("._builtdr", "build_dr"),
+    "check_containment": ("._builtdr", "check_containment"),
+    "contained_exactly": ("._builtdr", "contained_exactly"),
+    "containment_slack": ("._builtdr", "containment_slack"),
+    "left_regions": ("._builtdr", "left_regions"),
+    "left_spacing": ("._builtdr", "left_spacing"),
+    "right_regions": ("._builtdr", "right_regions"),
+    "build_dr_loops": ("._builtdr_loops", "build_dr_loops"),
+    "builtdr_loop_nest": ("._builtdr_loops", "builtdr_loop_nest"),
+    "build_dr_fast": ("._fast_builtdr", "build_dr_fast"),
+    "search_opt_path_fast": ("._fast_search", "search_opt_path_fast"),
+    "KERNELS": ("._kernels", "KERNELS"),
+    "kernel_name": ("._kernels", "kernel_name"),
+    "kernels": ("._kernels", "kernels"),
+    "link_reach": ("._kinematics", "link_reach"),
+    "link_rectangles": ("._kinematics", "link_rectangles"),
+    "progress_default": ("._progress", "progress_default"),
+    "progress_silenced": ("._progress", "progress_silenced"),
+    "search_opt_path": ("._search", "search_opt_path"),
+    "kernel_threads": ("._threads", "kernel_threads"),
+    "set_kernel_threads": ("._threads", "set_kernel_threads"),
+    "SNAP": ("._regions", "SNAP"),
+    "convex_hull": ("._regions", "convex_hull"),
+    "lattice_range": ("._regions", "lattice_range"),
+    "naive_hull": ("._regions", "naive_hull"),
+    "sweep_margin": ("._regions", "sweep_margin"),
+    "swept_region": ("._regions", "swept_region"),
+}
 
 __all__ = [
     "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "RightRegions", "build_dr",
@@ -21,3 +60,23 @@ __all__ = [
     "progress_silenced", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
     "set_kernel_threads", "swept_region",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """A public name, its module imported on first use (then bound here); a private module
+    (``_plan``) as ``import`` would give it."""
+    if name in _LAZY:
+        module, attr = _LAZY[name]
+        value = getattr(importlib.import_module(module, __name__), attr)
+        globals()[name] = value
+        return value
+    if name.startswith("_") and not name.startswith("__"):
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError:
+            pass
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

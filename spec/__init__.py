@@ -3,36 +3,166 @@
 The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 """
 
-from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
-from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
-from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
-                    VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
-                    left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
-from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
-                           contact_links_text, require_clear)
-from ._exact import ExactCell, ExactGaps, exact_path_gaps
-from ._trajectory import (CHUNK_ROWS, ReferenceSpeeds, Trajectory, TrajectorySummary,
-                          between_samples_bound, certify_trajectory, certify_trajectory_file,
-                          csv_column_order, executed_trajectory,
-                          load_trajectory, parse_trajectory_csv, parse_trajectory_json,
-                          tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
-from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
-from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name
-from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                     Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
-                     is_opt_path, is_path, is_path_paper, opt_path, path_violations)
-from ._polygon import polygon_distance, polygon_distances
-from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
-                        load_scenario, max_cells, parse_scenario)
-from ._triples import (TRIPLES, Failure, Triple, builtdr_triple, cells_failures, cost_failures,
-                       dr_cell_failures, dr_shape_failures, grid_failures, path_cells,
-                       search_failures, search_triple)
-from ._layers import (SPILL_BYTES, LayerSpill, Layers, npz_layers, npz_member, save_npz,
-                      spill_wanted)
-from ._witness import (KEY_BASE, LABEL_LIMITS, WITNESS_FORMAT, Witness, check_witness,
-                       closure_breaks, edge_bound, edge_holds, exclusion_breaks, goal_holds,
-                       label_in_range, label_key, load_witness, start_breaks, step_cost,
-                       stop_key)
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:     # the names as the type checker sees them; at run time _LAZY
+    from ._counts import MAX_EXTRA_POINTS, decimal, joint_grid
+    from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
+    from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
+                        VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
+                        left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
+    from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
+                               contact_links_text, require_clear)
+    from ._exact import ExactCell, ExactGaps, exact_path_gaps
+    from ._trajectory import (CHUNK_ROWS, ReferenceSpeeds, Trajectory, TrajectorySummary,
+                              between_samples_bound, certify_trajectory, certify_trajectory_file,
+                              csv_column_order, executed_trajectory,
+                              load_trajectory, parse_trajectory_csv, parse_trajectory_json,
+                              tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
+    from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
+    from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name
+    from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
+                         Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
+                         is_opt_path, is_path, is_path_paper, opt_path, path_violations)
+    from ._polygon import polygon_distance, polygon_distances
+    from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
+                            load_scenario, max_cells, parse_scenario)
+    from ._triples import (TRIPLES, Failure, Triple, builtdr_triple, cells_failures, cost_failures,
+                           dr_cell_failures, dr_shape_failures, grid_failures, path_cells,
+                           search_failures, search_triple)
+    from ._layers import (SPILL_BYTES, LayerSpill, Layers, npz_layers, npz_member, save_npz,
+                          spill_wanted)
+    from ._witness import (KEY_BASE, LABEL_LIMITS, WITNESS_FORMAT, Witness, check_witness,
+                           closure_breaks, edge_bound, edge_holds, exclusion_breaks, goal_holds,
+                           label_in_range, label_key, load_witness, start_breaks, step_cost,
+                           stop_key)
+
+#: Each public name -> (its module, its name there), imported on first use (PEP 562): a
+#: command loads only what it needs (no python-flint or shapely for `cfmpa certify`, issue 24.6).
+_LAZY: dict[str, tuple[str, str]] = {
+    "MAX_EXTRA_POINTS": ("._counts", "MAX_EXTRA_POINTS"),
+    "decimal": ("._counts", "decimal"),
+    "joint_grid": ("._counts", "joint_grid"),
+    "cases": ("._arith", "cases"),
+    "ceil_of": ("._arith", "ceil_of"),
+    "floor_of": ("._arith", "floor_of"),
+    "if_then": ("._arith", "if_then"),
+    "max_of": ("._arith", "max_of"),
+    "min_of": ("._arith", "min_of"),
+    "DISTANCE_ERROR_M": ("._grid", "DISTANCE_ERROR_M"),
+    "EPS": ("._grid", "EPS"),
+    "MAX_COORD_M": ("._grid", "MAX_COORD_M"),
+    "UNIT_ROUNDOFF": ("._grid", "UNIT_ROUNDOFF"),
+    "Grid": ("._grid", "Grid"),
+    "Variant": ("._grid", "Variant"),
+    "VariantRule": ("._grid", "VariantRule"),
+    "cell_box": ("._grid", "cell_box"),
+    "exact_n": ("._grid", "exact_n"),
+    "exact_tf": ("._grid", "exact_tf"),
+    "joint_points": ("._grid", "joint_points"),
+    "left_angles": ("._grid", "left_angles"),
+    "left_box": ("._grid", "left_box"),
+    "make_grid": ("._grid", "make_grid"),
+    "ptp_angles": ("._grid", "ptp_angles"),
+    "rest_box": ("._grid", "rest_box"),
+    "right_box": ("._grid", "right_box"),
+    "rule_of": ("._grid", "rule_of"),
+    "Certificate": ("._certificate", "Certificate"),
+    "ContactDetail": ("._certificate", "ContactDetail"),
+    "certificate_json": ("._certificate", "certificate_json"),
+    "certify": ("._certificate", "certify"),
+    "closest_links": ("._certificate", "closest_links"),
+    "contact_links_text": ("._certificate", "contact_links_text"),
+    "require_clear": ("._certificate", "require_clear"),
+    "ExactCell": ("._exact", "ExactCell"),
+    "ExactGaps": ("._exact", "ExactGaps"),
+    "exact_path_gaps": ("._exact", "exact_path_gaps"),
+    "CHUNK_ROWS": ("._trajectory", "CHUNK_ROWS"),
+    "ReferenceSpeeds": ("._trajectory", "ReferenceSpeeds"),
+    "Trajectory": ("._trajectory", "Trajectory"),
+    "TrajectorySummary": ("._trajectory", "TrajectorySummary"),
+    "between_samples_bound": ("._trajectory", "between_samples_bound"),
+    "certify_trajectory": ("._trajectory", "certify_trajectory"),
+    "certify_trajectory_file": ("._trajectory", "certify_trajectory_file"),
+    "csv_column_order": ("._trajectory", "csv_column_order"),
+    "executed_trajectory": ("._trajectory", "executed_trajectory"),
+    "load_trajectory": ("._trajectory", "load_trajectory"),
+    "parse_trajectory_csv": ("._trajectory", "parse_trajectory_csv"),
+    "parse_trajectory_json": ("._trajectory", "parse_trajectory_json"),
+    "tolerance_rad": ("._trajectory", "tolerance_rad"),
+    "trajectory_csv": ("._trajectory", "trajectory_csv"),
+    "trajectory_distances": ("._trajectory", "trajectory_distances"),
+    "tube_lipschitz": ("._trajectory", "tube_lipschitz"),
+    "TRAJECTORY_COLUMNS": ("._trajectory", "COLUMNS"),
+    "LINK_WORDS": ("._kinematics", "LINK_WORDS"),
+    "arm_corners": ("._kinematics", "arm_corners"),
+    "joints": ("._kinematics", "joints"),
+    "link_corners": ("._kinematics", "link_corners"),
+    "link_name": ("._kinematics", "link_name"),
+    "J1": ("._paths", "J1"),
+    "J2": ("._paths", "J2"),
+    "MOVES": ("._paths", "MOVES"),
+    "REASON_GOAL_BLOCKED": ("._paths", "REASON_GOAL_BLOCKED"),
+    "REASON_START_BLOCKED": ("._paths", "REASON_START_BLOCKED"),
+    "REASON_UNREACHABLE": ("._paths", "REASON_UNREACHABLE"),
+    "Cell": ("._paths", "Cell"),
+    "PathViolation": ("._paths", "PathViolation"),
+    "SearchResult": ("._paths", "SearchResult"),
+    "SearchStatus": ("._paths", "SearchStatus"),
+    "check_search_inputs": ("._paths", "check_search_inputs"),
+    "is_opt_path": ("._paths", "is_opt_path"),
+    "is_path": ("._paths", "is_path"),
+    "is_path_paper": ("._paths", "is_path_paper"),
+    "opt_path": ("._paths", "opt_path"),
+    "path_violations": ("._paths", "path_violations"),
+    "polygon_distance": ("._polygon", "polygon_distance"),
+    "polygon_distances": ("._polygon", "polygon_distances"),
+    "ANGLE_TOLERANCE": ("._scenario", "ANGLE_TOLERANCE"),
+    "DEFAULT_MAX_CELLS": ("._scenario", "DEFAULT_MAX_CELLS"),
+    "Arm": ("._scenario", "Arm"),
+    "LeftArm": ("._scenario", "LeftArm"),
+    "RightArm": ("._scenario", "RightArm"),
+    "Scenario": ("._scenario", "Scenario"),
+    "load_scenario": ("._scenario", "load_scenario"),
+    "max_cells": ("._scenario", "max_cells"),
+    "parse_scenario": ("._scenario", "parse_scenario"),
+    "TRIPLES": ("._triples", "TRIPLES"),
+    "Failure": ("._triples", "Failure"),
+    "Triple": ("._triples", "Triple"),
+    "builtdr_triple": ("._triples", "builtdr_triple"),
+    "cells_failures": ("._triples", "cells_failures"),
+    "cost_failures": ("._triples", "cost_failures"),
+    "dr_cell_failures": ("._triples", "dr_cell_failures"),
+    "dr_shape_failures": ("._triples", "dr_shape_failures"),
+    "grid_failures": ("._triples", "grid_failures"),
+    "path_cells": ("._triples", "path_cells"),
+    "search_failures": ("._triples", "search_failures"),
+    "search_triple": ("._triples", "search_triple"),
+    "SPILL_BYTES": ("._layers", "SPILL_BYTES"),
+    "LayerSpill": ("._layers", "LayerSpill"),
+    "Layers": ("._layers", "Layers"),
+    "npz_layers": ("._layers", "npz_layers"),
+    "npz_member": ("._layers", "npz_member"),
+    "save_npz": ("._layers", "save_npz"),
+    "spill_wanted": ("._layers", "spill_wanted"),
+    "KEY_BASE": ("._witness", "KEY_BASE"),
+    "LABEL_LIMITS": ("._witness", "LABEL_LIMITS"),
+    "WITNESS_FORMAT": ("._witness", "WITNESS_FORMAT"),
+    "Witness": ("._witness", "Witness"),
+    "check_witness": ("._witness", "check_witness"),
+    "closure_breaks": ("._witness", "closure_breaks"),
+    "edge_bound": ("._witness", "edge_bound"),
+    "edge_holds": ("._witness", "edge_holds"),
+    "exclusion_breaks": ("._witness", "exclusion_breaks"),
+    "goal_holds": ("._witness", "goal_holds"),
+    "label_in_range": ("._witness", "label_in_range"),
+    "label_key": ("._witness", "label_key"),
+    "load_witness": ("._witness", "load_witness"),
+    "start_breaks": ("._witness", "start_breaks"),
+    "step_cost": ("._witness", "step_cost"),
+    "stop_key": ("._witness", "stop_key"),
+}
 
 __all__ = [
     # scenario, grids and motion (docs/model.md §2-§3)
@@ -75,3 +205,23 @@ __all__ = [
     # the monitor between samples (docs/model.md §12; proofs/_obl_monitor.py)
     "ReferenceSpeeds", "between_samples_bound",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """A public name, its module imported on first use (then bound here); a private module
+    (``_plan``) as ``import`` would give it."""
+    if name in _LAZY:
+        module, attr = _LAZY[name]
+        value = getattr(importlib.import_module(module, __name__), attr)
+        globals()[name] = value
+        return value
+    if name.startswith("_") and not name.startswith("__"):
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError:
+            pass
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
