@@ -156,7 +156,8 @@ def prove_motion(motion: Any, *, max_depth: int = DEFAULT_MAX_DEPTH,
     """The proof loop of the module docstring, shared by the grid path's motion and a trajectory.
 
     ``motion`` gives ``pieces()``, ``lipschitz(seg, moving)``, ``distances(t, seg)`` and
-    ``detail(contact, seg)``. With ``first_contact`` a found contact does not stop the search:
+    ``detail(contact, seg)``, and may give ``end_distances(t0, t1, seg)``: both ends' distances
+    at once, the same values as two ``distances`` calls (fewer computed). With ``first_contact`` a found contact does not stop the search:
     every interval before it is still decided (halved down to ``max_depth``), so the contact
     reported is the first one, to within a piece's length / 2^max_depth.
     """
@@ -199,8 +200,9 @@ class Prover:
         first_contact, max_depth = self.first_contact, self.max_depth
         t0, t1, seg, moving = motion.pieces()
         lip = motion.lipschitz(seg, moving)                       # (K, 2, 2)
-        d0 = motion.distances(t0, seg)
-        d1 = motion.distances(t1, seg)
+        ends = getattr(motion, "end_distances", None)
+        d0, d1 = ends(t0, t1, seg) if ends else (motion.distances(t0, seg),
+                                                 motion.distances(t1, seg))
         depth = np.zeros(len(t0), dtype=np.int64)
         self.samples += 2 * len(t0)
 

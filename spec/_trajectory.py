@@ -461,6 +461,24 @@ class _TrajectoryMotion:
     def distances(self, t: FloatArray, seg: npt.NDArray[np.int64]) -> FloatArray:
         return trajectory_distances(self.scenario, self.angles(t, seg))
 
+    def end_distances(self, t0: FloatArray, t1: FloatArray,
+                      seg: npt.NDArray[np.int64]) -> tuple[FloatArray, FloatArray]:
+        """``distances(t0, seg), distances(t1, seg)`` of consecutive pieces, each configuration
+        computed once: where piece k's end (row k interpolated to u = 1) is bit for bit piece
+        k + 1's start (row k + 1), its distances are the same numbers (trajectory_distances is
+        one configuration's function), so they are copied instead of computed again."""
+        a0, a1 = self.angles(t0, seg), self.angles(t1, seg)
+        d0 = trajectory_distances(self.scenario, a0)
+        d1 = np.empty_like(d0)
+        same = np.zeros(len(a1), dtype=bool)
+        if len(a1) > 1:
+            bits0 = np.ascontiguousarray(a0).view(np.int64)
+            bits1 = np.ascontiguousarray(a1).view(np.int64)
+            same[:-1] = np.all(bits1[:-1] == bits0[1:], axis=1)
+        d1[same] = d0[1:][same[:-1]]
+        d1[~same] = trajectory_distances(self.scenario, a1[~same])
+        return d0, d1
+
     def detail(self, contact: tuple[float, tuple[int, int]], seg: int) -> ContactDetail:
         t, links = contact
         a = self.angles(np.array([t]), np.array([seg], dtype=np.int64))[0]

@@ -119,7 +119,7 @@ def test_streamed_certify_of_the_bundled_plans(tmp_path):
     from cfmpa.runs import plan, write_plan
     for name in ("default", "narrow-gap"):
         s = load_scenario(BUNDLED_DIR / f"{name}.toml")
-        res = plan(s, contracts="off")
+        res = plan(s, "modified", contracts="off")
         write_plan(res, tmp_path / name)
         path = tmp_path / name / "traj.csv"
         assert _streamed(s, path) == _whole(s, path), name
@@ -263,3 +263,35 @@ def test_no_part_holds_more_than_its_rows_and_the_carried_one(workcell, tmp_path
     # contiguous: each part starts at the previous one's last row, and the last ends at row 299
     assert all(o == po + pn - 1 for (po, pn), (o, _) in zip(seen, seen[1:]))
     assert seen[-1][0] + seen[-1][1] == 300
+
+
+def _ends_mismatch(motion) -> bool:
+    t0, t1, seg, _ = motion.pieces()
+    d0, d1 = motion.end_distances(t0, t1, seg)
+    want0, want1 = motion.distances(t0, seg), motion.distances(t1, seg)
+    return not (np.array_equal(d0.view(np.int64), want0.view(np.int64))
+                and np.array_equal(d1.view(np.int64), want1.view(np.int64)))
+
+
+def test_end_distances_are_the_two_distance_calls_bit_for_bit(workcell):
+    s, _, _, _ = workcell
+    rng = np.random.default_rng(3)      # angles of very different sizes: a0 + (a1 - a0) != a1
+    a = rng.uniform(0, 6, (400, 4)) * 10.0 ** rng.uniform(-6, 0, (400, 4))
+    traj = Trajectory(np.arange(400.0), a)
+    m = tr._TrajectoryMotion(s, traj)
+    t0, t1, seg, _ = m.pieces()
+    a0, a1 = m.angles(t0, seg), m.angles(t1, seg)
+    shared = np.all(a1[:-1] == a0[1:], axis=1)
+    assert shared.any() and not shared.all()      # both branches: copied and computed
+    assert not _ends_mismatch(m)
+    assert not _ends_mismatch(tr._TrajectoryMotion(s, Trajectory(traj.t[:1], traj.angles[:1])))
+
+
+def test_seeded_fault_end_distances_copied_from_the_wrong_piece_is_caught(workcell):
+    s, _, _, _ = workcell
+
+    class Shifted(tr._TrajectoryMotion):
+        def end_distances(self, t0, t1, seg):
+            d0, d1 = super().end_distances(t0, t1, seg)
+            return d0, np.concatenate([d0[:1], d1[:-1]])
+    assert _ends_mismatch(Shifted(s, _random(s, 50, 3, (2.5, 4.5))))
