@@ -157,9 +157,10 @@ def prove_motion(motion: Any, *, max_depth: int = DEFAULT_MAX_DEPTH,
 
     ``motion`` gives ``pieces()``, ``lipschitz(seg, moving)``, ``distances(t, seg)`` and
     ``detail(contact, seg)``, and may give ``end_distances(t0, t1, seg)``: both ends' distances
-    at once, the same values as two ``distances`` calls (fewer computed). With ``first_contact`` a found contact does not stop the search:
-    every interval before it is still decided (halved down to ``max_depth``), so the contact
-    reported is the first one, to within a piece's length / 2^max_depth.
+    at once, the same values as two ``distances`` calls (fewer computed). With
+    ``first_contact`` a found contact does not stop the search: every interval before it is
+    still decided (halved down to ``max_depth``), so the contact reported is the first one, to
+    within a piece's length / 2^max_depth.
     """
     prover = Prover(max_depth=max_depth, bound_ratio=bound_ratio, max_intervals=max_intervals,
                     first_contact=first_contact)
