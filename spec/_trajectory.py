@@ -36,7 +36,7 @@ from array import array
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, cast
+from typing import IO, Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -654,7 +654,8 @@ def certify_trajectory_file(path: str | Path, s: Scenario, *, allow_speed: bool 
                         None) from None
         with fh:
             reader = _HashingReader(fh)
-            lines = bounded_lines(reader, source, total=LIMITS["trajectory"])
+            # cast: bounded_lines reads only readline(size) of a binary stream
+            lines = bounded_lines(cast(IO[bytes], reader), source, total=LIMITS["trajectory"])
             first = next(lines, "")
             if not first.lstrip().startswith("{"):
                 parts = _csv_parts(itertools.chain([first], lines), s, source, allow_speed,
