@@ -11,7 +11,8 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time _LA
     from ._arith import cases, ceil_of, floor_of, if_then, max_of, min_of
     from ._grid import (DISTANCE_ERROR_M, EPS, MAX_COORD_M, UNIT_ROUNDOFF, Grid, Variant,
                         VariantRule, cell_box, exact_n, exact_tf, joint_points, left_angles,
-                        left_box, make_grid, ptp_angles, rest_box, right_box, rule_of)
+                        left_box, make_grid, ptp_angles, ptp_fraction, rest_box, right_box,
+                        rule_of)
     from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
                                contact_links_text, require_clear)
     from ._exact import ExactCell, ExactGaps, exact_path_gaps
@@ -65,6 +66,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "left_box": ("._grid", "left_box"),
     "make_grid": ("._grid", "make_grid"),
     "ptp_angles": ("._grid", "ptp_angles"),
+    "ptp_fraction": ("._grid", "ptp_fraction"),
     "rest_box": ("._grid", "rest_box"),
     "right_box": ("._grid", "right_box"),
     "rule_of": ("._grid", "rule_of"),
@@ -171,7 +173,7 @@ __all__ = [
     "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
     "MAX_EXTRA_POINTS", "decimal", "joint_grid",
     "load_scenario", "make_grid", "max_cells", "parse_scenario", "rest_box", "right_box",
-    "VariantRule", "cell_box", "ptp_angles", "rule_of",
+    "VariantRule", "cell_box", "ptp_angles", "ptp_fraction", "rule_of",
     # one definition on floats and on Z3 terms (the rules the proofs read)
     "cases", "ceil_of", "floor_of", "if_then", "max_of", "min_of",
     # geometry
