@@ -18,7 +18,9 @@ speed-up) runs in the full bench and alone with ``--only campaign`` (merged into
 results.json); --quick leaves it out (its cluster start alone is seconds). Likewise
 ``plan_scaling`` (``--only plan_scaling``): `cfmpa plan --contracts full` of the default
 workcell at dt = 0.02, 0.01, 0.0075 in fresh processes, with cells, seconds, peak resident
-memory and bytes a cell (docs/model.md §3's cell budget rests on it).
+memory and bytes a cell (docs/model.md §3's cell budget rests on it). And ``certify_stream``
+(``--only certify_stream``): `cfmpa certify` of a long slow trajectory of 10^6 rows (and of
+10^5, to show the peak does not grow with the rows), seconds and the child's peak memory.
 """
 
 from __future__ import annotations
@@ -133,10 +135,11 @@ def cli_has(command: str) -> bool:
 
 
 def cli_run(cfg: Config, argv: list[str], program: list[str] | None = None, *,
-            runs: int | None = None, warmup: int | None = None) -> dict[str, Any]:
+            runs: int | None = None, warmup: int | None = None,
+            env: dict[str, str] | None = None) -> dict[str, Any]:
     """Time a `cfmpa` command (or ``program``) in its own process; peak memory from that
     process's rusage (ru_maxrss: the largest of it and the children it waited for).
-    ``runs`` and ``warmup`` override the configuration's."""
+    ``runs`` and ``warmup`` override the configuration's; ``env`` is added to the environment."""
     exe = program or [str(cfmpa_exe())]
     times: list[float] = []
     peak = 0.0
@@ -146,7 +149,7 @@ def cli_run(cfg: Config, argv: list[str], program: list[str] | None = None, *,
         with tempfile.TemporaryFile() as err:   # a file, not a pipe: a full pipe would block
             t0 = time.perf_counter()
             proc = subprocess.Popen([*exe, *argv], cwd=ROOT, stdout=subprocess.DEVNULL,
-                                    stderr=err)
+                                    stderr=err, env=None if env is None else os.environ | env)
             _, status, usage = os.wait4(proc.pid, 0)
             seconds = time.perf_counter() - t0
             proc.returncode = os.waitstatus_to_exitcode(status)
@@ -286,6 +289,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
         res["campaign"] = campaign_section(cfg, tmp)
     res["monitor"] = monitor_section(cfg, tmp, base, have_cli and cli_has("monitor"))
     res["plan_scaling"] = plan_scaling_section(cfg, tmp) if have_cli else no_cli
+    res["certify_stream"] = certify_stream_section(cfg, tmp) if have_cli else no_cli
     res["targets"] = targets(res, cfg)
     res["informational"] = informational(res, cfg)
     res["meta"]["bench_wall_s"] = round(time.perf_counter() - t_start, 1)
@@ -334,6 +338,81 @@ def plan_scaling_section(cfg: Config, tmp: Path) -> dict[str, Any]:
                     "scaled to the grid), one run per dt in a fresh process; peak_mib is its "
                     "ru_maxrss, bytes_per_cell that over (N + 1) m n; time_exponent: the slope "
                     "of log seconds against log cells (least squares)"}
+
+
+#: `cfmpa certify` of a long slow trajectory (issue 24.4): rows, and the targets.
+CERTIFY_STREAM = {"rows": (100_000, 1_000_000), "quick_rows": (2_000, 20_000), "dt": 0.01,
+                  "target_s": 20.0, "target_mib": 300.0}
+
+
+def slow_trajectory_csv(path: Path, rows: int, dt: float) -> int:
+    """A trajectory CSV of ``rows`` rows every ``dt`` s in the default workcell: both arms
+    swaying slowly (at most 0.005 rad/s) well apart (about 0.38 m), so it is certified clear with
+    every piece proved at once. Written a block at a time; returns its size in bytes."""
+    import numpy as np
+
+    with open(path, "w") as fh:
+        fh.write("t,left1,left2,right1,right2\n")
+        for start in range(0, rows, 100_000):
+            t = np.arange(start, min(rows, start + 100_000)) * dt
+            a = np.column_stack([t, 1.68 + 0.1 * np.sin(2 * np.pi * t / 200),
+                                 -2.44 + 0.1 * np.sin(2 * np.pi * t / 150),
+                                 0.35 + 0.2 * np.sin(2 * np.pi * t / 300),
+                                 0.6 + 0.2 * np.sin(2 * np.pi * t / 250)])
+            np.savetxt(fh, a, fmt="%.12g", delimiter=",")
+    return path.stat().st_size
+
+
+def certify_stream_section(cfg: Config, tmp: Path) -> dict[str, Any]:
+    """`cfmpa certify` of ``slow_trajectory_csv`` at each row count, one run each in a fresh
+    process (CFMPA_MAX_TRAJECTORY_BYTES raised to the file's size): seconds, the child's peak
+    resident memory (ru_maxrss), bytes a row of that peak, and the command's own split into
+    reading and certifying (timings_s); ``peak_growth_mib``: the largest minus the smallest."""
+    rows_list = CERTIFY_STREAM["quick_rows"] if cfg.quick else CERTIFY_STREAM["rows"]
+    out: dict[str, Any] = {"runs": [], "target_s": CERTIFY_STREAM["target_s"],
+                           "target_mib": CERTIFY_STREAM["target_mib"],
+                           "note": "one run each; the trajectory is default.toml's arms swaying "
+                                   "slowly apart every 0.01 s (bench/run.py slow_trajectory_csv)"}
+    for rows in rows_list:
+        traj = tmp / f"slow-{rows}.csv"
+        size = slow_trajectory_csv(traj, rows, CERTIFY_STREAM["dt"])
+        report = tmp / f"certify-{rows}.json"
+        run = cli_run(cfg, ["certify", "default", "--traj", str(traj), "--json", str(report)],
+                      runs=1, warmup=0,
+                      env={"CFMPA_MAX_TRAJECTORY_BYTES": str(max(size, 32 * 2**20))})
+        entry: dict[str, Any] = {"rows": rows, "bytes": size}
+        if "median_s" in run:
+            doc = json.loads(report.read_text())
+            entry |= {"seconds": round(run["median_s"], 3), "peak_mib": run["peak_rss_mb"],
+                      "peak_bytes_per_row": round(run["peak_rss_mb"] * 2**20 / rows, 1),
+                      "clear": doc["clear"], "intervals": doc["intervals"],
+                      "timings_s": doc["timings_s"]}
+        else:
+            entry["error"] = run.get("error")
+        out["runs"].append(entry)
+        traj.unlink()
+    ok = [r for r in out["runs"] if "peak_mib" in r]
+    if len(ok) >= 2:
+        out["peak_growth_mib"] = round(ok[-1]["peak_mib"] - ok[0]["peak_mib"], 1)
+    return out
+
+
+def certify_stream_lines(sec: dict[str, Any]) -> list[str]:
+    lines = ["", "cfmpa certify, streamed (a long slow trajectory):",
+             f"{'rows':>9s} {'seconds':>9s} {'peak MiB':>9s} {'B/row':>7s} {'read s':>7s} "
+             f"{'cert s':>7s}"]
+    for r in sec.get("runs", []):
+        if "seconds" in r:
+            t = r["timings_s"]
+            lines.append(f"{r['rows']:9d} {r['seconds']:9.2f} {r['peak_mib']:9.1f} "
+                         f"{r['peak_bytes_per_row']:7.1f} {t.get('load', 0):7.2f} "
+                         f"{t.get('certificate', 0):7.2f}")
+        else:
+            lines.append(f"{r['rows']:9d} {r.get('error')}")
+    if "peak_growth_mib" in sec:
+        lines.append(f"peak growth over the rows: {sec['peak_growth_mib']} MiB (targets: "
+                     f"10^6 rows in {sec['target_s']:g} s and {sec['target_mib']:g} MiB)")
+    return lines
 
 
 def plan_json_of(folder: Path) -> dict[str, Any]:
@@ -899,6 +978,8 @@ def table(res: dict[str, Any]) -> str:
         lines += campaign_lines(camp)
     if "rows" in (res.get("plan_scaling") or {}):
         lines += plan_scaling_lines(res["plan_scaling"])
+    if "runs" in (res.get("certify_stream") or {}):
+        lines += certify_stream_lines(res["certify_stream"])
     lines += profile_lines(res.get("builtdr_profile"))
     lines.append("")
     lines.append("targets (measured, limit, verdict, what was measured):")
@@ -964,7 +1045,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent),
                     help="folder for results.json (default: bench/)")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
-    ap.add_argument("--only", choices=["campaign", "plan_scaling"], default=None,
+    ap.add_argument("--only", choices=["campaign", "plan_scaling", "certify_stream"],
+                    default=None,
                     help="run only this item and merge it into OUT/results.json")
     ap.add_argument("--prove", action="store_true",
                     help="also time `make prove` (cfmpa prove --audit DIR), one run of a minute "
@@ -973,7 +1055,9 @@ def main(argv: list[str] | None = None) -> int:
     cfg = Config.of(args.quick, args.runs, prove=args.prove)
     if args.only is not None:
         section, lines = {"campaign": (campaign_section, campaign_lines),
-                          "plan_scaling": (plan_scaling_section, plan_scaling_lines)}[args.only]
+                          "plan_scaling": (plan_scaling_section, plan_scaling_lines),
+                          "certify_stream": (certify_stream_section,
+                                             certify_stream_lines)}[args.only]
         out = Path(args.out) / "results.json"
         res = json.loads(out.read_text()) if out.exists() else {}
         with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:

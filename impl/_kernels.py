@@ -5,11 +5,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ._builtdr import build_dr
-from ._fast_builtdr import build_dr_fast
-from ._fast_search import search_opt_path_fast
-from ._search import search_opt_path
-
 __all__ = ["KERNELS", "kernel_name", "kernels"]
 
 #: The kernel names a user can pick; "fast" is bit-identical to "reference" (tested).
@@ -17,7 +12,14 @@ KERNELS: tuple[str, ...] = ("fast", "reference")
 
 
 def kernels(name: str = "fast") -> tuple[Callable[..., Any], Callable[..., Any]]:
-    """(build, search) of the kernel called ``name``; ValueError for another name."""
+    """(build, search) of the kernel called ``name``; ValueError for another name. The kernels
+    are imported here, not with KERNELS: every command's parser lists KERNELS, and the fast
+    ones load numba (issue 24.6)."""
+    from ._builtdr import build_dr
+    from ._fast_builtdr import build_dr_fast
+    from ._fast_search import search_opt_path_fast
+    from ._search import search_opt_path
+
     if name == "fast":
         return build_dr_fast, search_opt_path_fast
     if name == "reference":

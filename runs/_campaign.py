@@ -46,6 +46,7 @@ import numpy as np
 from ..errors import CfmpaError, InputError, WorkersLost
 from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
                     parse_scenario, polygon_distance)
+from ._limits import MAX_DT, MAX_WORKCELLS
 from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
                       error_message)
 from ._store import Store, open_store, read_store
@@ -57,11 +58,6 @@ __all__ = ["COMPARE_DT", "CONTACT_NOTE", "KERNEL", "MAX_DRAWS", "MAX_DT", "MAX_W
 
 #: Time step of campaign workcells (s): grids of about 10-30 layers of 60-80 x 50-65 cells.
 COMPARE_DT = 0.1
-#: The most workcells a campaign plans (--n): its bookkeeping is O(n) before the first task, and
-#: a million is days of planning on a cluster; more is refused before the store is opened.
-MAX_WORKCELLS = 1_000_000
-#: The coarsest --dt accepted (s); the finest is what the cell budget allows (CFMPA_MAX_CELLS).
-MAX_DT = 1.0
 #: Draws of a start or goal cell before the campaign keeps a pose in contact (then counted).
 MAX_DRAWS = 200
 #: Appended to a workcell's purpose when a pose was kept in contact after MAX_DRAWS draws.

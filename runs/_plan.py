@@ -83,10 +83,22 @@ class PlanResult:
 def versions() -> dict[str, str]:
     """Versions that can change an answer: the tool, Python, numpy, shapely, Z3."""
     import shapely
-    import z3
 
     return {"cfmpa": __version__, "python": platform.python_version(), "numpy": np.__version__,
-            "shapely": shapely.__version__, "z3": z3.get_version_string()}
+            "shapely": shapely.__version__, "z3": z3_version()}
+
+
+def z3_version() -> str:
+    """``z3.get_version_string()`` (major.minor.build) without importing Z3, which `cfmpa plan`
+    does not otherwise need (issue 24.6): the z3-solver distribution's version is
+    major.minor.build.revision. Imports Z3 only when that metadata is missing."""
+    from importlib import metadata
+
+    try:
+        return ".".join(metadata.version("z3-solver").split(".")[:3])
+    except metadata.PackageNotFoundError:
+        import z3
+        return str(z3.get_version_string())
 
 
 def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,

@@ -10,7 +10,6 @@ JSON outputs are byte-identical for the same inputs apart from ``timings_s``.
 
 from __future__ import annotations
 
-import hashlib
 import io
 import math
 import sys
@@ -28,9 +27,10 @@ from ..errors import MISSING, InputError
 from ..files import bounded_lines, dumps_json, echo, write_bytes_atomic
 from ._rosbag import BagOptions, bag_rows, bag_sha256, is_bag, load_bag_trajectory, write_bag
 from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
-                    between_samples_bound, certify_trajectory, closest_links, contact_links_text,
-                    csv_column_order, load_scenario, load_trajectory, tolerance_rad,
-                    trajectory_distances, tube_lipschitz)
+                    TrajectorySummary, between_samples_bound, certify_trajectory,
+                    certify_trajectory_file, closest_links, contact_links_text, csv_column_order,
+                    load_scenario, load_trajectory, tolerance_rad, trajectory_distances,
+                    tube_lipschitz)
 
 __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
            "LISTED_UNOBSERVED", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult", "Unobserved",
@@ -78,27 +78,29 @@ def _trajectory(path: str | Path, s: Scenario, allow_speed: bool, bag: BagOption
     return load_trajectory(path, s, allow_speed=allow_speed)
 
 
-def certify_json(s: Scenario, traj: Trajectory, cert: Certificate,
+def certify_json(s: Scenario, traj: Trajectory | TrajectorySummary, cert: Certificate,
                  timings: dict[str, float] | None = None,
                  sha256: str | None = None) -> dict[str, Any]:
-    """The JSON of `cfmpa certify` (keys stable: add, never rename)."""
+    """The JSON of `cfmpa certify` (keys stable: add, never rename), of a trajectory or of what
+    the streaming reader kept of it (``spec.TrajectorySummary``)."""
+    info = traj if isinstance(traj, TrajectorySummary) else TrajectorySummary.of(traj, cert)
     contact = None
     if cert.contact is not None and cert.contact_detail is not None:
         d = cert.contact_detail
         k = d.step
+        rows = info.contact_rows
         contact = {"t_s": d.t_s, "links": list(d.links), "links_text": contact_links_text(d.links),
                    "left_angles_rad": list(d.left_angles_rad),
                    "right_angles_rad": list(d.right_angles_rad),
                    "row": None if k is None else k,
-                   "line": None if k is None else traj.line(k),
-                   "segment": ("at rest after the last row" if k is None else
-                               f"rows {k}->{k + 1} (t {float(traj.t[k])!r}.."
-                               f"{float(traj.t[k + 1])!r} s)")}
+                   "line": None if k is None or rows is None else rows[0][1],
+                   "segment": ("at rest after the last row" if k is None or rows is None else
+                               f"rows {k}->{k + 1} (t {rows[0][0]!r}..{rows[1][0]!r} s)")}
     return {
         "scenario": s.name,
         "scenario_sha256": s.sha256,
-        "trajectory": {"file": traj.source, "sha256": sha256, "rows": traj.rows,
-                       "t_start_s": float(traj.t[0]), "t_end_s": float(traj.t[-1])},
+        "trajectory": {"file": info.source, "sha256": sha256, "rows": info.rows,
+                       "t_start_s": info.t_start_s, "t_end_s": info.t_end_s},
         "clear": cert.clear,
         "lower_bound_m": cert.lower_bound_m,
         "min_m": cert.min_clearance_m,
@@ -117,18 +119,27 @@ def certify_json(s: Scenario, traj: Trajectory, cert: Certificate,
 def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
                 json_out: str | Path | None = None, allow_speed: bool = False,
                 bag: BagOptions | None = None) -> int:
-    """Certify the trajectory file (or ROS 2 bag, read with ``bag``); print the summary; 0
-    clear, 1 not clear (bad input raises InputError, exit 2, nothing written)."""
+    """Certify the trajectory file, read and certified in one pass (memory independent of its
+    rows: ``spec.certify_trajectory_file``), or a ROS 2 bag (read with ``bag``, whole, within
+    the trajectory's row limit); print the summary; 0 clear, 1 not clear (bad input raises
+    InputError, exit 2, nothing written)."""
     s = _scenario(scenario)
     opts = _bag_options(bag, traj_path)
-    t0 = time.perf_counter()
-    traj = _trajectory(traj_path, s, allow_speed, opts)
-    t1 = time.perf_counter()
-    cert = certify_trajectory(s, traj)
-    t2 = time.perf_counter()
-    doc = certify_json(s, traj, cert, {"load": t1 - t0, "certificate": t2 - t1},
-                       _sha256(traj_path))
-    print(f"trajectory {traj_path}: {traj.rows} rows, t {traj.t[0]:.6g}..{traj.t[-1]:.6g} s "
+    timings: dict[str, float] = {}
+    if is_bag(traj_path):
+        t0 = time.perf_counter()
+        traj = _trajectory(traj_path, s, allow_speed, opts)
+        t1 = time.perf_counter()
+        cert = certify_trajectory(s, traj)
+        timings = {"load": t1 - t0, "certificate": time.perf_counter() - t1}
+        rows, t_start, t_end = traj.rows, float(traj.t[0]), float(traj.t[-1])
+        doc = certify_json(s, traj, cert, timings, _sha256(traj_path))
+    else:
+        info, cert, sha = certify_trajectory_file(traj_path, s, allow_speed=allow_speed,
+                                                  timings=timings)
+        rows, t_start, t_end = info.rows, info.t_start_s, info.t_end_s
+        doc = certify_json(s, info, cert, timings, sha)
+    print(f"trajectory {traj_path}: {rows} rows, t {t_start:.6g}..{t_end:.6g} s "
           f"(scenario {s.name})")
     sampled = (f"sampled minimum {cert.min_clearance_m * 1000:.6g} mm at t={cert.t_min_s:.6g} s "
                f"({cert.intervals} intervals)")

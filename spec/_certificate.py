@@ -59,6 +59,7 @@ __all__ = [
     "closest_links",
     "contact_links_text",
     "prove_motion",
+    "Prover",
     "require_clear",
     "interval_bound",
     "link_speeds",
@@ -157,74 +158,126 @@ def prove_motion(motion: Any, *, max_depth: int = DEFAULT_MAX_DEPTH,
     """The proof loop of the module docstring, shared by the grid path's motion and a trajectory.
 
     ``motion`` gives ``pieces()``, ``lipschitz(seg, moving)``, ``distances(t, seg)`` and
-    ``detail(contact, seg)``. With ``first_contact`` a found contact does not stop the search:
-    every interval before it is still decided (halved down to ``max_depth``), so the contact
-    reported is the first one, to within a piece's length / 2^max_depth.
+    ``detail(contact, seg)``, and may give ``end_distances(t0, t1, seg)``: both ends' distances
+    at once, the same values as two ``distances`` calls (fewer computed). With
+    ``first_contact`` a found contact does not stop the search: every interval before it is
+    still decided (halved down to ``max_depth``), so the contact reported is the first one, to
+    within a piece's length / 2^max_depth.
     """
-    t0, t1, seg, moving = motion.pieces()
-    lip = motion.lipschitz(seg, moving)                       # (K, 2, 2)
-    d0 = motion.distances(t0, seg)
-    d1 = motion.distances(t1, seg)
-    depth = np.zeros(len(t0), dtype=np.int64)
-    samples = 2 * len(t0)
+    prover = Prover(max_depth=max_depth, bound_ratio=bound_ratio, max_intervals=max_intervals,
+                    first_contact=first_contact)
+    prover.add(motion)
+    return prover.certificate()
 
-    best = _Best.of(np.concatenate([t0, t1]), np.concatenate([d0, d1]), np.concatenate([seg, seg]))
-    examined = len(t0)
-    proved_lb = math.inf
-    undecided: list[tuple[FloatArray, FloatArray]] = []
-    deepest = 0
-    while best.contact is None or first_contact:
-        if best.contact is not None:                # only what lies before it can come earlier
-            before = t0 < best.contact[0]
-            if not np.any(before):
+
+class Prover:
+    """The proof loop over a motion given in parts (``add``, in time order), keeping only
+    aggregates between parts: the least sampled distance, the first contact and its detail,
+    the proved lower bound, counts and the merged undecided intervals. One part is exactly
+    ``prove_motion``. With several, the loop runs part by part: the halving threshold
+    ``bound_ratio`` x (least sampled distance) and the work cap ``max_intervals`` see what the
+    parts so far sampled and examined, not what later parts will, so ``intervals``, ``samples``,
+    ``max_depth_used``, ``lower_bound_m`` and the sampled minimum may differ from one part of
+    the same pieces; every proved interval is proved all the same (its bound is its own), so
+    ``clear`` can differ only through the work cap. Parts must follow one another in time (a
+    part starts no earlier than the previous ended): once a contact is found, later parts
+    cannot hold an earlier one and are skipped (neither sampled nor counted)."""
+
+    def __init__(self, *, max_depth: int = DEFAULT_MAX_DEPTH,
+                 bound_ratio: float = DEFAULT_BOUND_RATIO,
+                 max_intervals: int = DEFAULT_MAX_INTERVALS, first_contact: bool = False) -> None:
+        self.max_depth, self.bound_ratio = max_depth, bound_ratio
+        self.max_intervals, self.first_contact = max_intervals, first_contact
+        self.best = _Best(math.inf, 0.0, None)
+        self.examined = 0
+        self.samples = 0
+        self.proved_lb = math.inf
+        self.deepest = 0
+        self.undecided: list[list[float]] = []        # merged, in time order
+        self.detail: ContactDetail | None = None
+
+    def add(self, motion: Any) -> bool:
+        """Decide ``motion``'s pieces; True when this part holds the contact reported."""
+        if self.best.contact is not None:
+            return False
+        first_contact, max_depth = self.first_contact, self.max_depth
+        t0, t1, seg, moving = motion.pieces()
+        lip = motion.lipschitz(seg, moving)                       # (K, 2, 2)
+        ends = getattr(motion, "end_distances", None)
+        d0, d1 = ends(t0, t1, seg) if ends else (motion.distances(t0, seg),
+                                                 motion.distances(t1, seg))
+        depth = np.zeros(len(t0), dtype=np.int64)
+        self.samples += 2 * len(t0)
+
+        best = self.best.update(np.concatenate([t0, t1]), np.concatenate([d0, d1]),
+                                np.concatenate([seg, seg]), earliest=first_contact)
+        self.examined += len(t0)
+        undecided: list[tuple[FloatArray, FloatArray]] = []
+        while best.contact is None or first_contact:
+            if best.contact is not None:            # only what lies before it can come earlier
+                before = t0 < best.contact[0]
+                if not np.any(before):
+                    break
+                t0, t1, seg, d0, d1, lip, depth = (x[before] for x in (t0, t1, seg, d0, d1, lip,
+                                                                        depth))
+            self.deepest = max(self.deepest, int(depth.max()))
+            lb = np.min(interval_bound(d0, d1, lip, (t1 - t0)[:, None, None]), axis=(1, 2))
+            proved = lb > EPS
+            tm = (t0 + t1) / 2.0
+            # Halving cannot tighten an atomic interval's bound: it has no interior instant (zero
+            # length, or no float between its ends) or nothing moves on it (L = 0, d constant).
+            # Its samples decide it; splitting it would only double it every round up to the caps.
+            atomic = (tm <= t0) | (tm >= t1) | np.all(lip == 0.0, axis=(1, 2))
+            at_cap = depth >= max_depth
+            over_budget = self.examined + 2 * len(t0) > self.max_intervals
+            settled = proved & (at_cap | over_budget | atomic | (lb >= self.bound_ratio * best.d))
+            stuck = ~proved & (at_cap | over_budget | atomic)
+            if np.any(settled):
+                self.proved_lb = min(self.proved_lb, float(lb[settled].min()))
+            if np.any(stuck):
+                undecided.append((t0[stuck], t1[stuck]))
+            split = ~(settled | stuck)
+            if not np.any(split):
                 break
-            t0, t1, seg, d0, d1, lip, depth = (x[before] for x in (t0, t1, seg, d0, d1, lip,
-                                                                    depth))
-        deepest = max(deepest, int(depth.max())) if first_contact else int(depth.max())
-        lb = np.min(interval_bound(d0, d1, lip, (t1 - t0)[:, None, None]), axis=(1, 2))
-        proved = lb > EPS
-        tm = (t0 + t1) / 2.0
-        # Halving cannot tighten an atomic interval's bound: it has no interior instant (zero
-        # length, or no float between its ends) or nothing moves on it (L = 0, d constant). Its
-        # samples decide it; splitting it would only double it every round up to the caps.
-        atomic = (tm <= t0) | (tm >= t1) | np.all(lip == 0.0, axis=(1, 2))
-        at_cap = depth >= max_depth
-        over_budget = examined + 2 * len(t0) > max_intervals
-        settled = proved & (at_cap | over_budget | atomic | (lb >= bound_ratio * best.d))
-        stuck = ~proved & (at_cap | over_budget | atomic)
-        if np.any(settled):
-            proved_lb = min(proved_lb, float(lb[settled].min()))
-        if np.any(stuck):
-            undecided.append((t0[stuck], t1[stuck]))
-        split = ~(settled | stuck)
-        if not np.any(split):
-            break
-        t0, t1, tm, seg, d0, d1, lip, depth = (x[split] for x in (t0, t1, tm, seg, d0, d1, lip,
-                                                                   depth))
-        dm = motion.distances(tm, seg)
-        samples += len(tm)
-        best = best.update(tm, dm, seg, earliest=first_contact)
-        t0, t1 = np.concatenate([t0, tm]), np.concatenate([tm, t1])
-        d0, d1 = np.concatenate([d0, dm]), np.concatenate([dm, d1])
-        seg, lip = np.concatenate([seg, seg]), np.concatenate([lip, lip])
-        depth = np.concatenate([depth, depth]) + 1
-        examined += len(t0)
+            t0, t1, tm, seg, d0, d1, lip, depth = (x[split] for x in (t0, t1, tm, seg, d0, d1,
+                                                                       lip, depth))
+            dm = motion.distances(tm, seg)
+            self.samples += len(tm)
+            best = best.update(tm, dm, seg, earliest=first_contact)
+            t0, t1 = np.concatenate([t0, tm]), np.concatenate([tm, t1])
+            d0, d1 = np.concatenate([d0, dm]), np.concatenate([dm, d1])
+            seg, lip = np.concatenate([seg, seg]), np.concatenate([lip, lip])
+            depth = np.concatenate([depth, depth]) + 1
+            self.examined += len(t0)
+        self.best = best
+        # This part's intervals lie after the previous parts': merging them onto the list is
+        # merging them all (_merge).
+        for a, b in _merge(undecided):
+            if self.undecided and a <= self.undecided[-1][1]:
+                self.undecided[-1][1] = max(self.undecided[-1][1], b)
+            else:
+                self.undecided.append([a, b])
+        if best.contact is None:
+            return False
+        self.detail = motion.detail(best.contact, best.contact_seg)
+        return True
 
-    merged = _merge(undecided)
-    clear = best.contact is None and not merged
-    return Certificate(
-        clear=clear,
-        min_clearance_m=best.d,
-        t_min_s=best.t,
-        lower_bound_m=proved_lb if clear else 0.0,
-        intervals=examined,
-        contact=best.contact,
-        undecided=merged,
-        samples=samples,
-        max_depth_used=deepest,
-        contact_detail=None if best.contact is None else motion.detail(best.contact,
-                                                                      best.contact_seg),
-    )
+    def certificate(self) -> Certificate:
+        """The certificate of the parts added so far."""
+        best, merged = self.best, tuple((a, b) for a, b in self.undecided)
+        clear = best.contact is None and not merged
+        return Certificate(
+            clear=clear,
+            min_clearance_m=best.d,
+            t_min_s=best.t,
+            lower_bound_m=self.proved_lb if clear else 0.0,
+            intervals=self.examined,
+            contact=best.contact,
+            undecided=merged,
+            samples=self.samples,
+            max_depth_used=self.deepest,
+            contact_detail=self.detail,
+        )
 
 
 def certificate_json(cert: Certificate) -> dict[str, Any]:

@@ -27,14 +27,16 @@ obligation ``Monitor.between_samples`` proves it with Z3 on this very function's
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import json
 import math
+import time
 from array import array
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, cast
+from typing import IO, Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -43,7 +45,7 @@ from ..errors import MISSING, InputError
 from ..files import LIMITS, bounded_lines, echo, read_bounded
 from ._arith import max_of
 from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
-                           Certificate, ContactDetail, link_rects, link_speeds, prove_motion)
+                           Certificate, ContactDetail, Prover, link_rects, link_speeds)
 from ._grid import EPS, Grid, exact_tf, left_angles
 from ._kinematics import reach
 from ._polygon import polygon_distances
@@ -53,7 +55,8 @@ __all__ = ["COLUMNS", "JOINTS", "Trajectory", "csv_column_order", "load_trajecto
            "parse_trajectory_csv", "parse_trajectory_json", "certify_trajectory",
            "executed_trajectory", "trajectory_csv", "tube_lipschitz", "tolerance_rad",
            "TOLERANCE_STEP_RAD", "SPEED_TOLERANCE", "trajectory_distances", "validate",
-           "between_samples_bound", "ReferenceSpeeds"]
+           "between_samples_bound", "ReferenceSpeeds", "CHUNK_ROWS", "TrajectorySummary",
+           "certify_trajectory_file"]
 
 #: The file columns, in the order of ``Trajectory.angles`` after t.
 COLUMNS = ("t", "left1", "left2", "right1", "right2")
@@ -62,6 +65,14 @@ JOINTS = COLUMNS[1:]
 TOLERANCE_STEP_RAD = 1e-6
 #: A joint speed is refused when above omega * (1 + SPEED_TOLERANCE) (float rounding only).
 SPEED_TOLERANCE = 1e-9
+#: Rows read, validated and certified at a time (docs/model.md §12): what certify holds of a
+#: trajectory file, whatever its length. A trajectory of at most this many rows is certified
+#: in one part, exactly as one piece list (spec._certificate.Prover).
+CHUNK_ROWS = 65_536
+#: Configurations per call of the polygon distance: its temporaries are about 7 KiB a
+#: configuration, and at 1024 they stay small enough to be reused rather than mapped afresh
+#: (4096 spent a fifth of certify's CPU time in the kernel, measured on 10^5 rows).
+DISTANCE_BATCH = 1_024
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -118,15 +129,10 @@ def csv_column_order(header: str, source: str | None = None) -> list[int]:
     return [names.index(c) for c in COLUMNS]
 
 
-def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str | None = None,
-                         allow_speed: bool = False) -> Trajectory:
-    """A CSV trajectory (its text, or its lines as ``files.bounded_lines`` streams them),
-    validated (``validate``); errors name the file and line, echoing at most ECHO_CHARS of a
-    value. Rows are kept as doubles only (8 bytes a value), not as text."""
-    lines = iter(text.splitlines() if isinstance(text, str) else text)
+def _csv_rows(lines: Iterator[str], source: str | None) -> Iterator[tuple[int, list[float]]]:
+    """(line number, the five values in COLUMNS order) for each row after the header (read
+    from ``lines``); a malformed row or a blank line that a row follows raises InputError."""
     order = csv_column_order(next(lines, ""), source)
-    vals: array[float] = array("d")
-    where: list[int] = []
     blank: int | None = None                        # the first of blank lines not yet followed
     no = 1
     for line in lines:
@@ -140,6 +146,7 @@ def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str 
         if len(fields) != len(COLUMNS):
             raise _fail("row", echo(line.strip()), f"must have {len(COLUMNS)} values, has "
                         f"{len(fields)}", source, no)
+        vals = []
         for name, i in zip(COLUMNS, order):
             try:
                 v = float(fields[i])
@@ -149,6 +156,19 @@ def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str 
             if not math.isfinite(v):
                 raise _fail(name, v, "must be finite", source, no)
             vals.append(v)
+        yield no, vals
+
+
+def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str | None = None,
+                         allow_speed: bool = False) -> Trajectory:
+    """A CSV trajectory (its text, or its lines as ``files.bounded_lines`` streams them),
+    validated (``validate``); errors name the file and line, echoing at most ECHO_CHARS of a
+    value. Rows are kept as doubles only (8 bytes a value), not as text."""
+    lines = iter(text.splitlines() if isinstance(text, str) else text)
+    vals: array[float] = array("d")
+    where: list[int] = []
+    for no, row in _csv_rows(lines, source):
+        vals.extend(row)
         where.append(no)
     if not where:
         raise _fail("trajectory", MISSING, "must have at least one row", source, 1)
@@ -213,6 +233,10 @@ def load_trajectory(path: str | Path, s: Scenario, *, allow_speed: bool = False)
                 return parse_trajectory_csv(itertools.chain([first], lines), s, source=source,
                                             allow_speed=allow_speed)
     data = read_bounded(p, limit, source, lines=False, field="trajectory")
+    return _parse_json_bytes(data, s, source, allow_speed)
+
+
+def _parse_json_bytes(data: bytes, s: Scenario, source: str, allow_speed: bool) -> Trajectory:
     try:
         doc = json.loads(data.decode("utf-8"))
     except UnicodeDecodeError:
@@ -225,39 +249,70 @@ def load_trajectory(path: str | Path, s: Scenario, *, allow_speed: bool = False)
 def validate(traj: Trajectory, s: Scenario, *, allow_speed: bool = False) -> None:
     """Strictly increasing t; joint speeds within the scenario's omega (unless ``allow_speed``);
     the subordinate's angles within its limits. Raises InputError naming the row."""
-    src = traj.source
+    checks = _Checks(s, traj.source, allow_speed)
+    checks.add(traj.t, traj.angles, traj.lines, 0)
+    checks.raise_first()
 
-    def where(k: int) -> tuple[str, int | None]:
-        line = traj.line(k)
-        return (f"row {k + 1}" if line is None else f"row {k + 1}"), line
 
-    dt = np.diff(traj.t)
-    bad = np.flatnonzero(dt <= 0)
-    if len(bad):
-        k = int(bad[0]) + 1
-        label, line = where(k)
-        raise _fail(f"t ({label})", float(traj.t[k]), f"must be greater than the previous time "
-                    f"{float(traj.t[k - 1])!r} (times strictly increase)", src, line)
-    for q in range(2):
-        lo, hi = s.right.limits[q]
-        col = traj.angles[:, 2 + q]
-        out = np.flatnonzero((col < lo - ANGLE_TOLERANCE) | (col > hi + ANGLE_TOLERANCE))
-        if len(out):
-            k = int(out[0])
-            label, line = where(k)
-            raise _fail(f"{JOINTS[2 + q]} ({label})", float(col[k]),
-                        f"must lie within the subordinate's limits [{lo!r}, {hi!r}]", src, line)
-    if allow_speed or traj.rows < 2:
-        return
-    omega = np.array([*s.left.omega, *s.right.omega])
-    speed = np.abs(np.diff(traj.angles, axis=0)) / dt[:, None]
-    over = speed > omega[None, :] * (1.0 + SPEED_TOLERANCE)
-    if np.any(over):
-        k, q = (int(x) for x in np.argwhere(over)[0])
-        label, line = where(k + 1)
-        raise _fail(f"{JOINTS[q]} speed ({label})", float(speed[k, q]),
-                    f"rad/s from the previous row exceeds omega = {float(omega[q])!r} rad/s "
-                    "(--allow-speed certifies it anyway)", src, line)
+class _Checks:
+    """``validate`` over rows given in order, a block at a time: the first failure of each
+    check is kept (the last row is carried into the next block's differences) and, at the end,
+    the failure of the first check in validate's order wins (times, then right1's and right2's
+    limits, then speeds), as if the rows had been validated at once."""
+
+    def __init__(self, s: Scenario, source: str | None, allow_speed: bool) -> None:
+        self.s, self.source, self.allow_speed = s, source, allow_speed
+        self.failures: dict[int, InputError] = {}
+        self.prev: tuple[float, FloatArray, int | None] | None = None
+        self.omega = np.array([*s.left.omega, *s.right.omega])
+
+    def add(self, t: FloatArray, angles: FloatArray, lines: Iterable[int] | None,
+            offset: int) -> None:
+        """Rows ``offset`` .. ``offset + len(t) - 1`` (file lines ``lines``, or None)."""
+        new_lines: list[int | None] = [None] * len(t) if lines is None else list(lines)
+        src, fail = self.source, self.failures
+        if self.prev is None:
+            tt, aa, ll, base = t, angles, new_lines, offset
+        else:
+            tt = np.concatenate([[self.prev[0]], t])
+            aa = np.concatenate([self.prev[1][None, :], angles])
+            ll, base = [self.prev[2], *new_lines], offset - 1
+        dt = np.diff(tt)
+        bad = np.flatnonzero(dt <= 0)
+        if 0 not in fail and len(bad):
+            j = int(bad[0]) + 1
+            fail[0] = _fail(f"t (row {base + j + 1})", float(tt[j]), f"must be greater than the "
+                            f"previous time {float(tt[j - 1])!r} (times strictly increase)", src,
+                            ll[j])
+        for q in range(2):
+            lo, hi = self.s.right.limits[q]
+            col = angles[:, 2 + q]
+            out = np.flatnonzero((col < lo - ANGLE_TOLERANCE) | (col > hi + ANGLE_TOLERANCE))
+            if 1 + q not in fail and len(out):
+                k = int(out[0])
+                fail[1 + q] = _fail(f"{JOINTS[2 + q]} (row {offset + k + 1})", float(col[k]),
+                                    f"must lie within the subordinate's limits [{lo!r}, {hi!r}]",
+                                    src, new_lines[k])
+        # After a time failure (which wins) a speed is no number: dt <= 0.
+        if 0 not in fail and 3 not in fail and not self.allow_speed and len(tt) > 1:
+            omega = self.omega
+            speed = np.abs(np.diff(aa, axis=0)) / dt[:, None]
+            over = speed > omega[None, :] * (1.0 + SPEED_TOLERANCE)
+            if np.any(over):
+                j, q = (int(x) for x in np.argwhere(over)[0])
+                fail[3] = _fail(f"{JOINTS[q]} speed (row {base + j + 2})", float(speed[j, q]),
+                                f"rad/s from the previous row exceeds omega = {float(omega[q])!r} "
+                                "rad/s (--allow-speed certifies it anyway)", src, ll[j + 1])
+        if len(t):
+            self.prev = (float(t[-1]), angles[-1].copy(), new_lines[-1])
+
+    @property
+    def failed(self) -> bool:
+        return bool(self.failures)
+
+    def raise_first(self) -> None:
+        if self.failures:
+            raise self.failures[min(self.failures)]
 
 
 def executed_trajectory(s: Scenario, g: Grid, path: Any) -> Trajectory:
@@ -357,8 +412,13 @@ class ReferenceSpeeds:
 
 
 def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
-    """d[k, a, b]: distance between left link a and right link b at configurations (K, 4)."""
+    """d[k, a, b]: distance between left link a and right link b at configurations (K, 4)
+    (computed DISTANCE_BATCH configurations at a time: each is its own, so the batches change
+    no value, only the temporaries' size)."""
     angles = np.asarray(angles, dtype=float).reshape(-1, 4)
+    if len(angles) > DISTANCE_BATCH:
+        return np.concatenate([trajectory_distances(s, angles[k:k + DISTANCE_BATCH])
+                               for k in range(0, len(angles), DISTANCE_BATCH)])
     left = link_rects(s.left, angles[:, :2])
     right = link_rects(s.right, angles[:, 2:])
     return polygon_distances(left[:, :, None], right[:, None, :])
@@ -366,17 +426,19 @@ def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
 
 @dataclass(frozen=True)
 class _TrajectoryMotion:
-    """A trajectory as the certificate's motion: pieces between rows (``seg`` = row index)."""
+    """A part of a trajectory as the certificate's motion: its pieces between rows (``seg`` the
+    row index in the whole trajectory; ``traj``'s first row is row ``offset``)."""
 
     scenario: Scenario
     traj: Trajectory
+    offset: int = 0
 
     def pieces(self) -> tuple[FloatArray, FloatArray, npt.NDArray[np.int64], npt.NDArray[np.bool_]]:
         tr = self.traj
         if tr.rows == 1:
             z = np.full(1, tr.t[0])
             return z, z.copy(), np.full(1, -1, dtype=np.int64), np.zeros(1, dtype=bool)
-        seg = np.arange(tr.rows - 1, dtype=np.int64)
+        seg = np.arange(self.offset, self.offset + tr.rows - 1, dtype=np.int64)
         return tr.t[:-1].copy(), tr.t[1:].copy(), seg, np.ones(len(seg), dtype=bool)
 
     def lipschitz(self, seg: npt.NDArray[np.int64], moving: npt.NDArray[np.bool_]) -> FloatArray:
@@ -384,7 +446,8 @@ class _TrajectoryMotion:
         if tr.rows == 1:
             w = np.zeros((len(seg), 4))
         else:
-            w = (np.abs(np.diff(tr.angles, axis=0)) / np.diff(tr.t)[:, None])[np.maximum(seg, 0)]
+            w = (np.abs(np.diff(tr.angles, axis=0)) / np.diff(tr.t)[:, None])[
+                np.maximum(seg - self.offset, 0)]
             w = np.where(seg[:, None] >= 0, w, 0.0)
         vl = link_speeds(self.scenario.left, w[:, :2])
         vr = link_speeds(self.scenario.right, w[:, 2:])
@@ -394,29 +457,227 @@ class _TrajectoryMotion:
         tr = self.traj
         if tr.rows == 1:
             return np.broadcast_to(tr.angles[0], (len(t), 4))
-        return np.where(seg[:, None] >= 0, tr._interp(t, np.maximum(seg, 0)), tr.angles[-1])
+        return np.where(seg[:, None] >= 0, tr._interp(t, np.maximum(seg - self.offset, 0)),
+                        tr.angles[-1])
 
     def distances(self, t: FloatArray, seg: npt.NDArray[np.int64]) -> FloatArray:
         return trajectory_distances(self.scenario, self.angles(t, seg))
+
+    def end_distances(self, t0: FloatArray, t1: FloatArray,
+                      seg: npt.NDArray[np.int64]) -> tuple[FloatArray, FloatArray]:
+        """``distances(t0, seg), distances(t1, seg)`` of consecutive pieces, each configuration
+        computed once: where piece k's end (row k interpolated to u = 1) is bit for bit piece
+        k + 1's start (row k + 1), its distances are the same numbers (trajectory_distances is
+        one configuration's function), so they are copied instead of computed again."""
+        a0, a1 = self.angles(t0, seg), self.angles(t1, seg)
+        d0 = trajectory_distances(self.scenario, a0)
+        d1 = np.empty_like(d0)
+        same = np.zeros(len(a1), dtype=bool)
+        if len(a1) > 1:
+            bits0 = np.ascontiguousarray(a0).view(np.int64)
+            bits1 = np.ascontiguousarray(a1).view(np.int64)
+            same[:-1] = np.all(bits1[:-1] == bits0[1:], axis=1)
+        d1[same] = d0[1:][same[:-1]]
+        d1[~same] = trajectory_distances(self.scenario, a1[~same])
+        return d0, d1
 
     def detail(self, contact: tuple[float, tuple[int, int]], seg: int) -> ContactDetail:
         t, links = contact
         a = self.angles(np.array([t]), np.array([seg], dtype=np.int64))[0]
         k = seg if seg >= 0 else None
-        # No grid cells for a trajectory: ``cells`` holds the waypoint rows (k, k + 1).
-        rows = (seg, seg + 1) if k is not None else (self.traj.rows - 1, self.traj.rows - 1)
+        # No grid cells for a trajectory: ``cells`` holds the waypoint rows (k, k + 1). Only a
+        # one-row trajectory has a piece at rest (seg -1), at its row 0.
+        rows = (seg, seg + 1) if k is not None else (0, 0)
         return ContactDetail(t, links, (float(a[0]), float(a[1])), (float(a[2]), float(a[3])),
                              k, ((rows[0], rows[0]), (rows[1], rows[1])))
 
 
+def _split(traj: Trajectory, chunk_rows: int) -> Iterator[tuple[Trajectory, int]]:
+    """``traj`` in parts of ``chunk_rows`` rows (each after the first also has the previous
+    part's last row, so that the pieces between parts are in one), with the row index of each
+    part's first row: the parts the file reader gives (``_CsvParts``)."""
+    if chunk_rows < 2:
+        raise ValueError("chunk_rows must be at least 2")
+    if traj.rows <= chunk_rows:
+        yield traj, 0
+        return
+    for start in range(0, traj.rows, chunk_rows):
+        lo = max(start - 1, 0)
+        hi = min(start + chunk_rows, traj.rows)
+        lines = None if traj.lines is None else traj.lines[lo:hi]
+        yield Trajectory(traj.t[lo:hi], traj.angles[lo:hi], traj.source, lines), lo
+
+
+@dataclass(frozen=True)
+class TrajectorySummary:
+    """What `cfmpa certify` reports of a trajectory it no longer holds: its file, row count and
+    time span, and for a contact on the piece between rows k and k + 1 the (time, file line) of
+    both rows (line None for JSON)."""
+
+    source: str | None
+    rows: int
+    t_start_s: float
+    t_end_s: float
+    contact_rows: tuple[tuple[float, int | None], tuple[float, int | None]] | None = None
+
+    @staticmethod
+    def of(traj: Trajectory, cert: Certificate) -> TrajectorySummary:
+        d = cert.contact_detail
+        k = None if d is None else d.step
+        rows = None if k is None else ((float(traj.t[k]), traj.line(k)),
+                                       (float(traj.t[k + 1]), traj.line(k + 1)))
+        return TrajectorySummary(traj.source, traj.rows, float(traj.t[0]), float(traj.t[-1]),
+                                 rows)
+
+
+class _Certifier:
+    """Trajectory parts (in time order) certified as they come, keeping only the prover's
+    aggregates, the row count, the time span and the contact's rows."""
+
+    def __init__(self, s: Scenario, source: str | None, **caps: Any) -> None:
+        self.s, self.source = s, source
+        self.prover = Prover(first_contact=True, **caps)
+        self.rows, self.t_start, self.t_end = 0, math.nan, math.nan
+        self.contact_rows: tuple[tuple[float, int | None], tuple[float, int | None]] | None = None
+
+    def add(self, part: Trajectory, offset: int) -> None:
+        if self.prover.add(_TrajectoryMotion(self.s, part, offset)):
+            d = self.prover.detail
+            k = None if d is None else d.step
+            if k is not None:
+                j = k - offset
+                self.contact_rows = ((float(part.t[j]), part.line(j)),
+                                     (float(part.t[j + 1]), part.line(j + 1)))
+
+    def summary(self) -> TrajectorySummary:
+        return TrajectorySummary(self.source, self.rows, self.t_start, self.t_end,
+                                 self.contact_rows)
+
+
 def certify_trajectory(s: Scenario, traj: Trajectory, *, max_depth: int = DEFAULT_MAX_DEPTH,
                        bound_ratio: float = DEFAULT_BOUND_RATIO,
-                       max_intervals: int = DEFAULT_MAX_INTERVALS) -> Certificate:
+                       max_intervals: int = DEFAULT_MAX_INTERVALS,
+                       chunk_rows: int = CHUNK_ROWS) -> Certificate:
     """The continuous-time certificate (docs/model.md §7) of a trajectory, both arms from it.
 
     The pieces are the rows' intervals; a contact reported is the first one (to within a
     piece's length / 2^max_depth). ``contact_detail.step`` is the row index k of the piece
-    [t_k, t_{k+1}] (None at rest after the last row).
+    [t_k, t_{k+1}] (None at rest after the last row). The pieces are decided ``chunk_rows``
+    rows at a time (spec._certificate.Prover: one part, hence exactly one piece list, up to
+    CHUNK_ROWS rows), as ``certify_trajectory_file`` does.
     """
-    return prove_motion(_TrajectoryMotion(s, traj), max_depth=max_depth, bound_ratio=bound_ratio,
-                        max_intervals=max_intervals, first_contact=True)
+    c = _Certifier(s, traj.source, max_depth=max_depth, bound_ratio=bound_ratio,
+                   max_intervals=max_intervals)
+    for part, offset in _split(traj, chunk_rows):
+        c.add(part, offset)
+    return c.prover.certificate()
+
+
+class _HashingReader:
+    """A binary file whose bytes, as ``readline`` returns them, go into a SHA-256 as well."""
+
+    def __init__(self, fh: Any) -> None:
+        self.fh, self.hash = fh, hashlib.sha256()
+
+    def readline(self, size: int = -1) -> bytes:
+        raw: bytes = self.fh.readline(size)
+        self.hash.update(raw)
+        return raw
+
+
+def _csv_parts(lines: Iterator[str], s: Scenario, source: str, allow_speed: bool,
+               chunk_rows: int, c: _Certifier) -> Iterator[tuple[Trajectory, int]]:
+    """The CSV trajectory's validated parts as ``_split`` makes them, read ``chunk_rows`` rows
+    at a time. The first failure of a row (parse, blank line) raises at once, as
+    ``parse_trajectory_csv`` would; a validation failure stops the parts and is raised once the
+    whole file is read (a later row's parse failure, or an earlier check, would win in
+    ``validate``'s order); counts rows and the time span into ``c``."""
+    checks = _Checks(s, source, allow_speed)
+    prev: tuple[float, FloatArray, int] | None = None
+    vals: array[float] = array("d")
+    where: list[int] = []
+
+    def flush() -> Iterator[tuple[Trajectory, int]]:
+        nonlocal prev, vals, where
+        arr = np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
+        t, a = arr[:, 0].copy(), arr[:, 1:].copy()
+        offset, lines_here = c.rows, where
+        vals, where = array("d"), []
+        if not c.rows:
+            c.t_start = float(t[0])
+        c.rows += len(t)
+        c.t_end = float(t[-1])
+        was_ok = not checks.failed
+        checks.add(t, a, lines_here, offset)
+        last = (float(t[-1]), a[-1].copy(), lines_here[-1])
+        if was_ok and not checks.failed:
+            if prev is None:
+                yield Trajectory(t, a, source, tuple(lines_here)), offset
+            else:
+                yield (Trajectory(np.concatenate([[prev[0]], t]),
+                                  np.concatenate([prev[1][None, :], a]), source,
+                                  (prev[2], *lines_here)), offset - 1)
+        prev = last
+
+    for no, row in _csv_rows(lines, source):
+        vals.extend(row)
+        where.append(no)
+        if len(where) >= chunk_rows:
+            yield from flush()
+    if where:
+        yield from flush()
+    if not c.rows:
+        raise _fail("trajectory", MISSING, "must have at least one row", source, 1)
+    checks.raise_first()
+
+
+def certify_trajectory_file(path: str | Path, s: Scenario, *, allow_speed: bool = False,
+                            chunk_rows: int = CHUNK_ROWS,
+                            timings: dict[str, float] | None = None,
+                            ) -> tuple[TrajectorySummary, Certificate, str]:
+    """(summary, certificate, SHA-256 of the file's bytes) of a trajectory file, read and
+    certified in one pass: a CSV ``chunk_rows`` rows at a time, so what is held does not grow
+    with the file (docs/model.md §12); a JSON file is read whole (within LIMITS["trajectory"])
+    and certified in the same parts. Errors are those of ``load_trajectory``, in the same
+    order; the certificate is ``certify_trajectory``'s of the loaded trajectory. ``timings``
+    gets the seconds spent reading (``load``) and certifying (``certificate``)."""
+    if chunk_rows < 2:
+        raise ValueError("chunk_rows must be at least 2")
+    p = Path(path)
+    source = str(p)
+    tim = {"load": 0.0, "certificate": 0.0}
+    c = _Certifier(s, source)
+    t0 = time.perf_counter()
+    if p.suffix.lower() != ".json":
+        try:
+            fh = open(p, "rb")
+        except OSError as exc:
+            raise _fail("trajectory", MISSING, f"cannot be read ({exc.strerror or exc})", source,
+                        None) from None
+        with fh:
+            reader = _HashingReader(fh)
+            # cast: bounded_lines reads only readline(size) of a binary stream
+            lines = bounded_lines(cast(IO[bytes], reader), source, total=LIMITS["trajectory"])
+            first = next(lines, "")
+            if not first.lstrip().startswith("{"):
+                parts = _csv_parts(itertools.chain([first], lines), s, source, allow_speed,
+                                   chunk_rows, c)
+                while True:
+                    part = next(parts, None)
+                    t1 = time.perf_counter()
+                    tim["load"] += t1 - t0
+                    if part is None:
+                        break
+                    c.add(*part)
+                    t0 = time.perf_counter()
+                    tim["certificate"] += t0 - t1
+                if timings is not None:
+                    timings.update(tim)
+                return c.summary(), c.prover.certificate(), reader.hash.hexdigest()
+    data = read_bounded(p, LIMITS["trajectory"], source, lines=False, field="trajectory")
+    traj = _parse_json_bytes(data, s, source, allow_speed)
+    t1 = time.perf_counter()
+    cert = certify_trajectory(s, traj, chunk_rows=chunk_rows)
+    if timings is not None:
+        timings.update(load=t1 - t0, certificate=time.perf_counter() - t1)
+    return TrajectorySummary.of(traj, cert), cert, hashlib.sha256(data).hexdigest()

@@ -38,7 +38,7 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert set(res) == {"meta", "builtdr", "builtdr_profile", "search", "shapely", "scaling",
                         "plan", "dr_cli", "check", "prove", "contracts", "one_degree", "monitor",
-                        "plan_scaling", "targets", "informational"}
+                        "plan_scaling", "certify_stream", "targets", "informational"}
     assert [r["dt"] for r in res["plan_scaling"]["rows"]] == [0.16, 0.08]
     assert all("error" not in r and r["bytes_per_cell"] > 0 for r in res["plan_scaling"]["rows"])
     for v in Variant:
@@ -212,3 +212,39 @@ def test_plan_scaling_reports_cells_peak_bytes_a_cell_and_the_exponent(tmp_path,
     assert [r["bytes_per_cell"] for r in sec["rows"]] == [15.0, 15.0]
     assert sec["time_exponent"] == 1.0
     assert "time ~ cells^1.0" in run.plan_scaling_lines(sec)[-1]
+
+
+def test_certify_stream_reports_seconds_peak_and_bytes_a_row(tmp_path, monkeypatch):
+    # cli_run made up: the peak 100 MiB at 10^5 rows and 110 MiB at 10^6 (growth 10 MiB).
+    run = bench_module()
+    cfg = run.Config.of(False, None)
+    monkeypatch.setattr(run, "CERTIFY_STREAM", run.CERTIFY_STREAM | {"rows": (100, 1000)})
+    peaks = iter([100.0, 110.0])
+    seen = []
+
+    def fake_cli_run(cfg, argv, *a, env=None, **k):
+        traj = Path(argv[argv.index("--traj") + 1])
+        seen.append((len(traj.read_text().splitlines()) - 1, env))
+        Path(argv[argv.index("--json") + 1]).write_text(json.dumps(
+            {"clear": True, "intervals": 7, "timings_s": {"load": 1.0, "certificate": 2.0}}))
+        return {"median_s": 3.0, "min_s": 3.0, "max_s": 3.0, "runs": 1,
+                "peak_rss_mb": next(peaks)}
+
+    monkeypatch.setattr(run, "cli_run", fake_cli_run)
+    sec = run.certify_stream_section(cfg, tmp_path)
+    assert [n for n, _ in seen] == [100, 1000]
+    assert all(int(e["CFMPA_MAX_TRAJECTORY_BYTES"]) >= 32 * 2**20 for _, e in seen)
+    assert [r["peak_bytes_per_row"] for r in sec["runs"]] == [
+        round(100 * 2**20 / 100, 1), round(110 * 2**20 / 1000, 1)]
+    assert sec["peak_growth_mib"] == 10.0
+    assert "peak growth over the rows: 10.0 MiB" in run.certify_stream_lines(sec)[-1]
+
+
+def test_the_slow_trajectory_is_valid_and_certified_clear(tmp_path):
+    from cfmpa.scenarios import BUNDLED_DIR
+    from cfmpa.spec import certify_trajectory_file, load_scenario
+    run = bench_module()
+    path = tmp_path / "slow.csv"
+    run.slow_trajectory_csv(path, 500, 0.01)
+    info, cert, _ = certify_trajectory_file(path, load_scenario(BUNDLED_DIR / "default.toml"))
+    assert info.rows == 500 and cert.clear and cert.intervals == 499

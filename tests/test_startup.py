@@ -1,0 +1,101 @@
+"""Start-up (issue 24.6): a command imports what it needs. After what `cfmpa dr`, `plan` and
+`certify` import and run (the parser of every command, their run_* functions, plan.json's versions,
+a certify), a fresh interpreter holds no z3, matplotlib, dask or distributed, and certify no numba,
+python-flint or shapely either. The packages spec, impl and runs import their modules on first use
+(PEP 562 ``__getattr__`` over ``_LAZY``); their ``__all__`` and the type checker's imports are
+the same names, each the module's own object. Seeded faults: an eager import planted before the
+check is caught."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("z3", "matplotlib", "dask", "distributed")
+#: What certify, which is spec only, does not need either.
+PLANNER = ("numba", "flint", "shapely")
+LAZY_PACKAGES = {"spec": "cfmpa.spec", "impl": "cfmpa.impl", "runs": "cfmpa.runs"}
+
+TRAJ = "t,left1,left2,right1,right2\n0,0.3,0.8,3.3,0.5\n2,0.3,0.8,3.3,0.5\n"
+
+
+def _loaded(code: str, prelude: str = "") -> list[str]:
+    """The top-level modules of HEAVY + PLANNER that ``prelude`` then ``code`` leave in a fresh
+    interpreter's sys.modules."""
+    probe = (f"{prelude}\n{code}\nimport json, sys\n"
+             f"print(json.dumps(sorted(m for m in {list(HEAVY + PLANNER)!r} if m in sys.modules)))")
+    proc = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _certify(tmp: Path) -> str:
+    traj = tmp / "t.csv"
+    traj.write_text(TRAJ)
+    return ("import contextlib, io\nfrom cfmpa.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            f"    assert main(['certify', 'default', '--traj', {str(traj)!r}]) == 0\n")
+
+
+#: What `cfmpa dr` and `cfmpa plan` import and call before their kernels: the whole parser,
+#: their run_* functions, the plan and plan.json's versions.
+DR_PLAN = ("from cfmpa.cli import _parser\n_parser()\n"
+           "from cfmpa.runs import plan, plan_json, run_dr, run_plan, versions, write_plan\n"
+           "versions()\n")
+
+
+def test_dr_and_plan_load_no_z3_matplotlib_or_dask():
+    assert not set(_loaded(DR_PLAN)) & set(HEAVY)
+
+
+def test_certify_loads_nothing_of_the_planner(tmp_path):
+    assert _loaded(_certify(tmp_path)) == []
+
+
+def test_seeded_fault_an_eager_import_is_caught(tmp_path):
+    # versions() as it was: it imported z3 for its version string
+    planted = "import z3\n"
+    assert "z3" in _loaded(DR_PLAN, planted)
+    # runs/__init__.py as it was: every module imported with the package
+    eager = "import cfmpa.runs\nfor n in cfmpa.runs.__all__: getattr(cfmpa.runs, n)\n"
+    assert "numba" in _loaded(_certify(tmp_path), eager)
+
+
+def test_z3_version_without_z3_is_z3s_own():
+    import z3
+
+    from cfmpa.runs._plan import z3_version
+    assert z3_version() == z3.get_version_string()
+
+
+def _type_checking_names(path: Path) -> dict[str, tuple[str, str]]:
+    """name -> (module, name there) of the imports under ``if TYPE_CHECKING:``."""
+    out: dict[str, tuple[str, str]] = {}
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, ast.If) and getattr(node.test, "id", None) == "TYPE_CHECKING":
+            for imp in node.body:
+                assert isinstance(imp, ast.ImportFrom) and imp.level == 1
+                for a in imp.names:
+                    out[a.asname or a.name] = ("." + str(imp.module), a.name)
+    return out
+
+
+@pytest.mark.parametrize("folder", sorted(LAZY_PACKAGES))
+def test_lazy_packages_keep_their_public_names(folder):
+    pkg = importlib.import_module(LAZY_PACKAGES[folder])
+    lazy = pkg._LAZY
+    assert _type_checking_names(ROOT / folder / "__init__.py") == lazy
+    assert set(pkg.__all__) <= set(lazy)
+    for name, (module, attr) in lazy.items():
+        assert getattr(pkg, name) is getattr(importlib.import_module(module, pkg.__name__), attr)
+    assert set(pkg.__all__) <= set(dir(pkg))
+    with pytest.raises(AttributeError):
+        pkg.no_such_name  # noqa: B018
