@@ -10,6 +10,7 @@ JSON outputs are byte-identical for the same inputs apart from ``timings_s``.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import math
 import sys
