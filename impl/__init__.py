@@ -2,7 +2,7 @@
 
 from typing import TYPE_CHECKING
 
-from .._lazy import lazy_exports
+from ..lazy import lazy_exports
 
 if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _EXPORTS
     from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
@@ -18,7 +18,7 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
     from ._threads import kernel_threads, set_kernel_threads
     from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
 
-#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa._lazy): a
+#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa.lazy): a
 #: command loads only the modules it needs (docs/model.md §1.1).
 _EXPORTS: dict[str, str] = {
     "ContainmentReport": "._builtdr:ContainmentReport",

@@ -29,13 +29,14 @@ exit 2.
 
 from typing import TYPE_CHECKING
 
-from .._lazy import lazy_exports
+from ..lazy import lazy_exports
 
 if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _EXPORTS
-    from ._campaign import (COMPARE_DT, CONTACT_NOTE, KERNEL, MAX_DRAWS, MAX_DT, MAX_WORKCELLS,
+    from ._campaign import (COMPARE_DT, CONTACT_NOTE, KERNEL, MAX_DRAWS,
                             STORE_NAME, Campaign,
                             CaseError, CaseResult, VariantOutcome, load_campaign, plan_workcell,
                             random_workcell, run_campaign, workcell_task)
+    from ._limits import MAX_DT, MAX_WORKCELLS
     from ._store import Store, open_store, read_store
     from ._batch import BATCH_JSON, batch_table, check_plan_folder, find_plan_folders, run_batch
     from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
@@ -59,7 +60,7 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
     from ._selftest import (FAULTS, SAMPLE, WORKCELLS, Fault, SelftestRow, run_fault, run_selftest,
                             selftest_rows, selftest_table, workcell)
 
-#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa._lazy): a
+#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa.lazy): a
 #: command loads only the modules it needs (docs/model.md §1.1).
 _EXPORTS: dict[str, str] = {
     "COMPARE_DT": "._campaign:COMPARE_DT",

@@ -5,7 +5,7 @@ The same definitions as Z3 terms are the public module ``cfmpa.spec.z3defs``.
 
 from typing import TYPE_CHECKING
 
-from .._lazy import lazy_exports
+from ..lazy import lazy_exports
 
 if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _EXPORTS
     from ._counts import (MAX_EXTRA_POINTS, SPACING_ROUNDING, SPEED_READING, SpacingCondition,
@@ -42,7 +42,7 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
                            label_in_range, label_key, load_witness, start_breaks, step_cost,
                            stop_key)
 
-#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa._lazy): a
+#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa.lazy): a
 #: command loads only the modules it needs (docs/model.md §1.1).
 _EXPORTS: dict[str, str] = {
     "CHUNK_ROWS": "._trajectory:CHUNK_ROWS",

@@ -30,7 +30,7 @@ ALLOWED = {
     "cfmpa.report": {"cfmpa.spec", "cfmpa.impl", "cfmpa.proofs", "cfmpa.runs"},
     "cfmpa": {"cfmpa.spec", "cfmpa.impl", "cfmpa.proofs", "cfmpa.runs", "cfmpa.report"},
 }
-LEAVES = {"cfmpa", "cfmpa._lazy", "cfmpa.errors", "cfmpa.files", "cfmpa.gitstate",
+LEAVES = {"cfmpa", "cfmpa.lazy", "cfmpa.errors", "cfmpa.files", "cfmpa.gitstate",
           "cfmpa.scenarios"}
 #: Libraries a module may not import, by module name prefix: the report presents what runs/
 #: computed (the campaign's engine is runs/_engine.py's), so it has no dask of its own; the
