@@ -829,7 +829,7 @@ def _monitor_one(s: Scenario, plans: _Plans, figures: dict[str, F.Figure]) -> di
 _MONITOR_KEYS = ("status", "samples", "outside", "outside_in_contact", "max_deviation_rad",
                  "t_first_s", "t_last_s", "first_outside_t", "first_outside_line",
                  "first_outside_joint", "first_outside_deviation_rad", "contact",
-                 "tolerance_rad")
+                 "tolerance_rad", "max_gap_s", "covered_fraction", "unobserved")
 
 
 def monitor_problems(mon: Mapping[str, Any]) -> list[str]:
