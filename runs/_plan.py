@@ -107,7 +107,7 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
          kernel: str | None = None, witness: bool = False) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
 
-    ``contracts`` is off (this function's default; `cfmpa plan` defaults to sampled), sampled
+    ``contracts`` is off (this function's default; `cfmpa plan` defaults to full), sampled
     (``sample`` random cells, ``seed``) or full (see _contracts).
     In every mode, off included, a certificate that is not clear (a contact, or an interval left
     undecided) is a violation. A violation raises ContractViolation; with ``stop=False``
