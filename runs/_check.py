@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, ContractViolation, InputError
+from ..files import LIMITS, read_bounded
 from ..spec import Grid, Scenario, Variant, load_scenario, make_grid
 from ..spec import certify, require_clear
 from ..spec import SearchResult, SearchStatus
@@ -138,10 +139,8 @@ def read_plan(path: str | Path) -> PlanDoc:
     """plan.json's keys that check needs (docs/model.md §9); InputError names a missing or bad key."""
     source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError("plan", MISSING, f"cannot be read ({exc.strerror or exc})",
-                         source=source) from None
+        # Bounded: /dev/zero or a file cut short of its end is refused at the limit (§3).
+        text = read_bounded(path, LIMITS["plan"], source, lines=False, field="plan").decode("utf-8")
     except UnicodeDecodeError:
         raise InputError("plan", MISSING, "is not UTF-8 text", source=source) from None
     try:

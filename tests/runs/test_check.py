@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import factory
-from cfmpa.errors import handled
+from cfmpa.errors import InputError, handled
 from cfmpa.runs._check import check_outputs, read_plan, run_check
 from cfmpa.runs._plan import plan, write_plan
 from cfmpa.runs._selftest import FAULTS, WORKCELLS
@@ -355,3 +355,19 @@ def test_check_rejects_every_fault_the_selftest_seeds(tmp_path):
                 "Theorem 4 post.optimal"], fault.name
             want = "witness.edge" if fault.name == "forged witness" else "witness.goal"
             assert want in report.failed[0].what, (fault.name, report.failed[0].what)
+
+
+def test_a_plan_file_is_read_within_its_limit(tmp_path, monkeypatch):
+    # /dev/zero (or a plan.json cut short of nothing) is refused at the limit, naming it;
+    # before, the whole device was read into memory (MemoryError).
+    from cfmpa.runs import read_plan
+
+    with pytest.raises(InputError) as e:
+        read_plan("/dev/zero")
+    assert "CFMPA_MAX_PLAN_BYTES" in e.value.render()
+    big = tmp_path / "plan.json"
+    big.write_text('{"path": [' + "[0, 0], " * 1000 + "[0, 0]]}")
+    monkeypatch.setenv("CFMPA_MAX_PLAN_BYTES", "1000")
+    with pytest.raises(InputError) as e:
+        read_plan(big)
+    assert "limit of 1,000 bytes" in e.value.render()
