@@ -152,10 +152,13 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "compared with sweep_margin's formula, read from the code by running it on Z3 terms and "
         "checked against its floats on samples; the lattice model is checked against "
         "lattice_range on samples. Lemmas enter by substitution into proved VCs; "
-        "Safety.region_soundness enters the compositions as its statement at the points used, "
-        "the predicates linkL, linkR and mem naming what it is about (a point of a link of "
-        "§2 at a configuration, of the polygon built for a box); norm chains are proved for "
-        "every function standing for |v|^2, so for |v|^2.",
+        "Safety.region_statement derives, from Safety.region_soundness's lemmas, the statement "
+        "the compositions use (a point of a link at a configuration of a box is a member of "
+        "the region built for the box), with linkL, linkR and mem given their meaning by two "
+        "definitions stated in it (a point of §2's rectangle at its local coordinates; the "
+        "hull contains the convex combinations of the grown rectangles' points at the "
+        "lattice configurations); norm chains are proved for every function standing for "
+        "|v|^2, so for |v|^2.",
         "Safety.*"),
     Assumption(
         "A12.float_distance_error",

@@ -1554,50 +1554,305 @@ def region_hypotheses(variant: str, at: _At) -> list[Hyp]:
     ]
 
 
-#: swept(x, lo1, hi1, lo2, hi2): the region built for link x and a box (impl.swept_region).
-_SWEPT_L = z3.Function("sweptL", z3.IntSort(), _R, _R, _R, _R, REGION)
-_SWEPT_R = z3.Function("sweptR", z3.IntSort(), _R, _R, _R, _R, REGION)
+#: swept(x, lo1, hi1, lo2, hi2, A1, A2, g1, g2): the region impl.swept_region builds for link x,
+#: the box [lo1, hi1] x [lo2, hi2], the lattice anchored at (A1, A2) with spacings (g1, g2).
+_SWEPT_L = z3.Function("sweptL", z3.IntSort(), *[_R] * 8, REGION)
+_SWEPT_R = z3.Function("sweptR", z3.IntSort(), *[_R] * 8, REGION)
+
+Box = tuple[Vec, Vec]
 
 
-def _swept(f: z3.FuncDeclRef, x: z3.ArithRef | int, box: tuple[Vec, Vec]) -> z3.ExprRef:
-    return f(x, box[0][0], box[0][1], box[1][0], box[1][1])
+def _swept(f: z3.FuncDeclRef, x: z3.ArithRef | int, box: Box, anchor: Vec, g: Vec
+           ) -> z3.ExprRef:
+    return f(x, box[0][0], box[0][1], box[1][0], box[1][1], anchor[0], anchor[1], g[0], g[1])
 
 
-def region_statement(link: Callable[..., z3.BoolRef], swept: z3.FuncDeclRef) -> z3.BoolRef:
-    """Safety.region_soundness's conclusion, over opaque links and regions, stated once: for
-    every link x, box, configuration theta in the box and point p, a point of link x at theta
-    is a member of the region built for x and the box."""
-    x = z3.Int("rs!x")
-    lo1, hi1, lo2, hi2, t1, t2, p1, p2 = z3.Reals("rs!lo1 rs!hi1 rs!lo2 rs!hi2 rs!t1 rs!t2 "
-                                                  "rs!p1 rs!p2")
-    box = ((lo1, hi1), (lo2, hi2))
-    return z3.ForAll([x, lo1, hi1, lo2, hi2, t1, t2, p1, p2], z3.Implies(
-        z3.And(in_box((t1, t2), box), link(x, (t1, t2), (p1, p2))),
-        member(_swept(swept, x, box), (p1, p2))))
+def spacing_ok(g: Vec) -> z3.BoolRef:
+    """The margin lemma's range of lattice spacings, 0 < g_q <= 157/50 (the loader's check)."""
+    return z3.And(0 < g[0], g[0] <= G_MAX, 0 < g[1], g[1] <= G_MAX)
+
+
+@dataclass(frozen=True)
+class ArmModel:
+    """One arm's links as the safety theorem reads them (docs/model.md §2, §4.2): the base b,
+    the lengths l1, l2, the half-widths r1, r2 (w/2), R_base of link 1 and R_elbow of link 2
+    (square roots, named), the opaque predicate "p is a point of link x at theta" (``link``),
+    the region built for a link and a box (``swept``), and the local coordinates of a point of
+    a link in the link's frame (``loc``: what the definition's "there are (u, v)" names)."""
+
+    tag: str
+    link: z3.FuncDeclRef
+    swept: z3.FuncDeclRef
+    loc: tuple[z3.FuncDeclRef, z3.FuncDeclRef]
+    b: Vec
+    l1: z3.ArithRef
+    l2: z3.ArithRef
+    r1: z3.ArithRef
+    r2: z3.ArithRef
+    rb1: z3.ArithRef
+    re2: z3.ArithRef
+
+    @classmethod
+    def named(cls, tag: str) -> ArmModel:
+        link = _LINK_L if tag == "L" else _LINK_R
+        swept = _SWEPT_L if tag == "L" else _SWEPT_R
+        loc = tuple(z3.Function(f"{tag}.loc{c}", z3.IntSort(), *[_R] * 4, _R) for c in "uv")
+        l1, l2, r1, r2, rb1, re2 = z3.Reals(" ".join(f"{tag}.{n}" for n in (
+            "l1", "l2", "r1", "r2", "Rb1", "Re2")))
+        return cls(tag, link, swept, (loc[0], loc[1]), _v(f"{tag}.b"), l1, l2, r1, r2, rb1, re2)
+
+    def holds(self, x: int, theta: Vec, p: Vec) -> z3.BoolRef:
+        return self.link(x, theta[0], theta[1], p[0], p[1])
+
+    def local(self, x: int, theta: Vec, p: Vec) -> Vec:
+        args = (x, theta[0], theta[1], p[0], p[1])
+        return (self.loc[0](*args), self.loc[1](*args))
+
+    def frame_point(self, x: int, alpha: z3.ArithRef, phi: z3.ArithRef, uv: Vec) -> Vec:
+        """docs/model.md §2: the point at local coordinates uv of link 1's frame (at the base,
+        turned by alpha = theta1) or link 2's (at the elbow b + l1 e(alpha), turned by
+        phi = theta1 + theta2)."""
+        if x == 0:
+            return _add(self.b, _rot(e(alpha), uv))
+        return _point2(self.b, self.l1, alpha, phi, uv[0], uv[1])
+
+    def point(self, x: int, theta: Vec, uv: Vec) -> Vec:
+        """The point at local coordinates uv of link x at theta."""
+        return self.frame_point(x, theta[0], theta[0] + theta[1], uv)
+
+    def reach(self, x: int) -> Vec:
+        """(R_base, R_elbow) as impl.link_reach gives them, in the proofs' names."""
+        return (self.rb1, z3.RealVal(0)) if x == 0 else (self.l1 + self.re2, self.re2)
+
+    def geometry(self) -> tuple[Hyp, ...]:
+        """The arm's link geometry (docs/model.md §2; the loader's checks), both links."""
+        return (
+            (f"{self.tag}: links (docs/model.md §2): l1, l2 > 0, r1 = w1/2 > 0, r2 = w2/2 > 0",
+             z3.And(self.l1 > 0, self.l2 > 0, self.r1 > 0, self.r2 > 0)),
+            (f"{self.tag}: R_base of link 1 = sqrt((l1 + r1)^2 + r1^2) (named)",
+             z3.And(self.rb1 >= 0, self.rb1 * self.rb1 == (self.l1 + self.r1) * (self.l1 + self.r1)
+                    + self.r1 * self.r1)),
+            (f"{self.tag}: R_elbow of link 2 = sqrt((l2 + r2)^2 + r2^2) (named)",
+             _elbow_reach(self.l2, self.r2, self.re2)),
+        )
+
+    def link_definition(self, x: int) -> tuple[list[z3.ExprRef], z3.BoolRef]:
+        """Definitional (docs/model.md §2): a point of link x at theta is the point of the
+        link's rectangle at its local coordinates (u, v): -r <= u <= l + r, |v| <= r. Returns
+        its bound names and its body."""
+        pre = f"{self.tag}.d1.{x}!"
+        t1, t2, p1, p2 = z3.Reals(f"{pre}t1 {pre}t2 {pre}p1 {pre}p2")
+        theta, p = (t1, t2), (p1, p2)
+        uv = self.local(x, theta, p)
+        r, ell = (self.r1, self.l1) if x == 0 else (self.r2, self.l2)
+        return [t1, t2, p1, p2], z3.Implies(
+            self.holds(x, theta, p),
+            z3.And(in_rect(uv, r, ell), _veq(p, self.point(x, theta, uv))))
+
+    def margin(self, x: int, box: Box, anchor: Vec, g: Vec,
+               margin: Callable[..., object] = sweep_margin) -> z3.ArithRef:
+        """impl.sweep_margin for the box's lattice (a joint with one lattice point is not
+        moving), read as Safety.region_soundness reads it."""
+        moving = []
+        for q in range(2):
+            lo_i, hi_i = lattice_range(box[q][0], box[q][1], anchor[q], g[q])
+            moving.append(z3.BoolVal(False) if (x == 0 and q == 1) else hi_i > lo_i)
+        return impl_margin(x, g, self.reach(x), (moving[0], moving[1]), margin)
+
+    def hull_definition(self, x: int, box: Box, anchor: Vec, g: Vec,
+                        margin: Callable[..., object] = sweep_margin
+                        ) -> tuple[list[z3.ExprRef], z3.BoolRef]:
+        """Definitional (docs/model.md §4.2: the region is the convex hull of the link's
+        rectangles grown by impl.sweep_margin at the lattice configurations of impl.lattice_range):
+        a point q that is a convex combination of points of those grown rectangles is a member
+        of the region. Stated for the corners the proof combines (four for link 2, two for link 1, whose
+        lattice has the one point anchor2 in theta2); returns its bound names and its body."""
+        n = 4 if x == 1 else 2
+        pre = f"{self.tag}.d2.{x}!"
+        lat = [lattice_range(box[q][0], box[q][1], anchor[q], g[q]) for q in range(2)]
+        delta = self.margin(x, box, anchor, g, margin)
+        r, ell = (self.r1, self.l1) if x == 0 else (self.r2, self.l2)
+        bound: list[z3.ExprRef] = []
+        conds: list[z3.BoolRef] = []
+        pts: list[Vec] = []
+        ws: list[z3.ArithRef] = []
+        for c in range(n):
+            i, j = z3.Int(f"{pre}i{c}"), z3.Int(f"{pre}j{c}")
+            al, be, ph, w = z3.Reals(f"{pre}alpha{c} {pre}beta{c} {pre}phi{c} {pre}w{c}")
+            uv = _v(f"{pre}uv{c}")
+            bound += [i, j, al, be, ph, w, uv[0], uv[1]]
+            conds += [lat[0][0] <= i, i <= lat[0][1], al == anchor[0] + z3.ToReal(i) * g[0],
+                      in_rect(uv, r + delta, ell), w >= 0]
+            if x == 1:
+                conds += [lat[1][0] <= j, j <= lat[1][1], be == anchor[1] + z3.ToReal(j) * g[1],
+                          ph == al + be]
+            pts.append(self.frame_point(x, al, ph, uv))
+            ws.append(w)
+        q = _v(f"{pre}q")
+        conds += [z3.Sum(ws) == 1, _veq(q, _weighted(ws, pts))]
+        body = z3.Implies(z3.And(conds), member(_swept(self.swept, x, box, anchor, g), q))
+        return bound + [q[0], q[1]], body
+
+
+def region_statement(arm: ArmModel, x: int) -> tuple[list[z3.ExprRef], z3.BoolRef]:
+    """Safety.region_statement's conclusion for link x of ``arm``, over its bound names: for
+    every box, lattice anchor and spacing (0 < g_q <= 157/50), configuration theta in the box
+    and point p, a point of link x at theta is a member of the region built for x, the box,
+    the anchor and the spacing."""
+    pre = f"{arm.tag}.rs{x}!"
+    lo1, hi1, lo2, hi2, a1, a2, g1, g2, t1, t2, p1, p2 = z3.Reals(
+        " ".join(pre + n for n in "lo1 hi1 lo2 hi2 A1 A2 g1 g2 t1 t2 p1 p2".split()))
+    box, anchor, g, theta, p = ((lo1, hi1), (lo2, hi2)), (a1, a2), (g1, g2), (t1, t2), (p1, p2)
+    body = z3.Implies(z3.And(in_box(theta, box), spacing_ok(g), arm.holds(x, theta, p)),
+                      member(_swept(arm.swept, x, box, anchor, g), p))
+    return [lo1, hi1, lo2, hi2, a1, a2, g1, g2, t1, t2, p1, p2], body
+
+
+def region_statement_closed(arm: ArmModel) -> z3.BoolRef:
+    """region_statement for both links of ``arm``, universally closed."""
+    parts = []
+    for x in LINKS:
+        bound, body = region_statement(arm, x)
+        parts.append(z3.ForAll(bound, body))
+    return z3.And(parts)
+
+
+#: The hypotheses of link{1,2}_in_region that the derivation discharges itself rather than
+#: passes through as definitions of the lemma's named quantities: the link's geometry (the
+#: arm's), theta in the box and the spacings (the statement's antecedent), (u, v) in the
+#: rectangle (the link's definition).
+_DERIVED = {
+    0: ("link 1 (docs/model.md §2): l1 > 0, r = w/2 > 0", "R_base = sqrt((l1 + r)^2 + r^2)",
+        "theta1 in the box", "lattice spacings 0 < g_q <= 3.14",
+        "(u, v) a point of link 1's rectangle"),
+    1: ("link 2 (docs/model.md §2): l1, l2 > 0, r = w/2 > 0",
+        "R_elbow = sqrt((l2 + r)^2 + r^2), R_base = l1 + R_elbow", "theta in the box",
+        "lattice spacings 0 < g_q <= 3.14", "(u, v) a point of link 2's rectangle"),
+}
+
+
+def region_statement_vc(arm: ArmModel, x: int, kit: Kit | None = None,
+                        margin: Callable[..., object] = sweep_margin) -> VC:
+    """Safety.region_statement for link x of ``arm``: region_statement's body at its bound
+    names (so its universal closure), from the link's definition at (theta, p), the hull's
+    definition at the corners link{x+1}_in_region exhibits, and that lemma (proved in
+    Safety.region_soundness) instantiated by substitution at the arm's geometry, the box,
+    theta and (u, v) = the point's local coordinates. ``margin`` is the region's (the tests'
+    mutant); the lemma keeps the kit's."""
+    kit = kit or region_kit()
+    lem = kit[f"link{x + 1}_in_region"]
+    bound, goal = region_statement(arm, x)
+    lo1, hi1, lo2, hi2, a1, a2, g1, g2, t1, t2, p1, p2 = bound
+    box, anchor, g, theta, p = ((lo1, hi1), (lo2, hi2)), (a1, a2), (g1, g2), (t1, t2), (p1, p2)
+    uv = arm.local(x, theta, p)
+    pre = "lk1" if x == 0 else "lk2"
+    R = z3.Real
+    if x == 0:
+        pairs = [(R("lk1.l1"), arm.l1), (R("lk1.r"), arm.r1), (R("lk1.Rb"), arm.rb1),
+                 (R("lk1.lo1"), lo1), (R("lk1.hi1"), hi1), (R("lk1.theta1"), t1),
+                 (R("lk1.A1"), a1), (R("lk1.g1"), g1), (R("lk1.g2"), g2)]
+    else:
+        pairs = [(R("lk2.l1"), arm.l1), (R("lk2.l2"), arm.l2), (R("lk2.r"), arm.r2),
+                 (R("lk2.Re"), arm.re2), (R("lk2.lo1"), lo1), (R("lk2.hi1"), hi1),
+                 (R("lk2.theta1"), t1), (R("lk2.A1"), a1), (R("lk2.g1"), g1),
+                 (R("lk2.lo2"), lo2), (R("lk2.hi2"), hi2), (R("lk2.theta2"), t2),
+                 (R("lk2.A2"), a2), (R("lk2.g2"), g2)]
+    pairs += [(R(f"{pre}.b.x"), arm.b[0]), (R(f"{pre}.b.y"), arm.b[1]),
+              (R(f"{pre}.u"), uv[0]), (R(f"{pre}.v"), uv[1])]
+    names = {n for n, _ in lem.hyps}
+    missing = [n for n in _DERIVED[x] if n not in names]
+    if missing:
+        raise KeyError(f"{lem.vc.name} has no hypotheses {missing}: _DERIVED is out of date")
+    def sub(f: z3.ExprRef) -> z3.ExprRef:
+        return concrete(z3.substitute(f, *pairs))
+    defs = [(f"{n} [{lem.vc.name}'s named quantity]", sub(h)) for n, h in lem.hyps
+            if n not in _DERIVED[x] and not n.startswith(_CARRIED + (_PROVED,))]
+    # The corners, weights and local coordinates link{x+1}_in_region's conclusion names.
+    c1, G1 = R(f"{pre}.joint1.c"), R(f"{pre}.joint1.G")
+    j1, st1 = z3.Int(f"{pre}.joint1.j"), z3.If(z3.Bool(f"{pre}.joint1.moving"), 1, 0)
+    D = _v(f"{pre}.D")
+    if x == 1:
+        c2, G2 = R("lk2.joint2.c"), R("lk2.joint2.G")
+        j2, st2 = z3.Int("lk2.joint2.j"), z3.If(z3.Bool("lk2.joint2.moving"), 1, 0)
+        lam, mu, nu = z3.Reals("lk2.lam lk2.mu lk2.nu")
+        alphas = (c1, c1, c1 + G1, c1 + G1)
+        betas = (c2, c2 + G2, c2, c2 + G2)
+        phis = (c1 + c2, (c1 + c2) + G2, (c1 + G1) + c2, ((c1 + G1) + c2) + G2)
+        i_s = (j1, j1, j1 + st1, j1 + st1)
+        j_s = (j2, j2 + st2, j2, j2 + st2)
+        ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
+    else:
+        lam = R("lk1.lam")
+        alphas = (c1, c1 + G1)
+        betas = phis = (R("lk1.unused"),) * 2
+        i_s, j_s = (j1, j1 + st1), (z3.IntVal(0),) * 2
+        ws = (1 - lam, lam)
+    uvs = [grown_coords(ph if x == 1 else a, *(sub(z) for z in (R(f"{pre}.u"), R(f"{pre}.v"))),
+                        D) for a, ph in zip(alphas, phis)]
+    hull_bound, hull = arm.hull_definition(x, box, anchor, g, margin)
+    inst: list[tuple[z3.ExprRef, z3.ExprRef]] = []
+    for c in range(len(alphas)):
+        vals = [i_s[c], j_s[c], alphas[c], betas[c], phis[c], ws[c], uvs[c][0], uvs[c][1]]
+        inst += list(zip(hull_bound[8 * c: 8 * c + 8], vals))
+    inst += list(zip(hull_bound[-2:], p))        # the combination is the point p itself
+    key = f"{arm.tag}: the hull's definition at link {x + 1}'s corners (docs/model.md §4.2)"
+    link_bound, link_def = arm.link_definition(x)
+    hyps: list[Hyp] = [
+        *arm.geometry(),
+        (f"{arm.tag}: link {x + 1}'s definition (docs/model.md §2) at (theta, p)",
+         z3.substitute(link_def, *zip(link_bound, [t1, t2, p1, p2]))),
+        (key, concrete(z3.substitute(hull, *inst))),
+    ]
+    hyps += defs
+    hyps += [(n, concrete(h)) for n, h in lem.use(pairs, f"{arm.tag}, link {x + 1}")]
+    # The lemma's small arm at rest in a one-point box, for the vacuity check; its point (u, v)
+    # becomes the local coordinates of p.
+    wit = tuple((sub(c), v) for c, v in lem.vc.witness)
+    return VC(f"region_statement_{arm.tag}_link{x + 1}", _dedupe(hyps), goal, key_premise=key,
+              witness=wit, counter_witness=wit)
+
+
+def region_statement_query() -> Z3Query:
+    kit = region_kit()
+    return Z3Query(tuple(region_statement_vc(ArmModel.named(t), x, kit)
+                         for t in ("L", "R") for x in LINKS))
 
 
 def region_instance_vc(variant: str) -> VC:
-    """The compositions' (c) hypotheses are instances of region_statement, once the regions are
-    read as BuiltDR builds them (layer k's: the region of its box, k < N; the rest layer's: of
-    the rest box; a cell's: of its box). A (c) hypothesis stronger than the statement (a box
-    condition dropped, say) is refuted here."""
+    """The compositions' (c) hypotheses are instances of Safety.region_statement (proved for
+    both arms' links from Safety.region_soundness's lemmas and the definitions of a link and a
+    region), once the regions are read as BuiltDR builds them: layer k's (k < N) is the region
+    of its box on the lattice anchored at theta_L(k dt) with spacing omega dt; the rest layer's
+    of the rest box (anchored at the goal for tight, else layer N-1's); a cell's of its box,
+    anchored at the cell's angles with spacing h. A (c) hypothesis stronger than the statement
+    (a box condition dropped, say) is refuted here."""
     at = _At.named()
     region_l, region_rest, region_r = _regions(variant)
     P, k, here = at.P, at.k, at.here
-    key = "Safety.region_soundness for the principal's links (its statement)"
+    arm_l, arm_r = ArmModel.named("L"), ArmModel.named("R")
+    g_l = (P.omega[0] * P.dt, P.omega[1] * P.dt)
+    rest_anchor = P.goal if Variant(variant).rest_at_goal else P.theta(
+        (z3.ToReal(at.d.N) - 1) * P.dt)
+    key = "Safety.region_statement for the principal's links"
     hyps: list[Hyp] = [
-        (key, region_statement(link_l, _SWEPT_L)),
-        ("Safety.region_soundness for the subordinate's links (its statement)",
-         region_statement(link_r, _SWEPT_R)),
-        ("layer k's regions are the regions built for its box (k < N)",
+        *arm_l.geometry(), *arm_r.geometry(),
+        (key, region_statement_closed(arm_l)),
+        ("Safety.region_statement for the subordinate's links", region_statement_closed(arm_r)),
+        ("the loader's spacing checks: 0 < omega_q dt <= 157/50, 0 < h_q <= 157/50",
+         z3.And(spacing_ok(g_l), spacing_ok(at.S.h))),
+        ("layer k's regions are the regions built for its box, anchored at theta_L(k dt), "
+         "spacing omega dt (k < N)",
          z3.Implies(z3.And(0 <= k, k < at.d.N), z3.And([
-             region_l(k, x) == _swept(_SWEPT_L, x, P.box(variant, z3.ToReal(k)))
+             region_l(k, x) == _swept(_SWEPT_L, x, P.box(variant, z3.ToReal(k)),
+                                      P.theta(z3.ToReal(k) * P.dt), g_l)
              for x in LINKS]))),
         ("the rest layer's regions are the regions built for the rest box",
-         z3.And([region_rest(x) == _swept(_SWEPT_L, x, P.rest_box(variant)) for x in LINKS])),
-        ("a cell's regions are the regions built for its box",
+         z3.And([region_rest(x) == _swept(_SWEPT_L, x, P.rest_box(variant), rest_anchor, g_l)
+                 for x in LINKS])),
+        ("a cell's regions are the regions built for its box, anchored at its angles, spacing h",
          z3.Implies(in_grid(at.d, here), z3.And([
-             region_r(here[0], here[1], x) == _swept(_SWEPT_R, x, at.S.box(here))
+             region_r(here[0], here[1], x) == _swept(_SWEPT_R, x, at.S.box(here),
+                                                     at.S.angle(here), at.S.h)
              for x in LINKS]))),
     ]
     goal = z3.And([h for _, h in region_hypotheses(variant, at)])
@@ -1771,6 +2026,28 @@ def safety_obligations() -> list[Obligation]:
         "by t_i, the same construction up to rounding (ledger A2).",
         Z, P, region_query))
     out.append(Obligation(
+        "Safety.region_statement", GROUP, "docs/model.md §2, §4.2, §10 (c')",
+        "For each arm (the principal L, the subordinate R) and each link x: for every box "
+        "[lo1, hi1] x [lo2, hi2], lattice anchor A and spacing g (0 < g_q <= 157/50), "
+        "configuration theta in the box and point p, if p is a point of link x at theta "
+        "(linkL/linkR) then p is a member of the region built for x, the box, A and g "
+        "(sweptL/sweptR). Derived, not named: from (1) the link's definition (docs/model.md §2: "
+        "p is the point of the link's rectangle, half-width r = w/2 extended by r past both "
+        "joints, at its local coordinates, a function of theta and p), (2) the region's "
+        "definition (§4.2: a convex combination of points of the link's rectangles grown by "
+        "impl.sweep_margin, read on the symbols, at lattice configurations whose indices "
+        "impl.lattice_range gives, run on the symbols, is a member of the region; stated at "
+        "the corners the proof combines), and (3) Safety.region_soundness's "
+        "link1_in_region / link2_in_region, instantiated by substitution at the arm's "
+        "geometry, the box, theta and the point's local coordinates, with the lemma's named "
+        "quantities (lattice indices, chord weights, points, the displacement) defined as it "
+        "defines them. The arm's geometry (l1, l2, r1, r2 > 0, R_base and R_elbow as square "
+        "roots) is a premise. Both definitions are definitional (what linkL and the region "
+        "mean); tests check (2)'s generating points against impl.swept_points and (1)'s "
+        "rectangle against the link rectangles impl computes. The compositions' "
+        "region_instances VC takes this statement, universally closed, as its premise.",
+        Z, P, region_statement_query))
+    out.append(Obligation(
         "Safety.separation", GROUP, "docs/model.md §4.3, §10 (d)",
         "What eps buys. (eps_margin) BuiltDR frees a pair of regions when the distance it "
         "computes in doubles (or a lower bound of it: a box gap, a separating-axis gap) exceeds "
@@ -1799,13 +2076,15 @@ def safety_obligations() -> list[Obligation]:
             "cells) and the time step; the free test is BuiltDR's own (float distance > eps), "
             "carried to the exact distance by Safety.separation's premises (eps, err, A12 at the "
             "eight pairs of regions of layer k and of the rest layer, what a positive distance "
-            "means). Safety.region_soundness enters as its statement for the regions involved "
-            "(a link at a configuration of a region's box lies in the region), instantiated at "
-            "theta_L(t), theta_R(t) and the point, its links and regions opaque here; the VC "
-            "region_instances proves each such hypothesis an instance of that one statement "
-            "(for every link, box, configuration in it and point), with the regions read as "
-            "BuiltDR builds them (layer k's, the rest layer's and a cell's: the region of its "
-            "box), so a hypothesis stronger than the statement fails. Every "
+            "means). The regions' soundness enters as hypotheses at theta_L(t), theta_R(t) and "
+            "the point (a link at a configuration of a region's box lies in the region); the VC "
+            "region_instances derives each from Safety.region_statement (proved from "
+            "Safety.region_soundness's lemmas and the definitions of a link and a region; here "
+            "its universal closure, the same term), the loader's spacing checks and the regions "
+            "read as BuiltDR builds them (layer k's: its box on the lattice anchored at "
+            "theta_L(k dt), spacing omega dt; the rest layer's: the rest box, anchored at the "
+            "goal for tight, else layer N-1's; a cell's: its box, anchored at its angles, "
+            "spacing h), so a hypothesis stronger than the statement fails. Every "
             "hypothesis that is not a proved lemma's instance is needed: cfmpa prove's negative "
             "controls drop each and require the composition without it not proved.",
             Z, P, lambda v=v: _composition_query(v)))

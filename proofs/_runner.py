@@ -91,7 +91,8 @@ EXPECTED_VERDICTS: dict[str, Verdict] = {
     "Certificate.lipschitz": _P, "Tolerance.tube_factor": _P, "Exact.gap_formula": _P,
     "Safety.original.principal_in_layer_box": _P, "Safety.modified.principal_in_layer_box": _P,
     "Safety.tight.principal_in_layer_box": _P, "Safety.subordinate_in_cell_box": _P,
-    "Safety.region_soundness": _P, "Safety.separation": _P, "Safety.original.composition": _P,
+    "Safety.region_soundness": _P, "Safety.region_statement": _P,
+    "Safety.separation": _P, "Safety.original.composition": _P,
     "Safety.modified.composition": _P, "Safety.tight.composition": _P,
 }
 

@@ -177,6 +177,10 @@ SUMMARIES: dict[str, str] = {
                                "inside the swept region the planner builds for that box: the "
                                "margin it adds covers the motion between the grid's sample "
                                "angles.",
+    "Safety.region_statement": "Hence, by what a link and a swept region are (a rectangle of "
+                               "the arm's geometry; the hull of the grown rectangles at the "
+                               "sample angles), every point of either arm's links at angles in a "
+                               "box is in that box's region.",
     "Safety.separation": "A pair of regions the planner frees, its rounded distance above "
                          "1e-9 m, is truly apart, since rounding errs by under 3e-11 m; links "
                          "in regions apart share no point.",

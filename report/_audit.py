@@ -338,6 +338,7 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
             related = [i for k, i in verdicts.items()
                        if k.startswith((f"Safety.{name}.", f"Scenario.{stem}."))
                        or k in ("Safety.subordinate_in_cell_box", "Safety.region_soundness",
+                                "Safety.region_statement",
                                 "Safety.separation", "Tolerance.tube")]
             related = [i for i in related if not i["id"].startswith(f"Scenario.{stem}.translation_")
                        or i["id"].endswith(f"_{name}")]

@@ -20,7 +20,8 @@ from cfmpa.spec import (exact_n, exact_tf, left_angles, left_box, load_scenario,
 
 REPO = Path(__file__).resolve().parents[2]
 IDS = [f"Safety.{v}.principal_in_layer_box" for v in S.VARIANTS] + [
-    "Safety.subordinate_in_cell_box", "Safety.region_soundness", "Safety.separation"] + [
+    "Safety.subordinate_in_cell_box", "Safety.region_soundness", "Safety.region_statement",
+    "Safety.separation"] + [
     f"Safety.{v}.composition" for v in S.VARIANTS]
 
 
