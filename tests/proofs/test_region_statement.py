@@ -190,7 +190,24 @@ def test_the_hull_definition_generates_impl_s_swept_points(arm, x, lo1, w1, lo2,
     # The margin the definition reads is sweep_margin's at those values.
     rb, re = link_reach(arm, x)
     env = {**_env(arm, "R"), "R.Rb1": rb if x == 0 else 0.0, "R.Re2": re}
-    term = model.margin(x, tuple((S._q(b[0]), S._q(b[1])) for b in box),
-                        (S._q(a1), S._q(a2)), (S._q(g1), S._q(g2)))
-    val = z3.simplify(z3.substitute(term, *[(z3.Real(k), S._q(v)) for k, v in env.items()]))
+    # Read on symbols (impl_margin reads sweep_margin on symbolic spacings), then evaluated.
+    names = "lo1 hi1 lo2 hi2 A1 A2 g1 g2".split()
+    sym = z3.Reals(" ".join(f"m!{n}" for n in names))
+    term = model.margin(x, ((sym[0], sym[1]), (sym[2], sym[3])), (sym[4], sym[5]),
+                        (sym[6], sym[7]))
+    values = (box[0][0], box[0][1], box[1][0], box[1][1], a1, a2, g1, g2)
+    pairs = [(z3.Real(k), S._q(v)) for k, v in env.items()] + [
+        (c, S._q(v)) for c, v in zip(sym, values)]
+    val = z3.simplify(z3.substitute(term, *pairs))
     assert abs(float(val.as_fraction()) - grow) <= 1e-12 * max(1.0, grow)
+
+
+def test_the_comparison_with_impl_catches_a_wrong_frame(monkeypatch):
+    # Seeded fault for the two checks above: link 2's frame turned by theta1 only.
+    arm = Arm(base=(0.1, -0.2), links=(0.5, 0.4), width=0.05, omega=(1.0, 1.0))
+    want = link_rectangles(arm, np.array(0.3), np.array(0.7), 1).reshape(-1, 2)
+    assert _same_set(_model_points(S.ArmModel.named("L"), 1, arm, [(0.3, 0.7)], 0.0), want)
+    monkeypatch.setattr(S.ArmModel, "frame_point",
+                        lambda self, x, alpha, phi, uv: S._point2(self.b, self.l1, alpha, alpha,
+                                                                  uv[0], uv[1]))
+    assert not _same_set(_model_points(S.ArmModel.named("L"), 1, arm, [(0.3, 0.7)], 0.0), want)
