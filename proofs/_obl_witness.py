@@ -18,8 +18,11 @@ T = max(LENGTH L - 1, N); its state at step k is ``(min(k, N), c(k), p(k))``.
 The checker's edge and goal conditions are not restated here: ``spec``'s own functions
 (``step_cost``, ``label_key``, ``edge_bound``, ``edge_holds``, ``label_in_range``,
 ``goal_holds``), which ``check_witness`` calls on numpy arrays, are called on Z3 terms, so a
-loosened condition fails ``labels.step`` or ``labels.optimal``. (The goal condition's "least
-label" in ``labels.conclusion`` and the reachable-set conditions are still written here.)
+loosened condition fails ``labels.step`` or ``labels.optimal``; the reachable set's conditions are
+``start_breaks``, ``closure_breaks`` and ``exclusion_breaks``, likewise run on Z3 terms (a
+loosened one fails ``reachable.base``, ``reachable.step`` or ``reachable.conclusion``). (The
+goal condition's "least label over the goal states" in ``labels.conclusion`` is still written
+here, on label pairs rather than the checker's keys.)
 ``labels.optimal`` closes the chain: the returned path's recomputed cost Q passes the checker's
 goal comparison against C, and the conclusion's C <= (J1, J2)(L) gives Q <= (J1, J2)(L).
 
@@ -43,7 +46,8 @@ from dataclasses import dataclass
 
 import z3
 
-from ..spec import edge_bound, edge_holds, goal_holds, label_in_range, label_key, step_cost
+from ..spec import (closure_breaks, edge_bound, edge_holds, exclusion_breaks, goal_holds,
+                    label_in_range, label_key, start_breaks, step_cost)
 from ..spec.z3defs import (Z3Dims, Z3PathVar, abs_int, in_grid, is_path_fixed, lex_le, position,
                             z3_path)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
@@ -113,18 +117,25 @@ def _state_array(name: str, sort: z3.SortRef) -> z3.ArrayRef:
     return z3.Array(name, ints, ints, ints, ints, ints, sort)
 
 
-def _free_edge(w: _World, src: State, d: Cell) -> tuple[z3.BoolRef, State]:
-    """(the move d from state ``src`` is a free edge, its target state): 0 <= s <= N, the cell in
-    the grid and free in layer s, p and d moves, cell + d in the grid and free in layer
-    min(s + 1, N); the target is (min(s + 1, N), cell + d, d)."""
+def _edge_parts(w: _World, src: State, d: Cell) -> tuple[z3.BoolRef, z3.BoolRef, State]:
+    """(an edge from a free state: 0 <= s <= N, the cell in the grid and free in layer s, p and
+    d moves, cell + d in the grid; its target free in layer min(s + 1, N); the target state
+    (min(s + 1, N), cell + d, d))."""
     s, i, j, pi, pj = src
     N = w.d.N
     t = z3.If(s + 1 < N, s + 1, N)
     target = (t, i + d[0], j + d[1], d[0], d[1])
-    free = z3.And(0 <= s, s <= N, in_grid(w.d, (i, j)), w.P[s, i, j] == 0,
+    edge = z3.And(0 <= s, s <= N, in_grid(w.d, (i, j)), w.P[s, i, j] == 0,
                   _move(pi), _move(pj), _move(d[0]), _move(d[1]),
-                  in_grid(w.d, (i + d[0], j + d[1])), w.P[t, i + d[0], j + d[1]] == 0)
-    return free, target
+                  in_grid(w.d, (i + d[0], j + d[1])))
+    return edge, w.P[t, i + d[0], j + d[1]] == 0, target
+
+
+def _free_edge(w: _World, src: State, d: Cell) -> tuple[z3.BoolRef, State]:
+    """(the move d from state ``src`` is a free edge: an edge from a free state to a free
+    target, its target state)."""
+    edge, target_free, target = _edge_parts(w, src, d)
+    return z3.And(edge, target_free), target
 
 
 def _edge_condition(w: _World, mark: z3.ArrayRef, then: Callable[[State, State, Cell], z3.BoolRef],
@@ -224,16 +235,20 @@ def _reachable_vcs() -> tuple[VC, ...]:
     w = _world()
     S = _state_array("reach", z3.BoolSort())
     origin = (0, w.start[0], w.start[1], 0, 0)
+    # spec.check_witness's own conditions (start_breaks, closure_breaks, exclusion_breaks), run
+    # on Z3 terms: the checker rejects where they hold, so the VCs assume they do not.
     start = ("witness.start: the start state in S when the start is free in layer 0",
-             z3.Implies(w.P[0, w.start[0], w.start[1]] == 0, S[origin]))
+             z3.Not(start_breaks(w.P[0, w.start[0], w.start[1]] == 0, S[origin])))
     k = z3.Int("k")
+    edge_k, target_free, target = _edge_parts(w, w.state(k), w.prev(k + 1))
     closure = ("witness.closure at L's edge k: it ends in S if it is a free edge from S",
-               _edge_condition(w, S, lambda src, dst, d: S[dst], w.state(k), w.prev(k + 1)))
+               z3.Implies(edge_k, z3.Not(closure_breaks(S[w.state(k)], target_free,
+                                                         S[target]))))
     qi, qj = z3.Ints("x!pi x!pj")
     exclusion = ("witness.exclusion: no admissible goal state in S",
-                 z3.Implies(w.P[w.d.N, w.goal[0], w.goal[1]] == 0, z3.ForAll([qi, qj], z3.Implies(
-                     z3.And(_move(qi), _move(qj)),
-                     z3.Not(S[w.d.N, w.goal[0], w.goal[1], qi, qj])))))
+                 z3.ForAll([qi, qj], z3.Implies(z3.And(_move(qi), _move(qj)), z3.Not(
+                     exclusion_breaks(w.P[w.d.N, w.goal[0], w.goal[1]] == 0,
+                                      S[w.d.N, w.goal[0], w.goal[1], qi, qj])))))
 
     def inv(x: z3.ArithRef) -> z3.BoolRef:
         return S[w.state(x)]

@@ -119,14 +119,15 @@ def test_the_obligations_costs_are_the_specs_j1_and_j2(case):
     assert (a1, a2 + abs(prev[T][0]) + abs(prev[T][1])) == (J1(cells), J2(cells))
 
 
-def _refuted(name, **patch):
-    """Z3's answer on VC ``name`` of Witness.labels_sound with spec's conditions replaced."""
+def _refuted(name, kind="labels", **patch):
+    """Z3's answer on VC ``name`` of Witness.labels_sound (or reachable_sound) with spec's
+    conditions replaced."""
     import cfmpa.proofs._obl_witness as W
     saved = {k: getattr(W, k) for k in patch}
     try:
         for k, f in patch.items():
             setattr(W, k, f)
-        vc = next(v for v in W.witness_vcs("labels") if v.name == name)
+        vc = next(v for v in W.witness_vcs(kind) if v.name == name)
     finally:
         for k, f in saved.items():
             setattr(W, k, f)
@@ -140,3 +141,16 @@ def test_the_proof_reads_the_checkers_edge_and_goal_conditions():
     assert _refuted("labels.optimal",
                     goal_holds=lambda c, m: (c[0] >= m[0]) & (c[1] >= m[1])) == z3.sat
     assert _refuted("labels.step") == z3.unsat
+
+
+def test_the_proof_reads_the_checkers_reachable_set_conditions():
+    # Seeded faults: each of spec's no-path conditions switched off (it never reports a break);
+    # the VC that rests on it fails.
+    never = z3.BoolVal(False)
+    assert _refuted("reachable.base", "reachable", start_breaks=lambda f, s: never) == z3.sat
+    assert _refuted("reachable.step", "reachable",
+                    closure_breaks=lambda a, f, b: never) == z3.sat
+    assert _refuted("reachable.conclusion", "reachable",
+                    exclusion_breaks=lambda f, s: never) == z3.sat
+    for name in ("reachable.base", "reachable.step", "reachable.conclusion"):
+        assert _refuted(name, "reachable") == z3.unsat
