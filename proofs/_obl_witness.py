@@ -20,9 +20,10 @@ The checker's edge and goal conditions are not restated here: ``spec``'s own fun
 ``goal_holds``), which ``check_witness`` calls on numpy arrays, are called on Z3 terms, so a
 loosened condition fails ``labels.step`` or ``labels.optimal``; the reachable set's conditions are
 ``start_breaks``, ``closure_breaks`` and ``exclusion_breaks``, likewise run on Z3 terms (a
-loosened one fails ``reachable.base``, ``reachable.step`` or ``reachable.conclusion``). (The
-goal condition's "least label over the goal states" in ``labels.conclusion`` is still written
-here, on label pairs rather than the checker's keys.)
+loosened one fails ``reachable.base``, ``reachable.step`` or ``reachable.conclusion``). The goal
+condition in ``labels.conclusion`` is the checker's comparison of keys (``label_key`` plus
+``stop_key``'s |p|_1, the least key split back into (J1, J2)), with witness.form's range at the
+goal states, which makes the key order the lexicographic one.
 ``labels.optimal`` closes the chain: the returned path's recomputed cost Q passes the checker's
 goal comparison against C, and the conclusion's C <= (J1, J2)(L) gives Q <= (J1, J2)(L).
 
@@ -46,8 +47,8 @@ from dataclasses import dataclass
 
 import z3
 
-from ..spec import (closure_breaks, edge_bound, edge_holds, exclusion_breaks, goal_holds,
-                    label_in_range, label_key, start_breaks, step_cost)
+from ..spec import (KEY_BASE, closure_breaks, edge_bound, edge_holds, exclusion_breaks,
+                    goal_holds, label_in_range, label_key, start_breaks, step_cost, stop_key)
 from ..spec.z3defs import (Z3Dims, Z3PathVar, abs_int, in_grid, is_path_fixed, lex_le, position,
                             z3_path)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
@@ -201,10 +202,17 @@ def _labels_vcs() -> tuple[VC, ...]:
             z3.And(in_range(w.state(k)), in_range(w.state(k + 1))))
     qi, qj = z3.Ints("g!pi g!pj")
     at_goal = (w.d.N, w.goal[0], w.goal[1], qi, qj)
-    goal = ("witness.goal: C <= label + (0, |p|_1) at every labelled admissible goal state",
+    # The checker's own comparison, run on Z3 terms: C is the least key (label_key plus
+    # stop_key's |p|_1) over the labelled admissible goal states, split back into (J1, J2).
+    goal = ("witness.goal: key(C) <= stop_key(key(label), p) at every labelled admissible goal "
+            "state (C: the least such key, split)",
             z3.ForAll([qi, qj], z3.Implies(
                 z3.And(_move(qi), _move(qj), has[at_goal], w.P[w.d.N, w.goal[0], w.goal[1]] == 0),
-                lex_le(C, (lab1[at_goal], lab2[at_goal] + abs_int(qi) + abs_int(qj))))))
+                label_key(C[0], C[1]) <= stop_key(key(at_goal), (qi, qj)))))
+    split = ("C's J2 is the least key's low 32 bits: 0 <= C.J2 < KEY_BASE",
+             z3.And(0 <= C[1], C[1] < KEY_BASE))
+    goal_form = ("witness.form at the goal states: labels unsigned, in range",
+                 z3.ForAll([qi, qj], in_range(at_goal)))
 
     def inv(x: z3.ArithRef) -> z3.BoolRef:
         return z3.And(has[w.state(x)], lex_le(label(w.state(x)), (A1[x], A2[x])))
@@ -220,7 +228,8 @@ def _labels_vcs() -> tuple[VC, ...]:
                            edge, form, ("0 <= k < T", z3.And(0 <= k, k < w.T)),
                            ("invariant at k", inv(k))),
            inv(k + 1), key_premise=edge[0]),
-        VC("labels.conclusion", w.base() + (prefix, goal, ("invariant at T", inv(w.T))),
+        VC("labels.conclusion", w.base() + (prefix, goal, split, goal_form,
+                                            ("invariant at T", inv(w.T))),
            lex_le(C, cost_L), key_premise=goal[0]),
         # The returned path's recomputed (J1, J2) = Q passes witness.goal (the checker's own
         # comparison, run on Z3 terms) and C <= (J1, J2)(L) for any valid L (the conclusion's

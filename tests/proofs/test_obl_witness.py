@@ -154,3 +154,15 @@ def test_the_proof_reads_the_checkers_reachable_set_conditions():
                     exclusion_breaks=lambda f, s: never) == z3.sat
     for name in ("reachable.base", "reachable.step", "reachable.conclusion"):
         assert _refuted(name, "reachable") == z3.unsat
+
+
+def test_the_conclusion_reads_the_checkers_goal_keys():
+    # Seeded fault: the checker's stop term loosened by one (a goal state's key one too big).
+    assert _refuted("labels.conclusion",
+                    stop_key=lambda k, p: k + abs(p[0]) + abs(p[1]) + 1) == z3.sat
+    assert _refuted("labels.conclusion") == z3.unsat
+    # Without witness.form's range at the goal states the key order is not the pair order.
+    import cfmpa.proofs._obl_witness as W
+    vc = next(v for v in W.witness_vcs("labels") if v.name == "labels.conclusion")
+    assert _answer(vc.without("witness.form at the goal states: labels unsigned, in range")) \
+        == z3.sat
