@@ -345,6 +345,35 @@ def arc_chord(vc: VC | None = None) -> ArcChord:
     return ArcChord(vc, r, g, c, s, cp, sp, t, rhs.arg(0), (lhs.arg(0), lhs.arg(1)))
 
 
+def arc_steps(arc: ArcChord, k: dict[str, Lemma]) -> dict[str, Lemma]:
+    """Margin.arc_chord's goal in three lemmas over its own names and premises (each decided
+    by both solvers alone, where the whole is Z3-only): the chord weight lies in [0, 1]
+    (arc_weight), the point is r (c_psi - c) from its chord point (arc_dist), and
+    0 <= r (c_psi - c) <= delta (arc_gap, where delta's constant is paid: cos x >= 1 - x^2/2).
+    The fourth, named Margin.arc_chord, is its re-proof here: its premises, the three lemmas
+    and square_monotone at its names give its own goal, unchanged."""
+    facts = arc.vc.hypotheses
+    key = arc.vc.key_premise or facts[0][0]
+    gap = arc.r * (arc.cp - arc.c)
+    mq = (concrete(arc.mq[0]), concrete(arc.mq[1]))
+    dist = mq[0] * mq[0] + mq[1] * mq[1]
+    wit = arc.vc.witness
+    out = {
+        "arc_weight": lemma("arc_weight", facts, z3.And(0 <= arc.t, arc.t <= 1), key,
+                            witness=wit),
+        "arc_dist": lemma("arc_dist", facts, dist == gap * gap, key, witness=wit),
+        "arc_gap": lemma("arc_gap", facts, z3.And(0 <= gap, gap <= arc.delta), key,
+                         witness=wit),
+    }
+    hyps = list(facts)
+    for name in ("arc_weight", "arc_dist", "arc_gap"):
+        hyps += out[name].use((), "Margin.arc_chord's names")
+    hyps += k["square_monotone"].at("r (c_psi - c) <= delta", a=gap, b=arc.delta, m=dist)
+    out["Margin.arc_chord"] = lemma("Margin.arc_chord", hyps, arc.vc.goal, key, witness=wit,
+                                    counter_witness=arc.vc.counter_witness)
+    return out
+
+
 # --- the margin impl computes, read symbolically -----------------------------------------------
 
 #: A probe arm: impl.sweep_margin is called with it on symbolic spacings, and its reach values
@@ -1242,6 +1271,7 @@ def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_m
               _rigid_id(), _arc_monotone(arc), _kin(), _reach_uv(0), _reach_uv(1), _reach_shift(),
               _lattice(), _margin_covers(arc, 0, margin), _margin_covers(arc, 1, margin)):
         k[L.vc.name] = L
+    k.update(arc_steps(arc, k))
     k["arc_in_place"], arc_t = _arc_in_place(arc, k)
     c2 = _Combine2.named()
     for L in (_triangle(k), _scale_bound(k)):
@@ -1258,14 +1288,13 @@ def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_m
 
 
 def region_query(kit: Kit | None = None) -> Z3Query:
-    """Safety.region_soundness: Margin.arc_chord's VC (re-proved: the lemma the margin rests
-    on) and every lemma of the kit."""
+    """Safety.region_soundness: Margin.arc_chord's VC (re-proved from its premises through
+    arc_weight, arc_dist and arc_gap: the lemma the margin rests on) and every lemma of the
+    kit."""
     kit = kit or region_kit()
     check_lattice_reading()
-    arc = kit.arc.vc
-    first = VC("Margin.arc_chord", arc.hypotheses, arc.goal, arc.key_premise, arc.witness,
-               arc.kind, arc.counter_witness)
-    return Z3Query((first,) + tuple(L.vc for L in kit.lemmas.values()))
+    first = kit["Margin.arc_chord"].vc
+    return Z3Query((first,) + tuple(L.vc for L in kit.lemmas.values() if L.vc is not first))
 
 
 # --- (a) the principal in its layer's box ------------------------------------------------------
