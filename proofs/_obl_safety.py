@@ -1160,6 +1160,14 @@ def _link2(kit: Kit) -> Lemma:
     hyps += k["transport_chord"].at("the base arc, in docs/model.md §2's form",
                                     X=nested(t1c, t2c), A=nested(c1, t2c), B=nested(c1e, t2c),
                                     X2=X2, A2=A, B2=B, t=lam, m=e1 * e1)
+    for where, X2_, A2_, B2_, alpha, t in (("the elbow arc at c1", A, Ks[0], Ks[1], c1, mu),
+                                           ("the elbow arc at c1 + G1", B, Ks[2], Ks[3], c1e,
+                                            nu)):
+        # The elbow arcs' points, named (A, B and the corners): what combine2_norm reads.
+        hyps += k["transport_chord"].at(f"{where}, in docs/model.md §2's form",
+                                        X=P(alpha, alpha + t2c), A=P(alpha, alpha + c2),
+                                        B=P(alpha, (alpha + c2) + G2), X2=X2_, A2=A2_, B2=B2_,
+                                        t=t, m=e2 * e2)
     D = _v("lk2.D")
     hyps.append(("D = X0 - h, h = (1 - lam) A' + lam B' (named)",
                  _veq(D, _sub(X0, _comb(_comb(Ks[0], Ks[1], mu), _comb(Ks[2], Ks[3], nu), lam)))))
@@ -1874,7 +1882,8 @@ def safety_obligations() -> list[Obligation]:
         "corners for link 2, two for link 1, which does not depend on theta2). The margin is "
         "derived, not assumed: clamping theta_q "
         "by at most SNAP g_q moves the point by at most SNAP g_q R_q (chord, from cos x >= 1 - "
-        "x^2/2), and Margin.arc_chord, re-proved here as the first VC, is instantiated by "
+        "x^2/2), and Margin.arc_chord, re-proved here as the first VC (from arc_weight, arc_dist "
+        "and arc_gap, where its constant is paid), is instantiated by "
         "substitution at every arc (about the base, and about the elbow at both ends), at (r, "
         "G, e(G/2), e(psi)), and moved from the origin to the arc's pivot and position by the "
         "rigid motion R(mid) (rigid_id, rot_norm, rot_scale, scale_norm): its bound r G^2/8 at "
@@ -1882,11 +1891,13 @@ def safety_obligations() -> list[Obligation]:
         "margin_covers_link1/2 show that impl.sweep_margin, read by calling it on symbolic "
         "spacings (its probe arm's reach replaced by symbols; the reading checked against its "
         "floats on sample arms), is at least the derived margin: a wrong constant fails the "
-        "obligation (1/16 in the lemma its first VC; 1/4 there, or 1/16 in sweep_margin, "
+        "obligation (1/16 in the lemma: arc_gap; 1/4 there, or 1/16 in sweep_margin, "
         "margin_covers). sin and cos are the uninterpreted Cos, Sin with "
-        "the ledger's facts (A3) at the points named. Split into lemmas Z3 proves quickly: small "
+        "the ledger's facts (A3) at the points named. Split into lemmas Z3 and cvc5 each decide "
+        "quickly: small "
         "ones on the polynomials, and compositions (chord, arc_in_place, reach_link2, grow, "
-        "combine1, combine2, transport, sum_subst, link1_in_region, link2_in_region) valid for "
+        "triangle, scale_bound, combine1, combine2_norm, combine2_weights, transport, "
+        "transport_chord, sum_subst, link1_in_region, link2_in_region) valid for "
         "every function sq, dt standing for |v|^2 and the dot product, each using the others "
         "by substitution with the facts they rest on carried along; intermediate quantities "
         "(lattice indices, chord weights, points, the displacement D) are named by their "
