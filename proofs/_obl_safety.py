@@ -715,12 +715,25 @@ def lattice_goal(L: Lattice, th: z3.ArithRef, A: z3.ArithRef, g: z3.ArithRef) ->
                   0 <= L.G, L.G <= g, snap_bound(th, L.theta_c, SNAP_Q * g))
 
 
-def _lattice() -> Lemma:
+def _lattice() -> tuple[Lemma, Lemma, Lemma]:
+    """lattice: the cell of theta_c and theta_c within SNAP g of theta; through lattice_span
+    (theta's lattice coordinate (theta - A)/g lies within SNAP of [i_lo, i_hi]: impl's floor and
+    ceil with their snap) and lattice_snap (hence |theta - theta_c| <= SNAP g), lemmas of
+    their own so that each solver decides each quickly."""
     lo, hi, th, A, g = z3.Reals("lat.lo lat.hi lat.theta lat.A lat.g")
     L = lattice("lat", lo, hi, th, A, g)
-    hyps = (("g > 0", g > 0), ("lo <= theta <= hi", z3.And(lo <= th, th <= hi))) + L.defs
-    return lemma("lattice", hyps, lattice_goal(L, th, A, g), "lo <= theta <= hi",
-                 names=dict(lo=lo, hi=hi, theta=th, A=A, g=g, **L.names()))
+    key = "lo <= theta <= hi"
+    hyps = (("g > 0", g > 0), (key, z3.And(lo <= th, th <= hi))) + L.defs
+    names = dict(lo=lo, hi=hi, theta=th, A=A, g=g, **L.names())
+    x = (th - A) / g
+    span = lemma("lattice_span", hyps, z3.And(z3.ToReal(L.i_lo) - SNAP_Q <= x,
+                                              x <= z3.ToReal(L.i_hi) + SNAP_Q), key, names=names)
+    with_span = hyps + tuple(span.use((), "the box's lattice"))
+    snap = lemma("lattice_snap", with_span, snap_bound(th, L.theta_c, SNAP_Q * g), key,
+                 names=names)
+    whole = lemma("lattice", with_span + tuple(snap.use((), "the box's lattice")),
+                  lattice_goal(L, th, A, g), key, names=names)
+    return span, snap, whole
 
 
 def margin_parts(arc: ArcChord, g: Vec, reach: Vec, G: Vec) -> tuple[z3.ArithRef, ...]:
@@ -1277,7 +1290,7 @@ def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_m
     for L in (_rot_norm(), _rot_scale(), _scale_norm(), _expand(), _dot_bound(),
               _square_monotone(), _proj_id(), _proj_bound(), _grow_id(), _chord0(), _chord_id(),
               _rigid_id(), _arc_monotone(arc), _kin(), _reach_uv(0), _reach_uv(1), _reach_shift(),
-              _lattice(), _margin_covers(arc, 0, margin), _margin_covers(arc, 1, margin)):
+              *_lattice(), _margin_covers(arc, 0, margin), _margin_covers(arc, 1, margin)):
         k[L.vc.name] = L
     k.update(arc_steps(arc, k))
     k["arc_in_place"], arc_t = _arc_in_place(arc, k)
