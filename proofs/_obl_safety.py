@@ -1058,6 +1058,15 @@ def _transport_chord() -> Lemma:
                  abstract=True, names=dict(X=X, A=A, B=B, X2=X2, A2=A2, B2=B2, t=t, m=m))
 
 
+def _shift_eq() -> Lemma:
+    """A point K named by its definition M, moved by d to Q (M + d = Q), gives K + d = Q: the
+    step from grow's conclusion at a corner to sum_subst's premise, made explicit."""
+    K, M, d, Q = (_v(f"se.{n}") for n in ("K", "M", "d", "Q"))
+    key = "K = M"
+    hyps = ((key, _veq(K, M)), ("M + d = Q", _veq(_add(M, d), Q)))
+    return lemma("shift_eq", hyps, _veq(_add(K, d), Q), key, names=dict(K=K, M=M, d=d, Q=Q))
+
+
 def _sum_subst(n: int) -> Lemma:
     """X = sum of w_i P_i and P_i = Q_i give X = sum of w_i Q_i."""
     X = _v(f"ss{n}.X")
@@ -1195,6 +1204,8 @@ def _link2(kit: Kit) -> Lemma:
     ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
     Qs = [_add(_elbow(b, l1, a), _rot(e(ph), grown_coords(ph, u, v, D)))
           for a, ph in zip(alphas, phis)]
+    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
+        hyps += k["shift_eq"].at(f"corner {i}", K=Ks[i], M=P(alpha, phi), d=D, Q=Qs[i])
     sub: dict[str, object] = dict(X=X0)
     for i in range(4):
         sub.update({f"P{i}": _add(Ks[i], D), f"Q{i}": Qs[i], f"w{i}": ws[i]})
@@ -1300,7 +1311,7 @@ def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_m
     for L in (_combine2_norm(k, c2), _combine2_weights(c2)):
         k[L.vc.name] = L
     for L in (_chord(k), _reach_link2(k), _grow(k), _combine1(k), _transport(),
-              _transport_chord(), _sum_subst(2), _sum_subst(4)):
+              _transport_chord(), _shift_eq(), _sum_subst(2), _sum_subst(4)):
         k[L.vc.name] = L
     kit = Kit(arc, k, arc_t, margin)
     k["link1_in_region"] = _link1(kit)
