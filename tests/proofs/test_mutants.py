@@ -96,7 +96,7 @@ def test_a_flipped_box_rule_fails_the_box_nesting(monkeypatch, tmp_path):
     import dataclasses
 
     from cfmpa.spec import _grid as grid
-    from cfmpa.spec._arith import if_then, max_of, min_of
+    from cfmpa.spec import if_then, max_of, min_of
 
     def flipped(a, b, step, up):
         end = a + if_then(up, -1.0, 1.0) * step

@@ -9,7 +9,7 @@ import z3
 
 from cfmpa.proofs._obl_builtdr import _box_nesting
 from cfmpa.spec import _grid as grid
-from cfmpa.spec._arith import if_then, max_of, min_of
+from cfmpa.spec import if_then, max_of, min_of
 
 
 def _answer(hyps, goal) -> z3.CheckSatResult:

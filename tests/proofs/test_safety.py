@@ -292,6 +292,24 @@ def test_the_lattice_model_is_lattice_range():
     S.check_lattice_reading()
 
 
+def test_a_widened_snap_fails_lattice_span(monkeypatch):
+    # Seeded fault: impl.lattice_range snapping within 1000 SNAP g (a copy run on the symbols):
+    # the lattice may then stop short of the box by more than the margin pays for.
+    from cfmpa.spec import cases, ceil_of, floor_of, max_of, min_of
+
+    def wide(lo, hi, anchor, g):
+        def span():
+            i_lo = floor_of((lo - anchor) / g + 1000 * SNAP)
+            i_hi = ceil_of((hi - anchor) / g - 1000 * SNAP)
+            return (min_of(i_lo, i_hi), max_of(i_lo, i_hi))
+        return cases(g <= 0, lambda: (0, 0), span)
+    good = {L.vc.name: L.vc for L in S._lattice()}
+    assert not _refuted(good["lattice_span"], pins=())
+    monkeypatch.setattr(S, "lattice_range", wide)
+    span, snap, whole = S._lattice()
+    assert span.vc.name == "lattice_span" and _refuted(span.vc, pins=())
+
+
 def test_region_lemmas_need_their_key_premises():
     kit = S.region_kit()
     for name, L in kit.lemmas.items():
