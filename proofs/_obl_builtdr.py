@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import z3
 
 from ..impl import builtdr_loop_nest
+from ..spec import Variant, ptp_angles
 from ..spec.z3defs import REGION, Z3Dims, blocked_exact, inter
 from ._extract import extract
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
@@ -130,30 +131,29 @@ def _query(variant: str, kind: str, bug: str | None = None, *, source: str | Non
 
 
 def _box_nesting() -> Z3Query:
-    """spec.left_box's three rules for one joint at layer k, with the PTP motion of spec's
-    left_angles: tight ⊆ modified ⊆ original. Quantifier-free polynomial real arithmetic."""
+    """The code's box rules (spec.Variant's rule table, which spec.left_box, impl and Safety
+    read) run on Z3 terms for one joint at layer k, with a_k, a_k+1 on the PTP motion of
+    spec.ptp_angles (spec.left_angles'): tight ⊆ modified ⊆ original. A changed rule changes
+    the statement; a rule that no longer nests fails it. Quantifier-free nonlinear real
+    arithmetic."""
     s0, g0, w, dt, tf, k = z3.Reals("start goal omega dt Tf k")
     a0, a1 = z3.Reals("a_k a_k1")
-    t0, t1 = k * dt, (k + 1) * dt
 
-    def at(a: z3.ArithRef, t: z3.ArithRef) -> z3.BoolRef:
-        # theta(t) = start + (goal - start) min(t/Tf, 1), multiplied out by Tf > 0.
-        return z3.If(t >= tf, a == g0, tf * (a - s0) == (g0 - s0) * t)
-    sign = z3.If(g0 > s0, z3.RealVal(1), z3.RealVal(-1))         # the s_q rule
-    step = w * dt
-
-    def lo_hi(x: z3.ArithRef, y: z3.ArithRef) -> tuple[z3.ArithRef, z3.ArithRef]:
-        return z3.If(x <= y, x, y), z3.If(x <= y, y, x)
-    orig = (a0 - step, a0 + step)
-    mod = lo_hi(a0, a0 + sign * step)
-    tight = lo_hi(a0, a1)
+    def theta(t: z3.ArithRef) -> z3.ArithRef:
+        # spec.ptp_angles on the symbols (both joints alike; joint 1 read).
+        return ptp_angles((s0, s0), (g0, g0), tf, t)[0]
+    step, up = w * dt, g0 > s0
+    orig, mod, tight = (Variant(v).joint_box(a0, a1, step, up)
+                        for v in ("original", "modified", "tight"))
     base = (("omega > 0", w > 0), ("dt > 0", dt > 0), ("k >= 0", k >= 0),
-            ("a_k = theta(k dt)", at(a0, t0)))
+            ("a_k = theta(k dt) (spec.ptp_angles)", a0 == theta(k * dt)))
     speed = ("|goal - start| <= omega Tf (Tf = max_q |goal_q - start_q| / omega_q)",
              z3.And(tf > 0, g0 - s0 <= w * tf, s0 - g0 <= w * tf))
     outer = VC("modified_in_original", base, z3.And(orig[0] <= mod[0], mod[1] <= orig[1]),
                key_premise="omega > 0")
-    inner = VC("tight_in_modified", base + (speed, ("a_k1 = theta((k+1) dt)", at(a1, t1))),
+    inner = VC("tight_in_modified",
+               base + (speed, ("a_k1 = theta((k+1) dt) (spec.ptp_angles)",
+                               a1 == theta((k + 1) * dt))),
                z3.And(mod[0] <= tight[0], tight[1] <= mod[1]), key_premise=speed[0])
     return Z3Query((outer, inner))
 
@@ -196,7 +196,9 @@ def builtdr_obligations() -> list[Obligation]:
         "|goal - start| <= omega Tf: with a_k = theta(k dt) on the PTP motion theta(t) = start + "
         "(goal - start) min(t/Tf, 1), the tight box [min, max of a_k, a_k+1] lies within the "
         "modified box [a_k, a_k + s_q omega dt] (s_q = +1 if goal > start, else -1), which "
-        "lies within the original box [a_k - omega dt, a_k + omega dt]: spec.left_box's rules. "
-        "Quantifier-free polynomial real arithmetic (products of the symbols), no quantifier.",
+        "lies within the original box [a_k - omega dt, a_k + omega dt]: spec.left_box's rules, "
+        "the code's own (spec.Variant's rule table run on Z3 terms, theta by spec.ptp_angles), "
+        "so a changed rule changes the statement and a rule that no longer nests fails it. "
+        "Quantifier-free nonlinear real arithmetic, no quantifier.",
         Z, P, _box_nesting))
     return out

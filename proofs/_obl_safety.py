@@ -345,6 +345,35 @@ def arc_chord(vc: VC | None = None) -> ArcChord:
     return ArcChord(vc, r, g, c, s, cp, sp, t, rhs.arg(0), (lhs.arg(0), lhs.arg(1)))
 
 
+def arc_steps(arc: ArcChord, k: dict[str, Lemma]) -> dict[str, Lemma]:
+    """Margin.arc_chord's goal in three lemmas over its own names and premises (each decided
+    by both solvers alone, where the whole is Z3-only): the chord weight lies in [0, 1]
+    (arc_weight), the point is r (c_psi - c) from its chord point (arc_dist), and
+    0 <= r (c_psi - c) <= delta (arc_gap, where delta's constant is paid: cos x >= 1 - x^2/2).
+    The fourth, named Margin.arc_chord, is its re-proof here: its premises, the three lemmas
+    and square_monotone at its names give its own goal, unchanged."""
+    facts = arc.vc.hypotheses
+    key = arc.vc.key_premise or facts[0][0]
+    gap = arc.r * (arc.cp - arc.c)
+    mq = (concrete(arc.mq[0]), concrete(arc.mq[1]))
+    dist = mq[0] * mq[0] + mq[1] * mq[1]
+    wit = arc.vc.witness
+    out = {
+        "arc_weight": lemma("arc_weight", facts, z3.And(0 <= arc.t, arc.t <= 1), key,
+                            witness=wit),
+        "arc_dist": lemma("arc_dist", facts, dist == gap * gap, key, witness=wit),
+        "arc_gap": lemma("arc_gap", facts, z3.And(0 <= gap, gap <= arc.delta), key,
+                         witness=wit),
+    }
+    hyps = list(facts)
+    for name in ("arc_weight", "arc_dist", "arc_gap"):
+        hyps += out[name].use((), "Margin.arc_chord's names")
+    hyps += k["square_monotone"].at("r (c_psi - c) <= delta", a=gap, b=arc.delta, m=dist)
+    out["Margin.arc_chord"] = lemma("Margin.arc_chord", hyps, arc.vc.goal, key, witness=wit,
+                                    counter_witness=arc.vc.counter_witness)
+    return out
+
+
 # --- the margin impl computes, read symbolically -----------------------------------------------
 
 #: A probe arm: impl.sweep_margin is called with it on symbolic spacings, and its reach values
@@ -686,12 +715,25 @@ def lattice_goal(L: Lattice, th: z3.ArithRef, A: z3.ArithRef, g: z3.ArithRef) ->
                   0 <= L.G, L.G <= g, snap_bound(th, L.theta_c, SNAP_Q * g))
 
 
-def _lattice() -> Lemma:
+def _lattice() -> tuple[Lemma, Lemma, Lemma]:
+    """lattice: the cell of theta_c and theta_c within SNAP g of theta; through lattice_span
+    (theta's lattice coordinate (theta - A)/g lies within SNAP of [i_lo, i_hi]: impl's floor and
+    ceil with their snap) and lattice_snap (hence |theta - theta_c| <= SNAP g), lemmas of
+    their own so that each solver decides each quickly."""
     lo, hi, th, A, g = z3.Reals("lat.lo lat.hi lat.theta lat.A lat.g")
     L = lattice("lat", lo, hi, th, A, g)
-    hyps = (("g > 0", g > 0), ("lo <= theta <= hi", z3.And(lo <= th, th <= hi))) + L.defs
-    return lemma("lattice", hyps, lattice_goal(L, th, A, g), "lo <= theta <= hi",
-                 names=dict(lo=lo, hi=hi, theta=th, A=A, g=g, **L.names()))
+    key = "lo <= theta <= hi"
+    hyps = (("g > 0", g > 0), (key, z3.And(lo <= th, th <= hi))) + L.defs
+    names = dict(lo=lo, hi=hi, theta=th, A=A, g=g, **L.names())
+    x = (th - A) / g
+    span = lemma("lattice_span", hyps, z3.And(z3.ToReal(L.i_lo) - SNAP_Q <= x,
+                                              x <= z3.ToReal(L.i_hi) + SNAP_Q), key, names=names)
+    with_span = hyps + tuple(span.use((), "the box's lattice"))
+    snap = lemma("lattice_snap", with_span, snap_bound(th, L.theta_c, SNAP_Q * g), key,
+                 names=names)
+    whole = lemma("lattice", with_span + tuple(snap.use((), "the box's lattice")),
+                  lattice_goal(L, th, A, g), key, names=names)
+    return span, snap, whole
 
 
 def margin_parts(arc: ArcChord, g: Vec, reach: Vec, G: Vec) -> tuple[z3.ArithRef, ...]:
@@ -834,53 +876,140 @@ def _weighted(ws: Sequence[z3.ArithRef], pts: Sequence[Vec]) -> Vec:
             z3.Sum([w * p[1] for w, p in zip(ws, pts)]))
 
 
-def _combine2(k: dict[str, Lemma]) -> Lemma:
-    """The two joints' bounds add: X0 (the point), X1, X2 (after snapping theta1, theta2),
-    A, B (its chord's ends about the base), A', B' (their chord points about the elbow, between
-    the corners K): |X0 - h| <= s1 + s2 + e1 + e2 <= Delta for h = (1 - lam) A' + lam B', a
-    convex combination of the corners, and X0 = sum of w_c (K_c + (X0 - h))."""
-    X0, X1, X2, A, B, K00, K01, K10, K11 = (_v(f"cb2.{n}") for n in
-                                            "X0 X1 X2 A B K00 K01 K10 K11".split())
-    lam, mu, nu, s1, s2, e1, e2, dl = z3.Reals("cb2.lam cb2.mu cb2.nu cb2.s1 cb2.s2 cb2.e1 "
-                                               "cb2.e2 cb2.Delta")
-    h1 = _comb(A, B, lam)
-    A2, B2 = _comb(K00, K01, mu), _comb(K10, K11, nu)
-    h = _comb(A2, B2, lam)
-    dA, dB = _sub(A, A2), _sub(B, B2)
-    xa, yb = _scale(1 - lam, dA), _scale(lam, dB)
+def _triangle(k: dict[str, Lemma]) -> Lemma:
+    """|x| <= a, |y| <= b (a, b >= 0) and z = x + y give |z| <= a + b, from expand and
+    dot_bound (combine2_norm's step, a lemma so that each solver decides it alone)."""
+    x, y, z = _v("tri.x"), _v("tri.y"), _v("tri.z")
+    a, b = z3.Reals("tri.a tri.b")
+    key = "|y| <= b"
+    hyps: list[Hyp] = [("z = x + y", _veq(z, _add(x, y))), ("a, b >= 0", z3.And(a >= 0, b >= 0)),
+                       ("|x| <= a", N2(x) <= a * a), (key, N2(y) <= b * b)]
+    hyps += k["expand"].at("z = x + y", x=x, y=y, z=z)
+    hyps += k["dot_bound"].at("x, y", x=x, y=y, a=a, b=b)
+    return lemma("triangle", hyps, N2(z) <= (a + b) * (a + b), key, abstract=True,
+                 names=dict(x=x, y=y, z=z, a=a, b=b))
+
+
+def _scale_bound(k: dict[str, Lemma]) -> Lemma:
+    """z = c y with c >= 0 and |y| <= b (b >= 0) give |z| <= c b, from scale_norm."""
+    y, z = _v("sb.y"), _v("sb.z")
+    c, b = z3.Reals("sb.c sb.b")
+    key = "|y| <= b"
+    hyps: list[Hyp] = [("z = c y", _veq(z, _scale(c, y))), ("c, b >= 0", z3.And(c >= 0, b >= 0)),
+                       (key, N2(y) <= b * b)]
+    hyps += k["scale_norm"].at("z = c y", c=c, y=y, z=z)
+    return lemma("scale_bound", hyps, N2(z) <= (c * b) * (c * b), key, abstract=True,
+                 names=dict(y=y, z=z, c=c, b=b))
+
+
+@dataclass(frozen=True)
+class _Combine2:
+    """The names of the two joints' combination (link 2): X0 (the point), X1, X2 (after
+    snapping theta1, theta2), A, B (its chord's ends about the base), A', B' (their chord points
+    about the elbow, between the corners K), h = (1 - lam) A' + lam B', D = X0 - h. What it
+    concludes is split in two lemmas that each solver decides alone: the bound on |D|
+    (combine2_norm) and the corners' weights (combine2_weights)."""
+
+    X0: Vec
+    X1: Vec
+    X2: Vec
+    A: Vec
+    B: Vec
+    K: tuple[Vec, Vec, Vec, Vec]
+    lam: z3.ArithRef
+    mu: z3.ArithRef
+    nu: z3.ArithRef
+    s1: z3.ArithRef
+    s2: z3.ArithRef
+    e1: z3.ArithRef
+    e2: z3.ArithRef
+    dl: z3.ArithRef
+    D: Vec
+
+    @classmethod
+    def named(cls) -> _Combine2:
+        X0, X1, X2, A, B, K00, K01, K10, K11 = (_v(f"cb2.{n}") for n in
+                                                "X0 X1 X2 A B K00 K01 K10 K11".split())
+        lam, mu, nu, s1, s2, e1, e2, dl = z3.Reals("cb2.lam cb2.mu cb2.nu cb2.s1 cb2.s2 cb2.e1 "
+                                                   "cb2.e2 cb2.Delta")
+        return cls(X0, X1, X2, A, B, (K00, K01, K10, K11), lam, mu, nu, s1, s2, e1, e2, dl,
+                   _v("cb2.D"))
+
+    @property
+    def corners(self) -> tuple[Vec, Vec]:
+        """A', B': the chord's ends' chord points about the elbow, between the corners."""
+        K = self.K
+        return _comb(K[0], K[1], self.mu), _comb(K[2], K[3], self.nu)
+
+    @property
+    def h(self) -> Vec:
+        A2, B2 = self.corners
+        return _comb(A2, B2, self.lam)
+
+    @property
+    def weights(self) -> tuple[z3.ArithRef, ...]:
+        lam, mu, nu = self.lam, self.mu, self.nu
+        return ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
+
+    def hyps(self) -> list[Hyp]:
+        """The premises both halves share (those link2_in_region instantiates)."""
+        A2, B2 = self.corners
+        X0, X1, X2, s1, s2, e1, e2 = self.X0, self.X1, self.X2, self.s1, self.s2, self.e1, self.e2
+        lam, mu, nu = self.lam, self.mu, self.nu
+        h1 = _comb(self.A, self.B, lam)
+        return [
+            ("D = X0 - h", _veq(self.D, _sub(X0, self.h))),
+            ("|X0 - X1| <= s1", N2(_sub(X0, X1)) <= s1 * s1),
+            ("|X1 - X2| <= s2", N2(_sub(X1, X2)) <= s2 * s2),
+            ("|X2 - h1| <= e1", N2(_sub(X2, h1)) <= e1 * e1),
+            ("|A - A'| <= e2", N2(_sub(self.A, A2)) <= e2 * e2),
+            ("|B - B'| <= e2", N2(_sub(self.B, B2)) <= e2 * e2),
+            ("s1, s2, e1, e2 >= 0", z3.And(s1 >= 0, s2 >= 0, e1 >= 0, e2 >= 0)),
+            ("s1 + s2 + e1 + e2 <= Delta", s1 + s2 + e1 + e2 <= self.dl),
+            ("0 <= lam, mu, nu <= 1", z3.And(0 <= lam, lam <= 1, 0 <= mu, mu <= 1, 0 <= nu,
+                                             nu <= 1)),
+        ]
+
+    def names(self) -> dict[str, object]:
+        K = self.K
+        return dict(X0=self.X0, X1=self.X1, X2=self.X2, A=self.A, B=self.B, K00=K[0], K01=K[1],
+                    K10=K[2], K11=K[3], lam=self.lam, mu=self.mu, nu=self.nu, s1=self.s1,
+                    s2=self.s2, e1=self.e1, e2=self.e2, Delta=self.dl, D=self.D)
+
+
+def _combine2_norm(k: dict[str, Lemma], c: _Combine2) -> Lemma:
+    """The two joints' bounds add: |D| <= s1 + s2 + e1 + e2 <= Delta, by four triangle steps
+    (X0 - X2, X0 - h1, h1 - h, X0 - h) and the scaled bounds of A - A', B - B'."""
+    A2, B2 = c.corners
+    h1 = _comb(c.A, c.B, c.lam)
+    dA, dB = _sub(c.A, A2), _sub(c.B, B2)
+    xa, yb = _scale(1 - c.lam, dA), _scale(c.lam, dB)
     c4 = _add(xa, yb)
-    D = _v("cb2.D")
-    z1, z2 = _sub(X0, X2), _sub(X0, h1)
-    key = "s1 + s2 + e1 + e2 <= Delta"
-    hyps: list[Hyp] = [
-        ("D = X0 - h", _veq(D, _sub(X0, h))),
-        ("|X0 - X1| <= s1", N2(_sub(X0, X1)) <= s1 * s1),
-        ("|X1 - X2| <= s2", N2(_sub(X1, X2)) <= s2 * s2),
-        ("|X2 - h1| <= e1", N2(_sub(X2, h1)) <= e1 * e1),
-        ("|A - A'| <= e2", N2(dA) <= e2 * e2), ("|B - B'| <= e2", N2(dB) <= e2 * e2),
-        ("s1, s2, e1, e2 >= 0", z3.And(s1 >= 0, s2 >= 0, e1 >= 0, e2 >= 0)),
-        (key, s1 + s2 + e1 + e2 <= dl),
-        ("0 <= lam, mu, nu <= 1", z3.And(0 <= lam, lam <= 1, 0 <= mu, mu <= 1, 0 <= nu, nu <= 1)),
-    ]
-    hyps += k["expand"].at("X0 - X2", x=_sub(X0, X1), y=_sub(X1, X2), z=z1)
-    hyps += k["dot_bound"].at("X0 - X1, X1 - X2", x=_sub(X0, X1), y=_sub(X1, X2), a=s1, b=s2)
-    hyps += k["expand"].at("X0 - h1", x=z1, y=_sub(X2, h1), z=z2)
-    hyps += k["dot_bound"].at("X0 - X2, X2 - h1", x=z1, y=_sub(X2, h1), a=s1 + s2, b=e1)
-    hyps += k["scale_norm"].at("(1 - lam)(A - A')", c=1 - lam, y=dA, z=xa)
-    hyps += k["scale_norm"].at("lam (B - B')", c=lam, y=dB, z=yb)
-    hyps += k["expand"].at("h1 - h", x=xa, y=yb, z=c4)
-    hyps += k["dot_bound"].at("(1 - lam)(A - A'), lam (B - B')", x=xa, y=yb, a=(1 - lam) * e2,
-                              b=lam * e2)
-    hyps += k["expand"].at("X0 - h", x=z2, y=c4, z=D)
-    hyps += k["dot_bound"].at("X0 - h1, h1 - h", x=z2, y=c4, a=s1 + s2 + e1, b=e2)
-    hyps += k["square_monotone"].at("s1 + s2 + e1 + e2 <= Delta", a=s1 + s2 + e1 + e2, b=dl,
-                                    m=N2(D))
-    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
-    goal = z3.And(N2(D) <= dl * dl, *[w >= 0 for w in ws], z3.Sum(ws) == 1,
-                  _veq(X0, _weighted(ws, [_add(K, D) for K in (K00, K01, K10, K11)])))
-    return lemma("combine2", hyps, goal, key, abstract=True,
-                 names=dict(X0=X0, X1=X1, X2=X2, A=A, B=B, K00=K00, K01=K01, K10=K10, K11=K11,
-                            lam=lam, mu=mu, nu=nu, s1=s1, s2=s2, e1=e1, e2=e2, Delta=dl, D=D))
+    z1, z2 = _sub(c.X0, c.X2), _sub(c.X0, h1)
+    s12 = c.s1 + c.s2
+    hyps = c.hyps()
+    hyps += k["triangle"].at("X0 - X2", x=_sub(c.X0, c.X1), y=_sub(c.X1, c.X2), z=z1, a=c.s1,
+                             b=c.s2)
+    hyps += k["triangle"].at("X0 - h1", x=z1, y=_sub(c.X2, h1), z=z2, a=s12, b=c.e1)
+    hyps += k["scale_bound"].at("(1 - lam)(A - A')", c=1 - c.lam, y=dA, z=xa, b=c.e2)
+    hyps += k["scale_bound"].at("lam (B - B')", c=c.lam, y=dB, z=yb, b=c.e2)
+    hyps += k["triangle"].at("h1 - h", x=xa, y=yb, z=c4, a=(1 - c.lam) * c.e2, b=c.lam * c.e2)
+    hyps += k["triangle"].at("X0 - h", x=z2, y=c4, z=c.D, a=s12 + c.e1,
+                             b=(1 - c.lam) * c.e2 + c.lam * c.e2)
+    hyps += k["square_monotone"].at("s1 + s2 + e1 + e2 <= Delta", a=s12 + c.e1 + c.e2, b=c.dl,
+                                    m=N2(c.D))
+    return lemma("combine2_norm", hyps, N2(c.D) <= c.dl * c.dl, "s1 + s2 + e1 + e2 <= Delta",
+                 abstract=True, names=c.names())
+
+
+def _combine2_weights(c: _Combine2) -> Lemma:
+    """The corners' weights: with D = X0 - h, the corners' weights are >= 0, sum to 1 and
+    X0 = sum of w_c (K_c + D) (a polynomial identity, no norms)."""
+    ws = c.weights
+    hyps = [h for h in c.hyps() if h[0] in ("D = X0 - h", "0 <= lam, mu, nu <= 1")]
+    goal = z3.And(*[w >= 0 for w in ws], z3.Sum(ws) == 1,
+                  _veq(c.X0, _weighted(ws, [_add(K, c.D) for K in c.K])))
+    return lemma("combine2_weights", hyps, goal, "D = X0 - h", abstract=True, names=c.names())
 
 
 def _combine1(k: dict[str, Lemma]) -> Lemma:
@@ -927,6 +1056,15 @@ def _transport_chord() -> Lemma:
             ("|X - ((1 - t) A + t B)|^2 <= m", N2(_sub(X, _comb(A, B, t))) <= m))
     return lemma("transport_chord", hyps, N2(_sub(X2, _comb(A2, B2, t))) <= m, key,
                  abstract=True, names=dict(X=X, A=A, B=B, X2=X2, A2=A2, B2=B2, t=t, m=m))
+
+
+def _shift_eq() -> Lemma:
+    """A point K named by its definition M, moved by d to Q (M + d = Q), gives K + d = Q: the
+    step from grow's conclusion at a corner to sum_subst's premise, made explicit."""
+    K, M, d, Q = (_v(f"se.{n}") for n in ("K", "M", "d", "Q"))
+    key = "K = M"
+    hyps = ((key, _veq(K, M)), ("M + d = Q", _veq(_add(M, d), Q)))
+    return lemma("shift_eq", hyps, _veq(_add(K, d), Q), key, names=dict(K=K, M=M, d=d, Q=Q))
 
 
 def _sum_subst(n: int) -> Lemma:
@@ -1044,18 +1182,30 @@ def _link2(kit: Kit) -> Lemma:
     hyps += k["transport_chord"].at("the base arc, in docs/model.md §2's form",
                                     X=nested(t1c, t2c), A=nested(c1, t2c), B=nested(c1e, t2c),
                                     X2=X2, A2=A, B2=B, t=lam, m=e1 * e1)
+    for where, X2_, A2_, B2_, alpha, t in (("the elbow arc at c1", A, Ks[0], Ks[1], c1, mu),
+                                           ("the elbow arc at c1 + G1", B, Ks[2], Ks[3], c1e,
+                                            nu)):
+        # The elbow arcs' points, named (A, B and the corners): what combine2_norm reads.
+        hyps += k["transport_chord"].at(f"{where}, in docs/model.md §2's form",
+                                        X=P(alpha, alpha + t2c), A=P(alpha, alpha + c2),
+                                        B=P(alpha, (alpha + c2) + G2), X2=X2_, A2=A2_, B2=B2_,
+                                        t=t, m=e2 * e2)
     D = _v("lk2.D")
     hyps.append(("D = X0 - h, h = (1 - lam) A' + lam B' (named)",
                  _veq(D, _sub(X0, _comb(_comb(Ks[0], Ks[1], mu), _comb(Ks[2], Ks[3], nu), lam)))))
-    hyps += k["combine2"].at("the link's points", X0=X0, X1=X1, X2=X2, A=A, B=B, K00=Ks[0],
-                             K01=Ks[1], K10=Ks[2], K11=Ks[3], lam=lam, mu=mu, nu=nu, s1=s1,
-                             s2=s2, e1=e1, e2=e2, Delta=dl, D=D)
+    # The two joints' bounds add (combine2_norm) and the corners' weights (combine2_weights).
+    cb2 = dict(X0=X0, X1=X1, X2=X2, A=A, B=B, K00=Ks[0], K01=Ks[1], K10=Ks[2], K11=Ks[3],
+               lam=lam, mu=mu, nu=nu, s1=s1, s2=s2, e1=e1, e2=e2, Delta=dl, D=D)
+    hyps += k["combine2_norm"].at("the link's points", **cb2)
+    hyps += k["combine2_weights"].at("the link's points", **cb2)
     for i, (alpha, phi) in enumerate(zip(alphas, phis)):
         hyps += k["grow"].at(f"corner {i}", phi=phi, u=u, v=v, r=r, ell=l2, delta=dl,
                              J=_elbow(b, l1, alpha), d=D)
     ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
     Qs = [_add(_elbow(b, l1, a), _rot(e(ph), grown_coords(ph, u, v, D)))
           for a, ph in zip(alphas, phis)]
+    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
+        hyps += k["shift_eq"].at(f"corner {i}", K=Ks[i], M=P(alpha, phi), d=D, Q=Qs[i])
     sub: dict[str, object] = dict(X=X0)
     for i in range(4):
         sub.update({f"P{i}": _add(Ks[i], D), f"Q{i}": Qs[i], f"w{i}": ws[i]})
@@ -1151,11 +1301,17 @@ def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_m
     for L in (_rot_norm(), _rot_scale(), _scale_norm(), _expand(), _dot_bound(),
               _square_monotone(), _proj_id(), _proj_bound(), _grow_id(), _chord0(), _chord_id(),
               _rigid_id(), _arc_monotone(arc), _kin(), _reach_uv(0), _reach_uv(1), _reach_shift(),
-              _lattice(), _margin_covers(arc, 0, margin), _margin_covers(arc, 1, margin)):
+              *_lattice(), _margin_covers(arc, 0, margin), _margin_covers(arc, 1, margin)):
         k[L.vc.name] = L
+    k.update(arc_steps(arc, k))
     k["arc_in_place"], arc_t = _arc_in_place(arc, k)
-    for L in (_chord(k), _reach_link2(k), _grow(k), _combine2(k), _combine1(k), _transport(),
-              _transport_chord(), _sum_subst(2), _sum_subst(4)):
+    c2 = _Combine2.named()
+    for L in (_triangle(k), _scale_bound(k)):
+        k[L.vc.name] = L
+    for L in (_combine2_norm(k, c2), _combine2_weights(c2)):
+        k[L.vc.name] = L
+    for L in (_chord(k), _reach_link2(k), _grow(k), _combine1(k), _transport(),
+              _transport_chord(), _shift_eq(), _sum_subst(2), _sum_subst(4)):
         k[L.vc.name] = L
     kit = Kit(arc, k, arc_t, margin)
     k["link1_in_region"] = _link1(kit)
@@ -1164,14 +1320,13 @@ def region_kit(arc_vc: VC | None = None, margin: Callable[..., object] = sweep_m
 
 
 def region_query(kit: Kit | None = None) -> Z3Query:
-    """Safety.region_soundness: Margin.arc_chord's VC (re-proved: the lemma the margin rests
-    on) and every lemma of the kit."""
+    """Safety.region_soundness: Margin.arc_chord's VC (re-proved from its premises through
+    arc_weight, arc_dist and arc_gap: the lemma the margin rests on) and every lemma of the
+    kit."""
     kit = kit or region_kit()
     check_lattice_reading()
-    arc = kit.arc.vc
-    first = VC("Margin.arc_chord", arc.hypotheses, arc.goal, arc.key_premise, arc.witness,
-               arc.kind, arc.counter_witness)
-    return Z3Query((first,) + tuple(L.vc for L in kit.lemmas.values()))
+    first = kit["Margin.arc_chord"].vc
+    return Z3Query((first,) + tuple(L.vc for L in kit.lemmas.values() if L.vc is not first))
 
 
 # --- (a) the principal in its layer's box ------------------------------------------------------
@@ -2006,7 +2161,8 @@ def safety_obligations() -> list[Obligation]:
         "corners for link 2, two for link 1, which does not depend on theta2). The margin is "
         "derived, not assumed: clamping theta_q "
         "by at most SNAP g_q moves the point by at most SNAP g_q R_q (chord, from cos x >= 1 - "
-        "x^2/2), and Margin.arc_chord, re-proved here as the first VC, is instantiated by "
+        "x^2/2), and Margin.arc_chord, re-proved here as the first VC (from arc_weight, arc_dist "
+        "and arc_gap, where its constant is paid), is instantiated by "
         "substitution at every arc (about the base, and about the elbow at both ends), at (r, "
         "G, e(G/2), e(psi)), and moved from the origin to the arc's pivot and position by the "
         "rigid motion R(mid) (rigid_id, rot_norm, rot_scale, scale_norm): its bound r G^2/8 at "
@@ -2014,11 +2170,14 @@ def safety_obligations() -> list[Obligation]:
         "margin_covers_link1/2 show that impl.sweep_margin, read by calling it on symbolic "
         "spacings (its probe arm's reach replaced by symbols; the reading checked against its "
         "floats on sample arms), is at least the derived margin: a wrong constant fails the "
-        "obligation (1/16 in the lemma its first VC; 1/4 there, or 1/16 in sweep_margin, "
+        "obligation (1/16 in the lemma: arc_gap; 1/4 there, or 1/16 in sweep_margin, "
         "margin_covers). sin and cos are the uninterpreted Cos, Sin with "
-        "the ledger's facts (A3) at the points named. Split into lemmas Z3 proves quickly: small "
+        "the ledger's facts (A3) at the points named. Split into lemmas Z3 and cvc5 each decide "
+        "quickly: small "
         "ones on the polynomials, and compositions (chord, arc_in_place, reach_link2, grow, "
-        "combine1, combine2, transport, sum_subst, link1_in_region, link2_in_region) valid for "
+        "triangle, scale_bound, combine1, combine2_norm, combine2_weights, transport, "
+        "transport_chord, shift_eq, sum_subst, link1_in_region, link2_in_region; the lattice "
+        "through lattice_span and lattice_snap) valid for "
         "every function sq, dt standing for |v|^2 and the dot product, each using the others "
         "by substitution with the facts they rest on carried along; intermediate quantities "
         "(lattice indices, chord weights, points, the displacement D) are named by their "

@@ -232,6 +232,10 @@ class _Printer:
             return f"(=> {self.term(args[0], frame, pre)} {self.term(args[1], frame, pol)})"
         if k in _NARY or k in _FIXED:
             op = _NARY.get(k) or _FIXED[k]
+            if k in (z3.Z3_OP_TO_INT, z3.Z3_OP_TO_REAL, z3.Z3_OP_IS_INT):
+                # to_int, to_real and is_int are declared only in the mixed logics (IRA): a
+                # query whose only integer is ToInt of a real is not QF_NRA.
+                self.ints = self.reals = True
             if k in (z3.Z3_OP_ADD, z3.Z3_OP_MUL) and len(args) == 1:
                 return self.term(args[0], frame)
             if k == z3.Z3_OP_MUL and sum(1 for x in args if not self._is_numeral(x)) > 1:

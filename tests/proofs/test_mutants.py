@@ -91,10 +91,18 @@ def test_assuming_found_in_the_search_wrapper_fails(monkeypatch, tmp_path):
 
 
 def test_a_flipped_box_rule_fails_the_box_nesting(monkeypatch, tmp_path):
-    # The modified box pointing away from the goal (s_q's sign flipped).
-    m = mutant(monkeypatch, "_obl_builtdr", "z3.If(g0 > s0, z3.RealVal(1), z3.RealVal(-1))",
-               "z3.If(g0 > s0, z3.RealVal(-1), z3.RealVal(1))", within="_box_nesting")
-    monkeypatch.setattr(runner, "builtdr_obligations", m.builtdr_obligations)
+    # The modified box pointing away from the goal (s_q's sign flipped), in a copy of the rule
+    # table's row: Thm3.box_nesting runs the code's rule, so it is the proof that fails.
+    import dataclasses
+
+    from cfmpa.spec import _grid as grid
+    from cfmpa.spec import if_then, max_of, min_of
+
+    def flipped(a, b, step, up):
+        end = a + if_then(up, -1.0, 1.0) * step
+        return (min_of(a, end), max_of(a, end))
+    monkeypatch.setitem(grid._RULES, "modified",
+                        dataclasses.replace(grid._RULES["modified"], joint_box=flipped))
     rc, obs = _prove(["Thm3.box_nesting"], tmp_path)
     assert rc == 1 and obs["Thm3.box_nesting"]["verdict"] == "failed"
     assert "refuted" in obs["Thm3.box_nesting"]["reason"]

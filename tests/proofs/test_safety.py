@@ -233,20 +233,27 @@ def test_region_soundness_instantiates_the_proved_arc_lemma(queries):
     arc = next(o for o in all_obs("/nonexistent", ["Margin.arc_chord"])).build().vcs[0]
     first = queries["Safety.region_soundness"][0]
     assert first.name == "Margin.arc_chord" and z3.eq(first.goal, arc.goal)
-    assert [n for n, _ in first.hypotheses] == [n for n, _ in arc.hypotheses]
+    # Its premises, then only instances of the proved steps (arc_weight, arc_dist, arc_gap,
+    # square_monotone), each itself a VC of the obligation.
+    names = [n for n, _ in first.hypotheses]
+    assert names[:len(arc.hypotheses)] == [n for n, _ in arc.hypotheses]
+    assert all(z3.eq(h, h0) for (_, h), (_, h0) in zip(first.hypotheses, arc.hypotheses))
+    steps = [n.split()[1] for n in names[len(arc.hypotheses):]]
+    assert steps == ["arc_weight", "arc_dist", "arc_gap", "square_monotone"]
+    assert set(steps) <= {vc.name for vc in queries["Safety.region_soundness"]}
 
 
 def test_a_margin_lemma_with_1_16_is_refuted():
     kit = S.region_kit(arc_vc=_arc_with(16))
-    q = S.region_query(kit)
-    assert q.vcs[0].name == "Margin.arc_chord"
-    assert _refuted(q.vcs[0], pins=())
+    # The step where the constant is paid (cos x >= 1 - x^2/2 gives g^2/8, not g^2/16) fails.
+    assert _refuted(kit["arc_gap"].vc, pins=())
+    assert not _refuted(kit["arc_weight"].vc, pins=()) and not _refuted(kit["arc_dist"].vc, pins=())
 
 
 def test_a_weaker_margin_lemma_no_longer_covers_sweep_margin():
     # r g^2/4 is true of an arc, but more than sweep_margin adds: margin_covers fails.
     kit = S.region_kit(arc_vc=_arc_with(4))
-    assert not _refuted(S.region_query(kit).vcs[0], pins=())
+    assert not _refuted(S.region_query(kit).vcs[0], pins=()) and not _refuted(kit["arc_gap"].vc)
     for name in ("margin_covers_link1", "margin_covers_link2"):
         assert _refuted(kit[name].vc, pins=())
 
@@ -284,6 +291,24 @@ def test_the_margin_read_from_impl_is_its_formula():
 
 def test_the_lattice_model_is_lattice_range():
     S.check_lattice_reading()
+
+
+def test_a_widened_snap_fails_lattice_span(monkeypatch):
+    # Seeded fault: impl.lattice_range snapping within 1000 SNAP g (a copy run on the symbols):
+    # the lattice may then stop short of the box by more than the margin pays for.
+    from cfmpa.spec import cases, ceil_of, floor_of, max_of, min_of
+
+    def wide(lo, hi, anchor, g):
+        def span():
+            i_lo = floor_of((lo - anchor) / g + 1000 * SNAP)
+            i_hi = ceil_of((hi - anchor) / g - 1000 * SNAP)
+            return (min_of(i_lo, i_hi), max_of(i_lo, i_hi))
+        return cases(g <= 0, lambda: (0, 0), span)
+    good = {L.vc.name: L.vc for L in S._lattice()}
+    assert not _refuted(good["lattice_span"], pins=())
+    monkeypatch.setattr(S, "lattice_range", wide)
+    span, snap, whole = S._lattice()
+    assert span.vc.name == "lattice_span" and _refuted(span.vc, pins=())
 
 
 def test_region_lemmas_need_their_key_premises():

@@ -85,6 +85,18 @@ def test_cvc5_replays_a_proof_and_a_refutation():
 
 
 @needs_cvc5
+def test_to_int_of_a_real_gets_a_mixed_logic_that_cvc5_accepts():
+    # A query whose only integer is ToInt of a real was QF_NRA, where cvc5 refuses to_int.
+    x, y = z3.Reals("x y")
+    q = smtlib_query([x * y >= 2, y > 0], z3.ToReal(z3.ToInt(x * y)) >= 0)
+    assert q.logic == "QF_NIRA"
+    with Cvc5Worker() as w:
+        assert w.check(q.text).answer == "unsat"
+        wrong = q.text.replace("(set-logic QF_NIRA)", "(set-logic QF_NRA)")
+        assert "to_int" in w.check(wrong).reason  # the seeded fault: the old logic choice
+
+
+@needs_cvc5
 def test_a_run_records_which_solvers_confirm_each_vc():
     ob = next(o for o in Z3_OBS if o.id == "Def1.segment")
     pr = discharge(ob)
