@@ -34,7 +34,7 @@ from typing import Any, TextIO
 import jinja2
 import numpy as np
 
-from ..files import dumps_json, jsonable, write_bytes_atomic
+from ..files import jsonable, write_bytes_atomic, write_json
 from ..errors import CfmpaError, InputError
 from ..scenarios import BUNDLED_DIR
 from ..impl import left_regions
@@ -155,7 +155,7 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
 def write_report(result: AuditResult, out_dir: str | Path) -> tuple[Path, Path]:
     """Write report.json, then report.html, each atomically; returns (html path, json path)."""
     out = Path(out_dir)
-    json_path = write_bytes_atomic(out / "report.json", dumps_json(result.doc).encode("utf-8"))
+    json_path = write_json(out / "report.json", result.doc)
     html_path = write_bytes_atomic(out / "report.html", render_html(result).encode("utf-8"))
     return html_path, json_path
 
