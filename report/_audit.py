@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 import jinja2
+import markupsafe
 import numpy as np
 
 from ..files import jsonable, write_bytes_atomic, write_json
@@ -264,9 +265,12 @@ def render_html(result: AuditResult) -> str:
     ctl = result.doc["controls"]["items"]
     premise = [c for c in ctl if c["checker"].startswith("Safety.")]
     groups = ([c for c in ctl if not c["checker"].startswith("Safety.")], premise)
+    sections = result.sections or SECTIONS
+    contents = [markupsafe.Markup(env.from_string(entry).render(doc=result.doc))
+                for sec in sections for entry in sec.contents_entries()]
     return env.get_template("template.html").render(
         doc=result.doc, figures=result.figures, cards=cards, columns=ob["summary"]["columns"],
-        control_groups=groups, sections=result.sections or SECTIONS)
+        control_groups=groups, sections=sections, contents=contents)
 
 
 def _obligations_part(proofs: ProofData) -> dict[str, Any]:
@@ -1177,12 +1181,16 @@ def _this_tree_item(doc: Mapping[str, Any]) -> dict[str, Any]:
 #: pictures and campaign, which do not need them (`cfmpa prove --audit` overlaps the two).
 SECTIONS: tuple[Section, ...] = (
     Section("summary", "Verdict per workcell", _compute_summary, "section_summary.html",
-            needs=("scenarios", "obligations")),
+            needs=("scenarios", "obligations"),
+            contents=('<a href="#workcells">Verdict per workcell</a>',)),
     Section("provenance", "Provenance and what this run checked", _compute_provenance,
             "section_provenance.html"),
     Section("obligations", "Summary of obligations, negative controls and obligations",
             _compute_obligations, "section_obligations.html", more=("controls",), deferred=True,
-            checks=(_obligations_item, _controls_item, _this_tree_item)),
+            checks=(_obligations_item, _controls_item, _this_tree_item),
+            contents=('<a href="#summary">Summary of obligations</a> and '
+                      '<a href="#controls">negative controls</a>',
+                      '<a href="#obligations">Obligations</a>')),
     Section("assumptions", "Assumptions ledger", _compute_assumptions,
             "section_assumptions.html", deferred=True),
     Section("findings", "Findings about the paper", _compute_findings, "section_findings.html",
@@ -1191,7 +1199,10 @@ SECTIONS: tuple[Section, ...] = (
             checks=(_selftest_item,)),
     Section("scenarios", "Scenarios", _compute_scenarios, "section_scenarios.html",
             more=("triples",), needs=("findings",),
-            checks=(_certified_item, _contracts_item, _tubes_item)),
+            checks=(_certified_item, _contracts_item, _tubes_item),
+            contents=('<a href="#scenarios">Scenarios</a>: {% for s in doc.scenarios %}'
+                      '<a href="#scenario-{{ s.name|anchor }}">{{ s.name }}</a>'
+                      '{% if not loop.last %}, {% endif %}{% endfor %}',)),
     Section("monitor", "Monitored execution", _compute_monitor, "section_monitor.html",
             checks=(lambda doc: _monitor_item(doc["monitor"]),)),
     Section("compare", "Comparison campaign", _compute_compare, "section_compare.html",

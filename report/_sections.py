@@ -14,6 +14,7 @@ campaign while the obligations are still being discharged.
 
 from __future__ import annotations
 
+import html
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -36,7 +37,8 @@ class Section:
     after every section that does not need it. ``finish(doc)``, when given, runs once every part
     is computed, for what a part shows of parts computed after it (a finding's related
     obligations). ``checks``: its items of the report's verdict. ``template``: the file (in this
-    package) that shows it, included in the page in the order of the sections' tuple."""
+    package) that shows it, included in the page in the order of the sections' tuple.
+    ``contents``: its entries in the page's contents (``contents_entries``)."""
 
     key: str
     title: str
@@ -47,6 +49,14 @@ class Section:
     more: tuple[str, ...] = ()
     deferred: bool = False
     finish: Callable[[dict[str, Any]], None] | None = None
+    contents: tuple[str, ...] | None = None
+
+    def contents_entries(self) -> tuple[str, ...]:
+        """Its entries in the page's list of contents, each a Jinja template (of report.json as
+        ``doc``) of one entry's HTML: ``contents``, or a link to ``#key`` named by the title."""
+        if self.contents is not None:
+            return self.contents
+        return (f'<a href="#{html.escape(self.key)}">{html.escape(self.title)}</a>',)
 
     @property
     def keys(self) -> tuple[str, ...]:

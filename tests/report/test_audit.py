@@ -1152,6 +1152,9 @@ def test_a_planted_section_is_in_the_json_the_html_and_the_verdict(report, tiny_
         # Shown last, after the campaign, before the page's footer.
         assert '<p class="extra">a planted part</p>' in html
         assert html.index('id="compare"') < html.index('id="extra"') < html.index("<footer>")
+        # And listed last in the page's contents (a link named by its title).
+        nav = html[html.index("<nav>"):html.index("</nav>")]
+        assert nav.rstrip().endswith('<li><a href="#extra">Extra</a></li>\n</ol>')
         assert html == render_html(result)
     # The rest of the page is the bundled sections' own: without the planted one, the same.
     plain = build_audit([str(tiny_file)], argv=report["argv"], proofs_json=str(results_json),
