@@ -49,7 +49,7 @@ from ._findings import (Finding, early_arrival_finding, inconsistency_finding, n
 from ._obligations import (ProofData, card_groups, control_summary, load_proofs, load_selftest,
                            read_results, summary_table)
 from ._provenance import provenance
-from ._sections import Section, compute_order, verdict_of
+from ._sections import Section, compute_order, numbers, verdict_of
 
 __all__ = ["AuditResult", "FORMAT", "SECTIONS", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
            "render_html", "run_audit", "write_report", "default_scenarios_dir",
@@ -266,11 +266,12 @@ def render_html(result: AuditResult) -> str:
     premise = [c for c in ctl if c["checker"].startswith("Safety.")]
     groups = ([c for c in ctl if not c["checker"].startswith("Safety.")], premise)
     sections = result.sections or SECTIONS
+    number = numbers(sections)
     contents = [markupsafe.Markup(env.from_string(entry).render(doc=result.doc))
                 for sec in sections for entry in sec.contents_entries()]
     return env.get_template("template.html").render(
         doc=result.doc, figures=result.figures, cards=cards, columns=ob["summary"]["columns"],
-        control_groups=groups, sections=sections, contents=contents)
+        control_groups=groups, sections=sections, contents=contents, number=number)
 
 
 def _obligations_part(proofs: ProofData) -> dict[str, Any]:
@@ -1187,7 +1188,7 @@ SECTIONS: tuple[Section, ...] = (
             "section_provenance.html"),
     Section("obligations", "Summary of obligations, negative controls and obligations",
             _compute_obligations, "section_obligations.html", more=("controls",), deferred=True,
-            checks=(_obligations_item, _controls_item, _this_tree_item),
+            checks=(_obligations_item, _controls_item, _this_tree_item), headings=2,
             contents=('<a href="#summary">Summary of obligations</a> and '
                       '<a href="#controls">negative controls</a>',
                       '<a href="#obligations">Obligations</a>')),

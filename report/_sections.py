@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Check", "Section", "compute_order", "verdict_of"]
+__all__ = ["Check", "Section", "compute_order", "numbers", "verdict_of"]
 
 #: A check of the report's verdict: report.json (every part computed) -> one verdict item,
 #: ``{"check": name, "ok": True | False | None (not available), "detail": text}``.
@@ -38,7 +38,8 @@ class Section:
     is computed, for what a part shows of parts computed after it (a finding's related
     obligations). ``checks``: its items of the report's verdict. ``template``: the file (in this
     package) that shows it, included in the page in the order of the sections' tuple.
-    ``contents``: its entries in the page's contents (``contents_entries``)."""
+    ``contents``: its entries in the page's contents (``contents_entries``). ``headings``: how
+    many numbered headings its template has (``number`` gives the first its number)."""
 
     key: str
     title: str
@@ -50,6 +51,7 @@ class Section:
     deferred: bool = False
     finish: Callable[[dict[str, Any]], None] | None = None
     contents: tuple[str, ...] | None = None
+    headings: int = 1
 
     def contents_entries(self) -> tuple[str, ...]:
         """Its entries in the page's list of contents, each a Jinja template (of report.json as
@@ -96,3 +98,15 @@ def verdict_of(doc: Mapping[str, Any], sections: Sequence[Section]) -> dict[str,
     False when any item is False (None, not available, counts neither way)."""
     items = [check(doc) for s in sections for check in s.checks]
     return {"ok": all(i["ok"] is not False for i in items), "items": items}
+
+
+def numbers(sections: Sequence[Section]) -> dict[str, int]:
+    """Each section's number on the page (key -> the number of its first heading): 1, 2, ...
+    in the tuple's order, a section with several headings taking as many numbers. The templates
+    number their headings and cross-references from it, so a section added anywhere renumbers
+    the rest."""
+    out, n = {}, 1
+    for s in sections:
+        out[s.key] = n
+        n += s.headings
+    return out

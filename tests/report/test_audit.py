@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import base64
 import copy
+import dataclasses
 import hashlib
 import html as html_lib
 import io
@@ -1109,8 +1110,7 @@ def _replayed(report):
             ctx.figures.update(figures)
             return {k: copy.deepcopy(doc[k]) for k in sec.keys}
         return compute
-    return tuple(Section(s.key, s.title, replay(s), s.template, checks=s.checks, needs=s.needs,
-                         more=s.more, deferred=s.deferred) for s in SECTIONS)
+    return tuple(dataclasses.replace(s, compute=replay(s)) for s in SECTIONS)
 
 
 def test_a_planted_section_is_in_the_json_the_html_and_the_verdict(report, tiny_file,
@@ -1131,7 +1131,8 @@ def test_a_planted_section_is_in_the_json_the_html_and_the_verdict(report, tiny_
 
     extra = Section("extra", "Extra", compute, "section_extra.html", checks=(check,),
                     needs=("scenarios",))
-    block = '<h2 id="extra">11. Extra</h2>\n<p class="extra">{{ doc.extra.note }}</p>\n'
+    block = ('<h2 id="extra">{{ number.extra }}. Extra</h2>\n'
+             '<p class="extra">{{ doc.extra.note }}</p>\n')
     source = audit._template_source
     monkeypatch.setattr(audit, "_template_source",
                         lambda name: block if name == "section_extra.html" else source(name))
@@ -1156,6 +1157,15 @@ def test_a_planted_section_is_in_the_json_the_html_and_the_verdict(report, tiny_
         nav = html[html.index("<nav>"):html.index("</nav>")]
         assert nav.rstrip().endswith('<li><a href="#extra">Extra</a></li>\n</ol>')
         assert html == render_html(result)
+        assert '<h2 id="extra">11. Extra</h2>' in html
+    # Placed second instead, it is section 2 and the ones after it are renumbered, references
+    # to them included.
+    moved = render_html(AuditResult(doc=result.doc, figures=result.figures,
+                                    sections=SECTIONS[:1] + (extra,) + SECTIONS[1:]))
+    assert '<h2 id="extra">2. Extra</h2>' in moved and "<h2>3. Provenance" in moved
+    assert '<h2 id="summary">4. Summary of obligations' in moved
+    assert '<h2 id="obligations">5. Obligations' in moved and "assumptions (section 6)" in moved
+    assert '<h2 id="compare">11. Comparison' in moved
     # The rest of the page is the bundled sections' own: without the planted one, the same.
     plain = build_audit([str(tiny_file)], argv=report["argv"], proofs_json=str(results_json),
                         compare_n=4, compare_seed=3, expected_ids=EXPECTED,
