@@ -5,6 +5,7 @@ variables, and echoed values cut to ECHO_CHARS characters."""
 
 from __future__ import annotations
 
+import enum
 import hashlib
 import io
 import json
@@ -21,9 +22,9 @@ import numpy as np
 
 from .errors import MISSING, InputError
 
-__all__ = ["ECHO_CHARS", "LIMITS", "Limit", "bounded_lines", "check_file_size", "dumps_json",
-           "echo", "jsonable", "npy_bytes", "read_bounded", "save_npy_atomic",
-           "write_atomic_with", "write_bytes_atomic"]
+__all__ = ["ECHO_CHARS", "LIMITS", "JsonStyle", "Limit", "bounded_lines", "check_file_size",
+           "dumps_json", "echo", "jsonable", "npy_bytes", "read_bounded", "save_npy_atomic",
+           "write_atomic_with", "write_bytes_atomic", "write_json"]
 
 #: An echoed value (a row, a field) longer than this in a message is cut to it.
 ECHO_CHARS = 80
@@ -212,9 +213,37 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     return write_atomic_with(path, lambda fh: fh.write(data))[0]
 
 
-def dumps_json(obj: Any) -> str:
-    """Deterministic JSON: sorted keys, two-space indent, trailing newline."""
-    return json.dumps(obj, indent=2, sort_keys=True, allow_nan=False) + "\n"
+class JsonStyle(enum.Enum):
+    """The layouts of the JSON cfmpa writes; every one sorts its keys and ends in a newline, so
+    the same data gives the same bytes. The value is json.dumps's indent (None: compact)."""
+
+    #: A document (report.json, plan.json, results.json, compare.json): two-space indent.
+    DOCUMENT = 2
+    #: A pinned file reviewed as a diff (obligations.lock): one-space indent.
+    LOCK = 1
+    #: One record a line (a campaign's or batch's store): no spaces at all.
+    LINE = None
+
+
+def dumps_json(obj: Any, style: JsonStyle = JsonStyle.DOCUMENT, *, ascii_only: bool = True,
+               allow_nan: bool = False) -> str:
+    """The one JSON writer: ``obj`` in ``style``, keys sorted, a trailing newline.
+    ``ascii_only``: non-ASCII characters as \\u escapes; ``allow_nan``: NaN and infinities
+    written as JavaScript's names (not JSON) instead of refused with ValueError."""
+    if style is JsonStyle.LINE:
+        text = json.dumps(obj, sort_keys=True, separators=(",", ":"), ensure_ascii=ascii_only,
+                          allow_nan=allow_nan)
+    else:
+        text = json.dumps(obj, indent=style.value, sort_keys=True, ensure_ascii=ascii_only,
+                          allow_nan=allow_nan)
+    return text + "\n"
+
+
+def write_json(path: str | os.PathLike[str], obj: Any, style: JsonStyle = JsonStyle.DOCUMENT,
+               *, ascii_only: bool = True, allow_nan: bool = False) -> Path:
+    """``dumps_json``'s text written atomically (UTF-8) to ``path``."""
+    return write_bytes_atomic(path, dumps_json(obj, style, ascii_only=ascii_only,
+                                               allow_nan=allow_nan).encode("utf-8"))
 
 
 def npy_bytes(array: np.ndarray) -> bytes:

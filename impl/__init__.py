@@ -13,7 +13,7 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
     from ._fast_search import search_opt_path_fast
     from ._kernels import KERNELS, kernel_name, kernels
     from ._kinematics import link_reach, link_rectangles
-    from ._progress import progress_default, progress_silenced
+    from ._progress import Progress, progress_default, progress_silenced
     from ._search import search_opt_path
     from ._threads import kernel_threads, set_kernel_threads
     from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
@@ -40,6 +40,7 @@ _EXPORTS: dict[str, str] = {
     "kernels": "._kernels:kernels",
     "link_reach": "._kinematics:link_reach",
     "link_rectangles": "._kinematics:link_rectangles",
+    "Progress": "._progress:Progress",
     "progress_default": "._progress:progress_default",
     "progress_silenced": "._progress:progress_silenced",
     "search_opt_path": "._search:search_opt_path",
@@ -54,7 +55,7 @@ _EXPORTS: dict[str, str] = {
 }
 
 __all__ = [
-    "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "RightRegions", "build_dr",
+    "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "Progress", "RightRegions", "build_dr",
     "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly",
     "containment_slack", "convex_hull", "kernel_name", "kernel_threads", "kernels", "lattice_range",
     "left_regions", "left_spacing", "link_reach", "link_rectangles", "naive_hull", "progress_default",

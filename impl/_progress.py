@@ -1,12 +1,15 @@
-"""A tiny progress bar on stderr for long BuiltDR builds and searches.
+"""cfmpa's one progress bar on stderr (``Progress``): long BuiltDR builds and searches, and the
+campaign's and batch's tasks (``cfmpa.runs`` draws it through ``Progress.for_terminal``).
 
-It draws only when stderr is a terminal and the grid is large (``PROGRESS_MIN_CELLS``), so logs,
-pipes and tests stay clean; ``progress=True`` forces it, ``False`` silences it.
+A build or search draws it only when stderr is a terminal and the grid is large
+(``PROGRESS_MIN_CELLS``), so logs, pipes and tests stay clean; ``progress=True`` forces it,
+``False`` silences it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import math
 import sys
 import time
 from collections.abc import Iterator
@@ -26,18 +29,40 @@ _WIDTH = 30
 
 
 class Progress:
-    """Counts finished units of work and redraws ``label [####   ] done/total`` in place."""
+    """cfmpa's one progress bar: ``label done/total [####   ] rate/s, elapsed, ETA`` redrawn
+    in place on a stream (None: silent); BuiltDR's layers, the search's, a campaign's or batch's
+    tasks. The rate is of the units done in this run (``start`` counts those done before it, e.g.
+    reused from a store), so the time left does not count reused work."""
 
-    def __init__(self, label: str, total: int, stream: TextIO | None) -> None:
-        self.label = label
-        self.total = max(int(total), 1)
-        self.stream = stream  # None: silent
-        self.done = 0
-        self._last = -_REDRAW_S
+    def __init__(self, label: str, total: int, start: int = 0, stream: TextIO | None = None
+                 ) -> None:
+        self.label, self.total = label, max(int(total), 1)
+        self.start = self.done = min(int(start), self.total)
+        self.stream = stream
+        self._t0 = time.monotonic()
+        self._last = -math.inf
+
+    @classmethod
+    def for_terminal(cls, label: str, total: int, start: int = 0,
+                     progress: bool | None = None, stream: TextIO | None = None) -> Progress:
+        """A bar on ``stream`` (default stderr) if ``progress`` is True, or None and the stream
+        is a terminal (and no ``progress_silenced`` is in force); silent otherwise (logs, pipes
+        and tests stay clean)."""
+        out = sys.stderr if stream is None else stream
+        if progress is None:
+            progress = _DEFAULT[0]
+        if progress is None:
+            isatty = getattr(out, "isatty", None)
+            progress = bool(isatty is not None and isatty())
+        return cls(label, total, start, out if progress else None)
 
     @property
     def enabled(self) -> bool:
         return self.stream is not None
+
+    def restart(self) -> None:
+        """The clock of the rate and the elapsed time starts now (when the work starts)."""
+        self._t0 = time.monotonic()
 
     def advance(self, units: int = 1) -> None:
         self.done = min(self.done + units, self.total)
@@ -46,20 +71,28 @@ class Progress:
         now = time.monotonic()
         if now - self._last >= _REDRAW_S or self.done == self.total:
             self._last = now
-            self._draw()
+            self._draw(now)
+
+    def line(self, now: float | None = None) -> str:
+        elapsed = (time.monotonic() if now is None else now) - self._t0
+        computed = self.done - self.start
+        rate = computed / elapsed if elapsed > 0 and computed > 0 else 0.0
+        left = "-" if rate == 0 else _duration((self.total - self.done) / rate)
+        filled = _WIDTH * self.done // self.total
+        bar = "#" * filled + " " * (_WIDTH - filled)
+        return (f"{self.label} {self.done}/{self.total} [{bar}] {rate:.2f}/s, "
+                f"{_duration(elapsed)} elapsed, ETA {left}  ")
 
     def close(self) -> None:
         if self.stream is not None:
-            self._draw()
+            self._draw(time.monotonic())
             self.stream.write("\n")
             self.stream.flush()
             self.stream = None
 
-    def _draw(self) -> None:
+    def _draw(self, now: float) -> None:
         assert self.stream is not None
-        filled = _WIDTH * self.done // self.total
-        bar = "#" * filled + " " * (_WIDTH - filled)
-        self.stream.write(f"\r{self.label} [{bar}] {self.done}/{self.total}")
+        self.stream.write("\r" + self.line(now))
         self.stream.flush()
 
     def __enter__(self) -> Progress:
@@ -68,6 +101,12 @@ class Progress:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
+
+
+def _duration(seconds: float) -> str:
+    s = int(round(seconds))
+    h, rest = divmod(s, 3600)
+    return f"{h}h{rest // 60:02d}m" if h else f"{rest // 60}m{rest % 60:02d}s"
 
 
 #: What ``progress=None`` means while ``progress_silenced`` is in force (False), else None.
@@ -101,4 +140,4 @@ def progress_bar(label: str, total: int, cells: int, progress: bool | None = Non
     if progress is None:
         isatty = getattr(out, "isatty", None)
         progress = bool(isatty is not None and isatty()) and cells >= PROGRESS_MIN_CELLS
-    return Progress(label, total, out if progress else None)
+    return Progress(label, total, stream=out if progress else None)

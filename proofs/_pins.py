@@ -30,7 +30,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from ..files import write_bytes_atomic
+from ..files import JsonStyle, write_json
 from ._obligation import Proof
 
 __all__ = ["LOCK", "Mismatch", "check_pins", "cvc5_skips", "load_lock", "pin_entry", "pin_key",
@@ -165,6 +165,5 @@ def repin(proofs: Iterable[Proof], path: str | Path | None = None, *,
                    "expected verdict and the sha256 of each VC's statement in standard SMT-LIB "
                    "2.6 (or of a check's source); per-scenario checks once, as Scenario.*.",
            "obligations": {k: new[k] for k in sorted(new)}}
-    text = json.dumps(doc, indent=1, sort_keys=True, ensure_ascii=False) + "\n"
-    write_bytes_atomic(f, text.encode("utf-8"))
+    write_json(f, doc, JsonStyle.LOCK, ascii_only=False, allow_nan=True)
     return conflicts + lines

@@ -26,7 +26,7 @@ import sympy
 import z3
 
 from .. import __version__
-from ..files import write_bytes_atomic
+from ..files import dumps_json, write_bytes_atomic
 from ..gitstate import package_state
 from ..scenarios import BUNDLED_DIR
 from ._ledger import ASSUMPTIONS, Assumption
@@ -493,7 +493,7 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
                         for a in run.assumptions],
         "seconds": round(run.seconds, 3),
     }
-    return json.dumps(doc, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
+    return dumps_json(doc, ascii_only=False, allow_nan=True)
 
 
 def kind_counts(proofs: Iterable[Proof]) -> dict[str, int]:

@@ -8,6 +8,8 @@ scenario the plans of the three variants with contracts, certificate, each found
 tolerance tube (docs/model.md §12) and pictures; per audited workcell one monitored simulated
 run of its modified plan, with and without an injected excursion (or why there is none); the
 seeded comparison campaign. Where a part's data is not available in this run, the part says so.
+Each part is a ``Section`` of SECTIONS (``_sections``): its compute, its checks (its rows of
+the verdict, in the sections' order) and its template file, section_<key>.html.
 
 report.json holds every number of the HTML (not the pictures). For the same inputs and version
 it is the same apart from the provenance (date, git state, command line), the times (keys
@@ -30,9 +32,10 @@ from pathlib import Path
 from typing import Any, TextIO
 
 import jinja2
+import markupsafe
 import numpy as np
 
-from ..files import dumps_json, jsonable, write_bytes_atomic
+from ..files import jsonable, write_bytes_atomic, write_json
 from ..errors import CfmpaError, InputError
 from ..scenarios import BUNDLED_DIR
 from ..impl import left_regions
@@ -46,8 +49,9 @@ from ._findings import (Finding, early_arrival_finding, inconsistency_finding, n
 from ._obligations import (ProofData, card_groups, control_summary, load_proofs, load_selftest,
                            read_results, summary_table)
 from ._provenance import provenance
+from ._sections import Section, compute_order, numbers, verdict_of
 
-__all__ = ["AuditResult", "FORMAT", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
+__all__ = ["AuditResult", "FORMAT", "SECTIONS", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
            "render_html", "run_audit", "write_report", "default_scenarios_dir",
            "MONITOR_VARIANT", "MONITOR_SIMULATION", "MONITOR_EXCURSION", "MONITOR_MAX_SAMPLES",
            "tube_problems", "monitor_problems", "monitor_settings", "workcell_summary"]
@@ -76,10 +80,12 @@ BOUND_AGREEMENT_M = 1e-12
 
 @dataclass(frozen=True)
 class AuditResult:
-    """The report's data (report.json) and its pictures (id -> Figure)."""
+    """The report's data (report.json), its pictures (id -> Figure) and the sections it was
+    built from, in the order they are shown (empty: SECTIONS)."""
 
     doc: dict[str, Any]
     figures: dict[str, F.Figure]
+    sections: tuple[Section, ...] = ()
 
 
 class _Progress:
@@ -150,22 +156,25 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
 def write_report(result: AuditResult, out_dir: str | Path) -> tuple[Path, Path]:
     """Write report.json, then report.html, each atomically; returns (html path, json path)."""
     out = Path(out_dir)
-    json_path = write_bytes_atomic(out / "report.json", dumps_json(result.doc).encode("utf-8"))
+    json_path = write_json(out / "report.json", result.doc)
     html_path = write_bytes_atomic(out / "report.html", render_html(result).encode("utf-8"))
     return html_path, json_path
 
 
 def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None = None,
                 proofs_json: str | Callable[[], str] | None = None,
-              scenarios_dir: str | None = None,
+                scenarios_dir: str | None = None,
                 contracts: str = "full", compare_n: int = DEFAULT_COMPARE_N,
                 compare_seed: int = 0, expected_ids: Sequence[str] | None = None,
                 campaign: str | Path | None = None,
-                progress: TextIO | _Progress | None = None) -> AuditResult:
-    """Compute everything the report shows (no files written). A callable ``proofs_json`` is
-    called for the results.json path once everything else is computed. ``progress``: a stream
-    for a line per stage (findings, each plan, each scenario's figures, the monitored run, the
-    campaign, the proofs) with its time."""
+                progress: TextIO | _Progress | None = None,
+                sections: Sequence[Section] | None = None) -> AuditResult:
+    """Compute everything the report shows (no files written): each of ``sections`` (default
+    SECTIONS) in ``compute_order``, then their ``finish`` steps and the verdict, their checks. A
+    callable ``proofs_json`` is called for the results.json path once everything else is
+    computed (the proofs' sections are deferred). ``progress``: a stream for a line per stage
+    (findings, each plan, each scenario's figures, the monitored run, the campaign, the proofs)
+    with its time."""
     stages = progress if isinstance(progress, _Progress) else _Progress(progress)
     sdir = Path(scenarios_dir) if scenarios_dir is not None else default_scenarios_dir()
     paths = _scenario_paths(scenarios, sdir)
@@ -181,49 +190,74 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
     recorded = None if campaign is None else load_campaign(campaign)   # input errors first
     if isinstance(proofs_json, (str, Path)):
         read_results(proofs_json)        # unreadable results: said now, not after the plans
-    plans = _Plans(contracts, stages)
-    figures: dict[str, F.Figure] = {}
-    # The plans, pictures and campaign first: they do not need the proofs, so `cfmpa prove
-    # --audit` computes them while the obligations are discharged (``proofs_json`` callable).
-    with stages.stage("findings (their plans listed above)"):
-        findings = _findings(sdir, loaded, plans, figures)
-    with stages.stage("mutation self-check"):
-        selftest = load_selftest()
-    scenario_parts = [_scenario_entry(s, plans, figures, stages) for s in loaded]
-    with stages.stage("monitored run"):
-        monitor = _monitor(loaded, plans, figures)
-    with stages.stage("campaign" + (f" (recorded in {campaign})" if recorded is not None else
-                                    f" ({compare_n} workcells)" if compare_n else " (not run)")):
-        compare = _compare(compare_n, compare_seed, figures, recorded, campaign)
-    parts = {"findings": findings, "selftest": selftest, "scenarios": scenario_parts,
-             "monitor": monitor, "compare": compare}
-    # The user's workcells are the ones to prove: given files bring their own per-scenario
-    # obligations (the bundled set, by default, its pinned ones).
-    with stages.stage("proofs (" + ("discharged afresh" if proofs_json is None else
-                                    "read from the prove run") + ")"):
-        proofs = load_proofs(proofs_json() if callable(proofs_json) else proofs_json, sdir,
-                             expected_ids, files=paths if scenarios else None)
-    doc = {
-        "format": FORMAT,
-        "provenance": provenance(argv, loaded),
-        **_proof_sections(proofs),
-        **parts,
-    }
-    _relate(doc["findings"], proofs)
-    doc["triples"] = _triples(plans)
-    doc["verdict"] = _verdict(doc)
-    # Section 1 (first on the page): computed last, from the parts above.
-    doc = {"format": doc["format"], "summary": workcell_summary(loaded, doc), **doc}
-    return AuditResult(doc=doc, figures=figures)
+    chosen = tuple(SECTIONS if sections is None else sections)
+    ctx = _Context(sdir=sdir, paths=paths, loaded=loaded, given=bool(scenarios),
+                   argv=argv, compare_n=compare_n, compare_seed=compare_seed,
+                   recorded=recorded, campaign=campaign, proofs_json=proofs_json,
+                   expected_ids=expected_ids, stages=stages, plans=_Plans(contracts, stages))
+    for sec in compute_order(chosen):
+        parts = sec.compute(ctx)
+        if set(parts) != set(sec.keys):
+            raise ValueError(f"section {sec.key!r} computed {sorted(parts)}, not {list(sec.keys)}")
+        ctx.doc.update(parts)
+    for sec in chosen:
+        if sec.finish is not None:
+            sec.finish(ctx.doc)
+    # report.json's keys are sorted when written; here the parts in the sections' order.
+    doc = {"format": FORMAT, **{k: ctx.doc[k] for sec in chosen for k in sec.keys},
+           "verdict": verdict_of(ctx.doc, chosen)}
+    return AuditResult(doc=doc, figures=ctx.figures, sections=chosen)
+
+
+@dataclass
+class _Context:
+    """What the sections are computed from: the inputs, the plans and pictures shared between
+    sections, the proofs (read or discharged once, on first use) and the parts computed so far
+    (``doc``)."""
+
+    sdir: Path
+    paths: list[Path]
+    loaded: list[Scenario]
+    given: bool                 # the scenarios were named (their own obligations are expected)
+    argv: Sequence[str] | None
+    compare_n: int
+    compare_seed: int
+    recorded: Campaign | None
+    campaign: str | Path | None
+    proofs_json: str | Callable[[], str] | None
+    expected_ids: Sequence[str] | None
+    stages: _Progress
+    plans: _Plans
+    figures: dict[str, F.Figure] = dataclasses.field(default_factory=dict)
+    doc: dict[str, Any] = dataclasses.field(default_factory=dict)
+    _proofs: ProofData | None = None
+
+    def proofs(self) -> ProofData:
+        """The obligation data; the user's workcells are the ones to prove: given files bring
+        their own per-scenario obligations (the bundled set, by default, its pinned ones)."""
+        if self._proofs is None:
+            source = self.proofs_json
+            with self.stages.stage("proofs (" + ("discharged afresh" if source is None else
+                                                "read from the prove run") + ")"):
+                self._proofs = load_proofs(source() if callable(source) else source, self.sdir,
+                                           self.expected_ids,
+                                           files=self.paths if self.given else None)
+        return self._proofs
+
+
+def _template_source(name: str) -> str:
+    """A template of this package by file name (the page, and each section's)."""
+    return resources.files("cfmpa.report").joinpath(name).read_text(encoding="utf-8")
 
 
 def render_html(result: AuditResult) -> str:
-    """The self-contained HTML page (CSS inline, pictures as data URIs, no external URL)."""
+    """The self-contained HTML page (CSS inline, pictures as data URIs, no external URL): the
+    page's frame, then each section's template in the order of the result's sections."""
     env = jinja2.Environment(autoescape=jinja2.select_autoescape(["html"], default=True),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
-                             lstrip_blocks=True, keep_trailing_newline=True)
+                             lstrip_blocks=True, keep_trailing_newline=True,
+                             loader=jinja2.FunctionLoader(lambda n: _template_source(n)))
     env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, s3=_s3, anchor=_anchor)
-    text = resources.files("cfmpa.report").joinpath("template.html").read_text(encoding="utf-8")
     ob = result.doc["obligations"]
     by_id = {r["id"]: r for r in ob["items"]}
     cards = [{**g, "rows": [by_id[i] for i in g["ids"]]} for g in ob["cards"]]
@@ -231,31 +265,43 @@ def render_html(result: AuditResult) -> str:
     ctl = result.doc["controls"]["items"]
     premise = [c for c in ctl if c["checker"].startswith("Safety.")]
     groups = ([c for c in ctl if not c["checker"].startswith("Safety.")], premise)
-    return env.from_string(text).render(doc=result.doc, figures=result.figures, cards=cards,
-                                        columns=ob["summary"]["columns"], control_groups=groups)
+    sections = result.sections or SECTIONS
+    number = numbers(sections)
+    contents = [markupsafe.Markup(env.from_string(entry).render(doc=result.doc))
+                for sec in sections for entry in sec.contents_entries()]
+    return env.get_template("template.html").render(
+        doc=result.doc, figures=result.figures, cards=cards, columns=ob["summary"]["columns"],
+        control_groups=groups, sections=sections, contents=contents, number=number)
+
+
+def _obligations_part(proofs: ProofData) -> dict[str, Any]:
+    """The report's "obligations" part."""
+    return {
+        "available": proofs.available, "source": proofs.source, "note": proofs.note,
+        "summary": summary_table(proofs.rows),
+        "cards": card_groups(proofs.rows),
+        "items": [r.as_json() for r in proofs.rows],
+        "missing_ids": list(proofs.missing_ids), "unexpected_ids": list(proofs.unexpected_ids),
+        "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
+                            and not proofs.unexpected_ids) if proofs.available else None,
+        "run": proofs.run, "not_run": list(proofs.not_run),
+        "depth": {"measures": proofs.depth_measures or DEPTH_MEASURES,
+                  "nonlinear_vcs": sum(v.nonlinear for r in proofs.rows for v in r.vcs),
+                  "vcs": sum(len(r.vcs) for r in proofs.rows)},
+    }
+
+
+def _assumptions_part(proofs: ProofData) -> dict[str, Any]:
+    """The report's "assumptions" part: the ledger."""
+    return {"available": proofs.ledger_available,
+            "source": proofs.source if proofs.ledger_available else
+            "not available in this run", "entries": list(proofs.ledger)}
 
 
 def _proof_sections(proofs: ProofData) -> dict[str, Any]:
-    """The report's "obligations" and "assumptions" parts."""
-    return {
-        "obligations": {
-            "available": proofs.available, "source": proofs.source, "note": proofs.note,
-            "summary": summary_table(proofs.rows),
-            "cards": card_groups(proofs.rows),
-            "items": [r.as_json() for r in proofs.rows],
-            "missing_ids": list(proofs.missing_ids), "unexpected_ids": list(proofs.unexpected_ids),
-            "all_as_expected": (all(r.as_expected for r in proofs.rows) and not proofs.missing_ids
-                                and not proofs.unexpected_ids) if proofs.available else None,
-            "run": proofs.run, "not_run": list(proofs.not_run),
-            "depth": {"measures": proofs.depth_measures or DEPTH_MEASURES,
-                      "nonlinear_vcs": sum(v.nonlinear for r in proofs.rows for v in r.vcs),
-                      "vcs": sum(len(r.vcs) for r in proofs.rows)},
-        },
-        "controls": _controls_part(proofs),
-        "assumptions": {"available": proofs.ledger_available,
-                        "source": proofs.source if proofs.ledger_available else
-                        "not available in this run", "entries": list(proofs.ledger)},
-    }
+    """The report's "obligations", "controls" and "assumptions" parts."""
+    return {"obligations": _obligations_part(proofs), "controls": _controls_part(proofs),
+            "assumptions": _assumptions_part(proofs)}
 
 
 #: What an obligation's depth measures, when results.json does not say (an older file).
@@ -274,7 +320,7 @@ def _controls_part(proofs: ProofData) -> dict[str, Any]:
             "missing_ids": list(proofs.missing_controls)}
 
 
-def _controls_item(doc: dict[str, Any]) -> dict[str, Any]:
+def _controls_item(doc: Mapping[str, Any]) -> dict[str, Any]:
     """The verdict's check of the negative controls: every one ended as it expects, and none
     that a whole prove run has is missing; None when the data has none (a fresh run)."""
     c = doc["controls"]
@@ -294,11 +340,12 @@ def _controls_item(doc: dict[str, Any]) -> dict[str, Any]:
                     if missing else ""))
 
 
-def _relate(findings: list[dict[str, Any]], proofs: ProofData) -> None:
+def _relate(doc: dict[str, Any]) -> None:
     """Give each finding the obligations that state it (by id prefix), with their verdicts."""
-    for f in findings:
-        f["related_obligations"] = [{"id": r.id, "verdict": r.verdict} for r in proofs.rows
-                                    if any(r.id.startswith(pre) for pre in f["related"])]
+    for f in doc["findings"]:
+        f["related_obligations"] = [{"id": r["id"], "verdict": r["verdict"]}
+                                    for r in doc["obligations"]["items"]
+                                    if any(r["id"].startswith(pre) for pre in f["related"])]
 
 
 # --- Section 1: the verdict per workcell -------------------------------------------------------
@@ -873,78 +920,96 @@ def _compare(n: int, seed: int, figures: dict[str, F.Figure], recorded: Campaign
             "rate_figure": {"id": rate.id, "caption": rate.caption}, **doc}
 
 
-# --- the report's own verdict -------------------------------------------------------------------
+# --- the report's own verdict: the sections' checks ---------------------------------------------
 
-def _verdict(doc: dict[str, Any]) -> dict[str, Any]:
-    """What the report checks, each ok True / False / None (not available), and the conjunction."""
+def _verdict(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """What the report checks, each ok True / False / None (not available), and the conjunction:
+    the checks of SECTIONS, in their order."""
+    return verdict_of(doc, SECTIONS)
+
+
+def _obligations_item(doc: Mapping[str, Any]) -> dict[str, Any]:
     ob = doc["obligations"]
-    items = []
-    if ob["available"]:
-        bad = [r["id"] for r in ob["items"] if not r["as_expected"]]
-        gaps = ob["missing_ids"] + ob["unexpected_ids"]
-        kinds = ob["summary"]["kinds"]
-        items.append(_item("obligations as expected", not bad and not gaps,
-                           f"{len(ob['items']) - len(bad)} of {len(ob['items'])} ("
-                           f"{kinds['theorem']} theorems, {kinds['definitional']} definitional)"
-                           + (f"; not as expected: {', '.join(bad)}" if bad else "")
-                           + (f"; missing ids: {', '.join(ob['missing_ids'])}"
-                              if ob["missing_ids"] else "")
-                           + (f"; unexpected ids: {', '.join(ob['unexpected_ids'])}"
-                              if ob["unexpected_ids"] else "")))
-    else:
-        items.append(_item("obligations as expected", None, ob["source"]))
-    items.append(_controls_item(doc))
-    items.append(_proofs_of_this_tree(ob, doc["provenance"]))
+    if not ob["available"]:
+        return _item("obligations as expected", None, ob["source"])
+    bad = [r["id"] for r in ob["items"] if not r["as_expected"]]
+    gaps = ob["missing_ids"] + ob["unexpected_ids"]
+    kinds = ob["summary"]["kinds"]
+    return _item("obligations as expected", not bad and not gaps,
+                 f"{len(ob['items']) - len(bad)} of {len(ob['items'])} ("
+                 f"{kinds['theorem']} theorems, {kinds['definitional']} definitional)"
+                 + (f"; not as expected: {', '.join(bad)}" if bad else "")
+                 + (f"; missing ids: {', '.join(ob['missing_ids'])}"
+                    if ob["missing_ids"] else "")
+                 + (f"; unexpected ids: {', '.join(ob['unexpected_ids'])}"
+                    if ob["unexpected_ids"] else ""))
+
+
+def _findings_item(doc: Mapping[str, Any]) -> dict[str, Any]:
     fnd = [f for f in doc["findings"] if f["available"]]
     missing = [f["id"] for f in doc["findings"] if not f["available"]]
     not_rep = [f["id"] for f in fnd if not f["reproduced"]]
-    items.append(_item("findings reproduced on data", (not not_rep) if fnd else None,
-                       f"{len(fnd) - len(not_rep)} of {len(doc['findings'])}"
-                       + (f"; not reproduced: {', '.join(not_rep)}" if not_rep else "")
-                       + (f"; not available: {', '.join(missing)}" if missing else "")))
-    plans = [(s["name"], v) for s in doc["scenarios"] for v in s["variants"]]
-    found = [(n, v) for n, v in plans if v["status"] == "found"]
+    return _item("findings reproduced on data", (not not_rep) if fnd else None,
+                 f"{len(fnd) - len(not_rep)} of {len(doc['findings'])}"
+                 + (f"; not reproduced: {', '.join(not_rep)}" if not_rep else "")
+                 + (f"; not available: {', '.join(missing)}" if missing else ""))
+
+
+def _plans_of(doc: Mapping[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+    return [(s["name"], v) for s in doc["scenarios"] for v in s["variants"]]
+
+
+def _certified_item(doc: Mapping[str, Any]) -> dict[str, Any]:
+    found = [(n, v) for n, v in _plans_of(doc) if v["status"] == "found"]
     unclear = [f"{n}/{v['variant']}" for n, v in found
                if not (v["clearance"] and v["clearance"]["clear"])]
-    items.append(_item("found paths certified clear", not unclear if found else None,
-                       f"{len(found) - len(unclear)} of {len(found)} found paths"
-                       + (f"; not clear: {', '.join(unclear)}" if unclear else "")))
+    return _item("found paths certified clear", not unclear if found else None,
+                 f"{len(found) - len(unclear)} of {len(found)} found paths"
+                 + (f"; not clear: {', '.join(unclear)}" if unclear else ""))
+
+
+def _contracts_item(doc: Mapping[str, Any]) -> dict[str, Any]:
+    plans = _plans_of(doc)
     # Off mode still writes a record (checked = 0); only records that checked something count.
     recorded = [(n, v) for n, v in plans if v["contracts"] and v["contracts"].get("checked", 0) > 0]
     violated = [f"{n}/{v['variant']}" for n, v in recorded if v["contracts"].get("violations")]
     # A plan stopped by a violated precondition recorded no count, yet it failed a contract.
     stopped = [f"{n}/{v['variant']}" for n, v in plans if v["status"] == "contract_violation"]
-    items.append(_item("contracts hold", (not violated and not stopped)
-                       if recorded or stopped else None,
-                       f"{len(recorded)} of {len(plans)} plans recorded contracts"
-                       + (f"; violated: {', '.join(violated)}" if violated else "")
-                       + (f"; stopped by a violation: {', '.join(stopped)}" if stopped else "")))
-    st = doc["selftest"]
-    if st["available"]:
-        missed = [r["fault"] for r in st["rows"] if r.get("caught_full") is False]
-        items.append(_item("self-check faults caught (full mode)", not missed,
-                           f"{len(st['rows']) - len(missed)} of {len(st['rows'])}"
-                           + (f"; missed: {', '.join(map(str, missed))}" if missed else "")))
-    else:
-        items.append(_item("self-check faults caught (full mode)", None, st["source"]))
+    return _item("contracts hold", (not violated and not stopped) if recorded or stopped else None,
+                 f"{len(recorded)} of {len(plans)} plans recorded contracts"
+                 + (f"; violated: {', '.join(violated)}" if violated else "")
+                 + (f"; stopped by a violation: {', '.join(stopped)}" if stopped else ""))
+
+
+def _tubes_item(doc: Mapping[str, Any]) -> dict[str, Any]:
+    found = [v for _, v in _plans_of(doc) if v["status"] == "found"]
     tubes = [pl for s in doc["scenarios"] for pl in (s["tube"] or {}).get("plans", [])]
     problems = tube_problems(doc)
-    items.append(_item("tolerance tubes agree with certify",
-                       (not problems) if found else None,
-                       f"{len(tubes)} found plans' tubes (c > 2 L delta; tolerance_rad as "
-                       f"plan.json and cfmpa certify give it)"
-                       + (f"; {'; '.join(problems)}" if problems else "")))
-    items.append(_monitor_item(doc["monitor"]))
+    return _item("tolerance tubes agree with certify", (not problems) if found else None,
+                 f"{len(tubes)} found plans' tubes (c > 2 L delta; tolerance_rad as "
+                 f"plan.json and cfmpa certify give it)"
+                 + (f"; {'; '.join(problems)}" if problems else ""))
+
+
+def _selftest_item(doc: Mapping[str, Any]) -> dict[str, Any]:
+    st = doc["selftest"]
+    if not st["available"]:
+        return _item("self-check faults caught (full mode)", None, st["source"])
+    missed = [r["fault"] for r in st["rows"] if r.get("caught_full") is False]
+    return _item("self-check faults caught (full mode)", not missed,
+                 f"{len(st['rows']) - len(missed)} of {len(st['rows'])}"
+                 + (f"; missed: {', '.join(map(str, missed))}" if missed else ""))
+
+
+def _campaign_item(doc: Mapping[str, Any]) -> dict[str, Any]:
     cmp_ = doc["compare"]
-    if cmp_["available"]:
-        bad = {k: v for k, v in cmp_["checks"].items() if v}
-        raised = len(cmp_["errors"])
-        items.append(_item("campaign checks", not bad and not raised, f"{cmp_['n']} workcells"
-                           + (f"; failed: {bad}" if bad else "; all counts 0")
-                           + (f"; {raised} workcell(s) raised" if raised else "")))
-    else:
-        items.append(_item("campaign checks", None, cmp_["note"]))
-    return {"ok": all(i["ok"] is not False for i in items), "items": items}
+    if not cmp_["available"]:
+        return _item("campaign checks", None, cmp_["note"])
+    bad = {k: v for k, v in cmp_["checks"].items() if v}
+    raised = len(cmp_["errors"])
+    return _item("campaign checks", not bad and not raised, f"{cmp_['n']} workcells"
+                 + (f"; failed: {bad}" if bad else "; all counts 0")
+                 + (f"; {raised} workcell(s) raised" if raised else ""))
 
 
 def _monitor_item(mon: Mapping[str, Any]) -> dict[str, Any]:
@@ -1059,3 +1124,89 @@ def _s3(x: Any) -> str:
 def _anchor(name: str) -> str:
     return "".join(c if c.isalnum() else "-" for c in str(name)).strip("-").lower() or "x"
 
+
+
+# --- the sections, in the order the page shows them (docs/model.md §8) ----------------------------
+
+def _compute_summary(c: _Context) -> dict[str, Any]:
+    return {"summary": workcell_summary(c.loaded, c.doc)}
+
+
+def _compute_provenance(c: _Context) -> dict[str, Any]:
+    return {"provenance": provenance(c.argv, c.loaded)}
+
+
+def _compute_obligations(c: _Context) -> dict[str, Any]:
+    proofs = c.proofs()
+    return {"obligations": _obligations_part(proofs), "controls": _controls_part(proofs)}
+
+
+def _compute_assumptions(c: _Context) -> dict[str, Any]:
+    return {"assumptions": _assumptions_part(c.proofs())}
+
+
+def _compute_findings(c: _Context) -> dict[str, Any]:
+    with c.stages.stage("findings (their plans listed above)"):
+        return {"findings": _findings(c.sdir, c.loaded, c.plans, c.figures)}
+
+
+def _compute_selftest(c: _Context) -> dict[str, Any]:
+    with c.stages.stage("mutation self-check"):
+        return {"selftest": load_selftest()}
+
+
+def _compute_scenarios(c: _Context) -> dict[str, Any]:
+    entries = [_scenario_entry(s, c.plans, c.figures, c.stages) for s in c.loaded]
+    # The triples of every plan computed so far: the findings' (needed first) and these.
+    return {"scenarios": entries, "triples": _triples(c.plans)}
+
+
+def _compute_monitor(c: _Context) -> dict[str, Any]:
+    with c.stages.stage("monitored run"):
+        return {"monitor": _monitor(c.loaded, c.plans, c.figures)}
+
+
+def _compute_compare(c: _Context) -> dict[str, Any]:
+    label = ("campaign" + (f" (recorded in {c.campaign})" if c.recorded is not None else
+                           f" ({c.compare_n} workcells)" if c.compare_n else " (not run)"))
+    with c.stages.stage(label):
+        return {"compare": _compare(c.compare_n, c.compare_seed, c.figures, c.recorded,
+                                    c.campaign)}
+
+
+def _this_tree_item(doc: Mapping[str, Any]) -> dict[str, Any]:
+    return _proofs_of_this_tree(doc["obligations"], doc["provenance"])
+
+
+#: The report's parts, in the order the page shows them; each one's checks are its rows of the
+#: verdict, in this order too. The proofs' sections are deferred: computed after the plans,
+#: pictures and campaign, which do not need them (`cfmpa prove --audit` overlaps the two).
+SECTIONS: tuple[Section, ...] = (
+    Section("summary", "Verdict per workcell", _compute_summary, "section_summary.html",
+            needs=("scenarios", "obligations"),
+            contents=('<a href="#workcells">Verdict per workcell</a>',)),
+    Section("provenance", "Provenance and what this run checked", _compute_provenance,
+            "section_provenance.html"),
+    Section("obligations", "Summary of obligations, negative controls and obligations",
+            _compute_obligations, "section_obligations.html", more=("controls",), deferred=True,
+            checks=(_obligations_item, _controls_item, _this_tree_item), headings=2,
+            contents=('<a href="#summary">Summary of obligations</a> and '
+                      '<a href="#controls">negative controls</a>',
+                      '<a href="#obligations">Obligations</a>')),
+    Section("assumptions", "Assumptions ledger", _compute_assumptions,
+            "section_assumptions.html", deferred=True),
+    Section("findings", "Findings about the paper", _compute_findings, "section_findings.html",
+            checks=(_findings_item,), finish=_relate),
+    Section("selftest", "Mutation self-check", _compute_selftest, "section_selftest.html",
+            checks=(_selftest_item,)),
+    Section("scenarios", "Scenarios", _compute_scenarios, "section_scenarios.html",
+            more=("triples",), needs=("findings",),
+            checks=(_certified_item, _contracts_item, _tubes_item),
+            contents=('<a href="#scenarios">Scenarios</a>: {% for s in doc.scenarios %}'
+                      '<a href="#scenario-{{ s.name|anchor }}">{{ s.name }}</a>'
+                      '{% if not loop.last %}, {% endif %}{% endfor %}',)),
+    Section("monitor", "Monitored execution", _compute_monitor, "section_monitor.html",
+            checks=(lambda doc: _monitor_item(doc["monitor"]),)),
+    Section("compare", "Comparison campaign", _compute_compare, "section_compare.html",
+            checks=(_campaign_item,)),
+)

@@ -16,7 +16,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..files import dumps_json, write_bytes_atomic
+from ..files import write_json
 from ..runs import COMPARE_DT, CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Campaign, run_campaign
 from ..spec import SearchStatus, Variant
 from ._stats import mcnemar_exact_p, wilson_interval
@@ -162,7 +162,7 @@ def run_compare(n: int = 100, seed: int = 0, out: str | None = None, *, dt: floa
     doc = campaign_json(c)
     print(format_campaign(doc), file=so)
     if out is not None:
-        path = write_bytes_atomic(Path(out) / "compare.json", dumps_json(doc).encode())
+        path = write_json(Path(out) / "compare.json", doc)
         print(f"wrote     {path}", file=so)
     t = c.timings_s
     print(f"time      {t.get('run', 0.0):.1f} s: {c.n - c.reused} workcell(s) planned in "

@@ -135,9 +135,11 @@ class ControlRow:
         return self.outcome in self.expected and self.recorded_ok is not False
 
     def as_json(self) -> dict[str, Any]:
-        return {"id": self.id, "checker": self.checker, "what": self.what,
-                "expected": list(self.expected), "outcome": self.outcome, "ok": self.ok,
-                "detail": self.detail, "seconds": self.seconds}
+        """The record's fields as report.json holds them, with the report's ``ok`` in place of
+        the recorded one (derived from the fields: a field added is shown, not forgotten)."""
+        doc = dataclasses.asdict(self)
+        del doc["recorded_ok"]
+        return {**doc, "expected": list(self.expected), "ok": self.ok}
 
 
 @dataclass(frozen=True)

@@ -24,13 +24,16 @@ __all__ = ["run_prove_audit"]
 def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
                     scenarios_dir: str | Path | None = None, only: Sequence[str] | None = None,
                     repin: bool = False, workers: int | None = None,
-                    argv: Sequence[str] | None = None, stdout: TextIO | None = None) -> int:
+                    argv: Sequence[str] | None = None, stdout: TextIO | None = None,
+                    progress: bool = True) -> int:
     """Discharge every obligation into ``out_dir`` (``proofs.run_prove``) and write the audit
     report of that run to ``audit`` (``report.run_audit``); the exit code is the prove run's,
     else the report's. InputError (exit 2, nothing run) for ``only``: a report a reviewer trusts
     is of a whole run, a selection would show the rest missing. ``stdout`` gets the prove run's
     summary; the report process prints on sys.stdout and sys.stderr as it inherits them through
-    the fork (a stream of this process's memory would not reach the terminal from there)."""
+    the fork (a stream of this process's memory would not reach the terminal from there).
+    ``progress``: the report process writes a line per stage with its time on its sys.stderr,
+    as `cfmpa audit` does (the proofs' stage last: it waits for this run's results.json)."""
     # Through the packages, not their modules: the names a caller (or a test's stand-in) sees.
     from .. import proofs, report
 
@@ -50,6 +53,7 @@ def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
     def write_audit() -> int:
         return int(report.run_audit(None, str(audit), argv=list(argv or ["cfmpa"]),
                                     proofs_json=proofs_ready,
+                                    progress=sys.stderr if progress else None,
                                     scenarios_dir=None if scenarios_dir is None
                                     else str(scenarios_dir)))
 

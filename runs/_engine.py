@@ -40,7 +40,7 @@ from typing import Any, TextIO
 from urllib.parse import urlsplit
 
 from ..errors import CfmpaError, InputError, WorkersLost
-from ..impl import progress_default
+from ..impl import Progress
 
 __all__ = ["CONNECT_TIMEOUT_S", "RETRIES", "SCHEMES", "WORKER_TIMEOUT_S", "Engine", "ProgressBar",
            "TaskLost", "check_scheduler_address", "error_message"]
@@ -94,69 +94,8 @@ def check_scheduler_address(address: str) -> str:
     return f"{parts.scheme}://{parts.netloc}"
 
 
-class ProgressBar:
-    """``label done/total [####   ] rate/s, ETA`` redrawn in place on a stream (None: silent).
-
-    The rate is of the tasks computed in this run (``start`` counts those done before it, e.g.
-    reused from a store), so the estimate of the time left does not count reused work."""
-
-    _REDRAW_S = 0.2
-    _WIDTH = 28
-
-    def __init__(self, label: str, total: int, start: int = 0, stream: TextIO | None = None
-                 ) -> None:
-        self.label, self.total, self.start, self.done = label, max(total, 1), start, start
-        self.stream = stream
-        self._t0 = time.monotonic()
-        self._last = -math.inf
-
-    @classmethod
-    def for_terminal(cls, label: str, total: int, start: int = 0,
-                     progress: bool | None = None, stream: TextIO | None = None) -> ProgressBar:
-        """A bar on ``stream`` (default stderr) if ``progress`` is True, or None and the stream
-        is a terminal; silent otherwise (logs, pipes and tests stay clean)."""
-        out = sys.stderr if stream is None else stream
-        if progress is None:
-            progress = progress_default()
-        if progress is None:
-            isatty = getattr(out, "isatty", None)
-            progress = bool(isatty is not None and isatty())
-        return cls(label, total, start, out if progress else None)
-
-    def restart(self) -> None:
-        """The clock of the rate and the elapsed time starts now (when the tasks start)."""
-        self._t0 = time.monotonic()
-
-    def advance(self, units: int = 1) -> None:
-        self.done = min(self.done + units, self.total)
-        now = time.monotonic()
-        if self.stream is not None and (now - self._last >= self._REDRAW_S
-                                        or self.done == self.total):
-            self._last = now
-            self.stream.write("\r" + self.line(now))
-            self.stream.flush()
-
-    def line(self, now: float | None = None) -> str:
-        elapsed = (time.monotonic() if now is None else now) - self._t0
-        computed = self.done - self.start
-        rate = computed / elapsed if elapsed > 0 and computed > 0 else 0.0
-        left = "-" if rate == 0 else _duration((self.total - self.done) / rate)
-        filled = self._WIDTH * self.done // self.total
-        bar = "#" * filled + " " * (self._WIDTH - filled)
-        return (f"{self.label} {self.done}/{self.total} [{bar}] {rate:.2f}/s, "
-                f"{_duration(elapsed)} elapsed, ETA {left}  ")
-
-    def close(self) -> None:
-        if self.stream is not None:
-            self.stream.write("\n")
-            self.stream.flush()
-            self.stream = None
-
-
-def _duration(seconds: float) -> str:
-    s = int(round(seconds))
-    h, rest = divmod(s, 3600)
-    return f"{h}h{rest // 60:02d}m" if h else f"{rest // 60}m{rest % 60:02d}s"
+#: The campaign's and batch's bar: cfmpa's one progress bar (``impl.Progress``).
+ProgressBar = Progress
 
 
 def _probe_scheduler(address: str, timeout: float) -> None:

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from ..errors import InputError
+from ..files import JsonStyle, dumps_json
 
 try:  # POSIX; elsewhere the store is simply not locked
     import fcntl
@@ -58,8 +59,7 @@ class Store:
 
 
 def _line(obj: dict[str, Any]) -> bytes:
-    return (json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
-            + "\n").encode("utf-8")
+    return dumps_json(obj, JsonStyle.LINE).encode("utf-8")
 
 
 def open_store(path: str | os.PathLike[str], fmt: str, version: int,

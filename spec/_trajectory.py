@@ -27,6 +27,7 @@ obligation ``Monitor.between_samples`` proves it with Z3 on this very function's
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import json
@@ -219,21 +220,45 @@ def load_trajectory(path: str | Path, s: Scenario, *, allow_speed: bool = False)
     LIMITS["line"], the file within LIMITS["trajectory"]; JSON, read whole, within the latter."""
     p = Path(path)
     source = str(p)
-    limit = LIMITS["trajectory"]
-    if p.suffix.lower() != ".json":
-        try:
-            fh = open(p, "rb")
-        except OSError as exc:
-            raise _fail("trajectory", MISSING, f"cannot be read ({exc.strerror or exc})", source,
-                        None) from None
-        with fh:
-            lines = bounded_lines(fh, source, total=limit)
-            first = next(lines, "")
-            if not first.lstrip().startswith("{"):
-                return parse_trajectory_csv(itertools.chain([first], lines), s, source=source,
-                                            allow_speed=allow_speed)
-    data = read_bounded(p, limit, source, lines=False, field="trajectory")
+    with _csv_lines(p, source) as csv:
+        if csv is not None:
+            return parse_trajectory_csv(csv.lines, s, source=source, allow_speed=allow_speed)
+    data = read_bounded(p, LIMITS["trajectory"], source, lines=False, field="trajectory")
     return _parse_json_bytes(data, s, source, allow_speed)
+
+
+@dataclass(frozen=True)
+class _CsvFile:
+    """A trajectory file open as CSV: its bounded lines (the first included) and, when asked
+    for, the reader that hashes the bytes the lines were read from."""
+
+    lines: Iterator[str]
+    hashing: _HashingReader | None
+
+
+@contextlib.contextmanager
+def _csv_lines(p: Path, source: str, *, hashing: bool = False) -> Iterator[_CsvFile | None]:
+    """The trajectory file open as CSV, streamed line by line within LIMITS["line"] and, in
+    all, LIMITS["trajectory"]; None when it is JSON (it ends in .json, or its first line starts
+    with ``{``), which the caller reads whole after the ``with``. An unreadable file raises
+    InputError naming it. Both readers (``load_trajectory``, ``certify_trajectory_file``) open
+    and bound their file here, so they take a file for the same format and refuse it alike."""
+    if p.suffix.lower() == ".json":
+        yield None
+        return
+    try:
+        fh = open(p, "rb")
+    except OSError as exc:
+        raise _fail("trajectory", MISSING, f"cannot be read ({exc.strerror or exc})", source,
+                    None) from None
+    with fh:
+        reader = _HashingReader(fh) if hashing else None
+        # cast: bounded_lines reads only readline(size) of a binary stream
+        stream = cast(IO[bytes], reader) if reader is not None else fh
+        lines = bounded_lines(stream, source, total=LIMITS["trajectory"])
+        first = next(lines, "")
+        yield (None if first.lstrip().startswith("{")
+               else _CsvFile(itertools.chain([first], lines), reader))
 
 
 def _parse_json_bytes(data: bytes, s: Scenario, source: str, allow_speed: bool) -> Trajectory:
@@ -648,32 +673,21 @@ def certify_trajectory_file(path: str | Path, s: Scenario, *, allow_speed: bool 
     tim = {"load": 0.0, "certificate": 0.0}
     c = _Certifier(s, source)
     t0 = time.perf_counter()
-    if p.suffix.lower() != ".json":
-        try:
-            fh = open(p, "rb")
-        except OSError as exc:
-            raise _fail("trajectory", MISSING, f"cannot be read ({exc.strerror or exc})", source,
-                        None) from None
-        with fh:
-            reader = _HashingReader(fh)
-            # cast: bounded_lines reads only readline(size) of a binary stream
-            lines = bounded_lines(cast(IO[bytes], reader), source, total=LIMITS["trajectory"])
-            first = next(lines, "")
-            if not first.lstrip().startswith("{"):
-                parts = _csv_parts(itertools.chain([first], lines), s, source, allow_speed,
-                                   chunk_rows, c)
-                while True:
-                    part = next(parts, None)
-                    t1 = time.perf_counter()
-                    tim["load"] += t1 - t0
-                    if part is None:
-                        break
-                    c.add(*part)
-                    t0 = time.perf_counter()
-                    tim["certificate"] += t0 - t1
-                if timings is not None:
-                    timings.update(tim)
-                return c.summary(), c.prover.certificate(), reader.hash.hexdigest()
+    with _csv_lines(p, source, hashing=True) as csv:
+        if csv is not None and csv.hashing is not None:
+            parts = _csv_parts(csv.lines, s, source, allow_speed, chunk_rows, c)
+            while True:
+                part = next(parts, None)
+                t1 = time.perf_counter()
+                tim["load"] += t1 - t0
+                if part is None:
+                    break
+                c.add(*part)
+                t0 = time.perf_counter()
+                tim["certificate"] += t0 - t1
+            if timings is not None:
+                timings.update(tim)
+            return c.summary(), c.prover.certificate(), csv.hashing.hash.hexdigest()
     data = read_bounded(p, LIMITS["trajectory"], source, lines=False, field="trajectory")
     traj = _parse_json_bytes(data, s, source, allow_speed)
     t1 = time.perf_counter()

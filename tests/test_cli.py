@@ -251,6 +251,25 @@ def test_prove_that_stops_opens_the_gate_with_stop_and_the_report_writes_nothing
     assert marker.read_text().endswith("results.json")
 
 
+def test_prove_audit_prints_the_reports_stage_lines_on_stderr(tmp_path, capfd, monkeypatch):
+    # As `cfmpa audit` does (issue 26 item 5): the report process (forked) writes a line per
+    # stage on its stderr. A stand-in report writes a stage line to the progress stream it is
+    # given; a stand-in prove run succeeds. capfd: the child writes to the inherited fd 2.
+    import cfmpa.proofs
+    import cfmpa.report
+
+    def report(files, out_dir, *, proofs_json, progress=None, **kw):
+        proofs_json()
+        if progress is not None:
+            progress.write("audit: proofs (read from the prove run)   1.0 s\n")
+        return 0
+    monkeypatch.setattr(cfmpa.report, "run_audit", report)
+    monkeypatch.setattr(cfmpa.proofs, "run_prove", lambda **kw: 0)
+    assert main(["prove", "--out", str(tmp_path / "p"), "--audit", str(tmp_path / "a")]) == 0
+    out, err = capfd.readouterr()
+    assert "audit: proofs (read from the prove run)" in err and "audit: " not in out
+
+
 # --- outputs checked before the work (issue 22.6) ---------------------------------------------
 
 def _no_work(monkeypatch):

@@ -31,9 +31,19 @@ def _strip_times(doc: dict) -> dict:
 
 
 def test_fixed_ids_match_the_collected_obligations_exactly():
-    ids = [o.id for o in collect_obligations(scenarios_dir="/nonexistent")]
+    # Compared as a mapping id -> verdict (issue 25 item 4): EXPECTED_VERDICTS need not follow
+    # the order the obligations are collected in, but every id and its verdict must match.
+    from cfmpa.proofs import EXPECTED_VERDICTS
+
+    obs = collect_obligations(scenarios_dir="/nonexistent")
+    ids = [o.id for o in obs]
     assert len(ids) == len(set(ids))
-    assert tuple(ids) == FIXED_IDS
+    collected = {o.id: o.expected for o in obs}
+    assert collected == EXPECTED_VERDICTS and set(FIXED_IDS) == set(ids)
+    # The comparison is blind to order only: reordered it holds, a changed verdict fails it.
+    assert dict(reversed(list(EXPECTED_VERDICTS.items()))) == collected
+    flipped = dict(EXPECTED_VERDICTS, **{"Prop8.printed": Verdict.PROVED})
+    assert flipped != collected
 
 
 def test_scenario_ids_come_from_the_files_found(tmp_path: Path):

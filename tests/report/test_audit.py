@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import base64
 import copy
+import dataclasses
 import hashlib
 import html as html_lib
 import io
@@ -40,8 +41,9 @@ from cfmpa.errors import InputError
 from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
-from cfmpa.report._audit import (_controls_item, _proof_sections, _verdict, contract_rows,
-                                 workcell_summary)
+from cfmpa.report._audit import (SECTIONS, _controls_item, _proof_sections, _verdict,
+                                 contract_rows, workcell_summary)
+from cfmpa.report._sections import Section, compute_order, verdict_of
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import load_proofs
 from cfmpa.gitstate import MAX_PATHS, git_state
@@ -1041,3 +1043,140 @@ def test_full_audit_of_the_bundled_scenarios(tmp_path, capsys):
     assert not doc["obligations"]["missing_ids"] and doc["compare"]["n"] == 100
     html = (out / "report.html").read_text()
     assert all(f'<span class="id">{o["id"]}</span>' in html for o in doc["obligations"]["items"])
+
+
+# --- the sections (report/_sections.py, issue 25 item 2) ----------------------------------------
+# The order they are computed and shown in, the verdict made of their checks, and a planted extra
+# section, which must appear in report.json, the HTML and the verdict with nothing else touched
+# but its Section and its template.
+
+def _section(key, *, needs=(), deferred=False, more=(), seen=None):
+    def compute(ctx):
+        if seen is not None:
+            seen.append(key)
+        return {k: {} for k in (key, *more)}
+    return Section(key, key, compute, f"section_{key}.html", needs=needs, deferred=deferred,
+                   more=more)
+
+
+def test_compute_order_defers_and_follows_needs():
+    a, b = _section("a", deferred=True), _section("b", needs=("c",))
+    c, d = _section("c"), _section("d", needs=("a",))
+    assert [s.key for s in compute_order((a, b, c, d))] == ["c", "b", "a", "d"]
+    # The bundled tuple: the proofs after everything that does not need them, section 1 after
+    # the parts it summarises.
+    order = [s.key for s in compute_order(SECTIONS)]
+    assert order.index("obligations") > max(order.index(k) for k in
+                                            ("findings", "scenarios", "monitor", "compare"))
+    assert order.index("summary") > order.index("obligations") > order.index("scenarios")
+    assert order.index("findings") < order.index("scenarios")   # the triples of every plan
+
+
+@pytest.mark.parametrize("sections, message", [
+    ((_section("a"), _section("b", more=("a",))), "both write 'a'"),
+    ((_section("a", needs=("zz",)),), "which no section writes"),
+    ((_section("a", needs=("b",)), _section("b", needs=("a",))), "need each other"),
+])
+def test_compute_order_refuses_a_bad_tuple(sections, message):
+    with pytest.raises(ValueError, match=message):
+        compute_order(sections)
+
+
+def test_verdict_is_the_sections_checks_in_their_order():
+    def check(name, ok):
+        return lambda doc: {"check": name, "ok": ok, "detail": ""}
+    s1 = Section("a", "a", lambda c: {"a": 1}, "x", checks=(check("one", True),))
+    s2 = Section("b", "b", lambda c: {"b": 1}, "x", checks=(check("two", None),
+                                                            check("three", True)))
+    v = verdict_of({}, (s1, s2))
+    assert [i["check"] for i in v["items"]] == ["one", "two", "three"] and v["ok"] is True
+    s3 = Section("c", "c", lambda c: {"c": 1}, "x", checks=(check("four", False),))
+    assert verdict_of({}, (s1, s2, s3))["ok"] is False
+
+
+def test_schema_names_every_sections_part():
+    # A section's part is a top-level key of report.json: the schema must require it.
+    schema = json.loads((ROOT / "report" / "schema.json").read_text())
+    parts = {k for s in SECTIONS for k in s.keys}
+    assert set(schema["required"]) == parts | {"format", "verdict"}
+
+
+def _replayed(report):
+    """The bundled sections with their computations replaced by the fixture's parts."""
+    doc, figures = report["doc"], report["result"].figures
+
+    def replay(sec):
+        def compute(ctx):
+            ctx.figures.update(figures)
+            return {k: copy.deepcopy(doc[k]) for k in sec.keys}
+        return compute
+    return tuple(dataclasses.replace(s, compute=replay(s)) for s in SECTIONS)
+
+
+def test_a_planted_section_is_in_the_json_the_html_and_the_verdict(report, tiny_file,
+                                                                   results_json, tmp_path,
+                                                                   monkeypatch):
+    import cfmpa.report._audit as audit
+
+    doc = report["doc"]
+    seen = {}
+
+    def compute(ctx):
+        # computed after the parts it needs, which it reads from the build's context
+        seen["scenarios"] = [s["name"] for s in ctx.doc["scenarios"]]
+        return {"extra": {"note": "a planted part", "ok": holds[0]}}
+
+    def check(d):
+        return {"check": "extra part holds", "ok": d["extra"]["ok"], "detail": "planted"}
+
+    extra = Section("extra", "Extra", compute, "section_extra.html", checks=(check,),
+                    needs=("scenarios",))
+    block = ('<h2 id="extra">{{ number.extra }}. Extra</h2>\n'
+             '<p class="extra">{{ doc.extra.note }}</p>\n')
+    source = audit._template_source
+    monkeypatch.setattr(audit, "_template_source",
+                        lambda name: block if name == "section_extra.html" else source(name))
+    for ok in (True, False):
+        holds = [ok]
+        result = build_audit([str(tiny_file)], argv=report["argv"],
+                             proofs_json=str(results_json), compare_n=4, compare_seed=3,
+                             expected_ids=EXPECTED, sections=_replayed(report) + (extra,))
+        out = tmp_path / str(ok)
+        write_report(result, out)
+        written = json.loads((out / "report.json").read_text())
+        html = (out / "report.html").read_text()
+        assert written["extra"] == {"note": "a planted part", "ok": ok}
+        assert seen["scenarios"] == [s["name"] for s in doc["scenarios"]]
+        items = written["verdict"]["items"]
+        assert items[:-1] == doc["verdict"]["items"] and items[-1]["check"] == "extra part holds"
+        assert written["verdict"]["ok"] is ok
+        # Shown last, after the campaign, before the page's footer.
+        assert '<p class="extra">a planted part</p>' in html
+        assert html.index('id="compare"') < html.index('id="extra"') < html.index("<footer>")
+        # And listed last in the page's contents (a link named by its title).
+        nav = html[html.index("<nav>"):html.index("</nav>")]
+        assert nav.rstrip().endswith('<li><a href="#extra">Extra</a></li>\n</ol>')
+        assert html == render_html(result)
+        assert '<h2 id="extra">11. Extra</h2>' in html
+    # Placed second instead, it is section 2 and the ones after it are renumbered, references
+    # to them included.
+    moved = render_html(AuditResult(doc=result.doc, figures=result.figures,
+                                    sections=SECTIONS[:1] + (extra,) + SECTIONS[1:]))
+    assert '<h2 id="extra">2. Extra</h2>' in moved and "<h2>3. Provenance" in moved
+    assert '<h2 id="summary">4. Summary of obligations' in moved
+    assert '<h2 id="obligations">5. Obligations' in moved and "assumptions (section 6)" in moved
+    assert '<h2 id="compare">11. Comparison' in moved
+    # The rest of the page is the bundled sections' own: without the planted one, the same.
+    plain = build_audit([str(tiny_file)], argv=report["argv"], proofs_json=str(results_json),
+                        compare_n=4, compare_seed=3, expected_ids=EXPECTED,
+                        sections=_replayed(report))
+    assert plain.doc["verdict"] == doc["verdict"]
+    assert "extra" not in plain.doc and 'id="extra"' not in render_html(plain)
+
+
+def test_a_section_computing_other_parts_than_it_declares_is_refused(report, tiny_file,
+                                                                    results_json):
+    bad = Section("extra", "Extra", lambda ctx: {"extra": 1, "stray": 2}, "section_extra.html")
+    with pytest.raises(ValueError, match="computed"):
+        build_audit([str(tiny_file)], argv=report["argv"], proofs_json=str(results_json),
+                    compare_n=0, expected_ids=EXPECTED, sections=_replayed(report) + (bad,))
