@@ -377,7 +377,7 @@ def run_code_selftest(names: Sequence[str] | None = None, *,
                       json_out: str | None = None, stdout: TextIO | None = None) -> int:
     """`cfmpa selftest --code`: the table on ``stdout`` (default sys.stdout), and JSON if asked;
     0 iff cfmpa prove caught every mutant run (1 otherwise)."""
-    from ..files import write_bytes_atomic
+    from ..files import JsonStyle, dumps_json, write_bytes_atomic
 
     so = sys.stdout if stdout is None else stdout
     _chosen(names, checks)
@@ -391,8 +391,7 @@ def run_code_selftest(names: Sequence[str] | None = None, *,
         doc = {"checks": list(checks), "prove_only": list(prove_only),
                "mutants": [{"mutant": r.mutant, "what": r.what, "caught": r.caught,
                             "detail": r.detail, "seconds": r.seconds} for r in rows]}
-        text = json.dumps(doc, indent=1, sort_keys=True) + "\n"
-        write_bytes_atomic(json_out, text.encode())
+        write_bytes_atomic(json_out, dumps_json(doc, JsonStyle.LOCK).encode())
     if "prove" not in checks:
         return 0
     missed = [r.mutant for r in rows if not r.caught.get("prove")]
