@@ -17,7 +17,7 @@ The campaign item (`cfmpa compare`, a fixed campaign with 1 and 2 local workers,
 speed-up) runs in the full bench and alone with ``--only campaign`` (merged into an existing
 results.json); --quick leaves it out (its cluster start alone is seconds). Likewise
 ``plan_scaling`` (``--only plan_scaling``): `cfmpa plan --contracts full` of the default
-workcell at dt = 0.02, 0.01, 0.0075 in fresh processes, with cells, seconds, peak resident
+workcell at dt = 0.02, 0.01, 0.0075, 0.005 in fresh processes, with cells, seconds, peak resident
 memory and bytes a cell (docs/model.md §3's cell budget rests on it). And ``certify_stream``
 (``--only certify_stream``): `cfmpa certify` of a long slow trajectory of 10^6 rows (and of
 10^5, to show the peak does not grow with the rows), seconds and the child's peak memory.
@@ -59,7 +59,7 @@ class Config:
     scaling_dts: tuple[float, ...] = (0.04, 0.02, 0.01)
     #: `cfmpa plan --contracts full` of the default workcell per dt, fresh processes (item 1 of
     #: issue 24: bytes a cell); 0.005 (381 M cells) is left to a quiet machine.
-    plan_scaling_dts: tuple[float, ...] = (0.02, 0.01, 0.0075)
+    plan_scaling_dts: tuple[float, ...] = (0.02, 0.01, 0.0075, 0.005)
     one_degree: dict[str, Any] = field(default_factory=dict)
     prove: bool = False                    # time `make prove` (cfmpa prove --audit): one run
     monitor_samples: int = 1_000_000       # the monitor's log (10^6 samples)
