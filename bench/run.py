@@ -20,7 +20,9 @@ results.json); --quick leaves it out (its cluster start alone is seconds). Likew
 workcell at dt = 0.02, 0.01, 0.0075, 0.005 in fresh processes, with cells, seconds, peak resident
 memory and bytes a cell (docs/model.md §3's cell budget rests on it). And ``certify_stream``
 (``--only certify_stream``): `cfmpa certify` of a long slow trajectory of 10^6 rows (and of
-10^5, to show the peak does not grow with the rows), seconds and the child's peak memory.
+10^5, to show the peak does not grow with the rows), seconds and the child's peak memory. And
+``tools`` (``--only tools``): BuiltDR fast of the bundled gripper and levels workcells, with
+their ratio to the default workcell's.
 """
 
 from __future__ import annotations
@@ -290,6 +292,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
     res["monitor"] = monitor_section(cfg, tmp, base, have_cli and cli_has("monitor"))
     res["plan_scaling"] = plan_scaling_section(cfg, tmp) if have_cli else no_cli
     res["certify_stream"] = certify_stream_section(cfg, tmp) if have_cli else no_cli
+    res["tools"] = tools_section(cfg, tmp)
     res["targets"] = targets(res, cfg)
     res["informational"] = informational(res, cfg)
     res["meta"]["bench_wall_s"] = round(time.perf_counter() - t_start, 1)
@@ -412,6 +415,41 @@ def certify_stream_lines(sec: dict[str, Any]) -> list[str]:
     if "peak_growth_mib" in sec:
         lines.append(f"peak growth over the rows: {sec['peak_growth_mib']} MiB (targets: "
                      f"10^6 rows in {sec['target_s']:g} s and {sec['target_mib']:g} MiB)")
+    return lines
+
+
+TOOL_WORKCELLS = ("gripper", "levels")
+
+
+def tools_section(cfg: Config, tmp: Path) -> dict[str, Any]:
+    """BuiltDR fast (modified) of the bundled tool and height workcells against the default
+    workcell they are built on (the same arms, motion and grid: ``default_at``'s overrides on
+    each file), in worker processes: the medians and each one's ratio to the default's. A tool
+    adds a region per arm and up to five pairs of parts; heights drop pairs (docs/model.md §2)."""
+    base = default_at(cfg.dt)
+    names = ("default",) + TOOL_WORKCELLS
+    items = [{"kind": "builtdr", "impl": "fast", "variant": "modified",
+              "scenario": base | {"path": f"scenarios/{name}.toml"}} for name in names]
+    got = dict(zip(names, in_workers(cfg, items)))
+    ref = med(got["default"])
+    rows = {}
+    for name in names:
+        m = med(got[name])
+        rows[name] = got[name] | {"ratio_to_default": (round(m / ref, 2) if m and ref else None)}
+    return {"dt": cfg.dt, "variant": "modified", "rows": rows,
+            "note": "build_dr_fast in its own process per workcell, after a warm-up; the ratio "
+                    "is of medians from this one run"}
+
+
+def tools_lines(sec: dict[str, Any]) -> list[str]:
+    lines = ["", f"BuiltDR fast with tools and heights (modified, dt = {sec.get('dt')}):",
+             f"{'workcell':>10s} {'median s':>9s} {'peak MiB':>9s} {'x default':>9s}"]
+    for name, r in sec.get("rows", {}).items():
+        if "median_s" in r:
+            lines.append(f"{name:>10s} {r['median_s']:9.3f} {r.get('peak_rss_mb', 0):9.1f} "
+                         f"{r['ratio_to_default'] or 0:9.2f}")
+        else:
+            lines.append(f"{name:>10s} {failed(r)}")
     return lines
 
 
@@ -980,6 +1018,8 @@ def table(res: dict[str, Any]) -> str:
         lines += plan_scaling_lines(res["plan_scaling"])
     if "runs" in (res.get("certify_stream") or {}):
         lines += certify_stream_lines(res["certify_stream"])
+    if "rows" in (res.get("tools") or {}):
+        lines += tools_lines(res["tools"])
     lines += profile_lines(res.get("builtdr_profile"))
     lines.append("")
     lines.append("targets (measured, limit, verdict, what was measured):")
@@ -1045,7 +1085,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent),
                     help="folder for results.json (default: bench/)")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
-    ap.add_argument("--only", choices=["campaign", "plan_scaling", "certify_stream"],
+    ap.add_argument("--only", choices=["campaign", "plan_scaling", "certify_stream", "tools"],
                     default=None,
                     help="run only this item and merge it into OUT/results.json")
     ap.add_argument("--prove", action="store_true",
@@ -1057,7 +1097,8 @@ def main(argv: list[str] | None = None) -> int:
         section, lines = {"campaign": (campaign_section, campaign_lines),
                           "plan_scaling": (plan_scaling_section, plan_scaling_lines),
                           "certify_stream": (certify_stream_section,
-                                             certify_stream_lines)}[args.only]
+                                             certify_stream_lines),
+                          "tools": (tools_section, tools_lines)}[args.only]
         out = Path(args.out) / "results.json"
         res = json.loads(out.read_text()) if out.exists() else {}
         with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:

@@ -18,7 +18,8 @@ from typing import Any
 
 from .errors import InputError
 
-__all__ = ["FILE", "FOLDER", "Budget", "budgets", "check_output", "checked", "cpus",
+__all__ = ["FILE", "FOLDER", "Budget", "budgets", "check_log_output", "check_output", "checked",
+           "cpus",
            "bag_arguments", "engine_arguments", "json_argument", "kernel_argument", "number", "out_argument",
            "output", "positive", "run_checks", "scenario_argument", "trajectory_arguments",
            "variant_argument"]
@@ -31,7 +32,7 @@ def variant(value: str) -> str:
     try:
         return Variant(value).value
     except ValueError:
-        raise argparse.ArgumentTypeError(f"--variant must be one of "
+        raise argparse.ArgumentTypeError(f"must be one of "
                                          f"{', '.join(v.value for v in Variant)}, got {value!r}"
                                          ) from None
 
@@ -46,8 +47,11 @@ def variant_argument(p: argparse.ArgumentParser) -> None:
     """--variant, one of spec.Variant's members (default modified)."""
     from .spec import Variant
 
-    p.add_argument("--variant", type=variant, default="modified",
-                   help=f"{' | '.join(v.value for v in Variant)} (default: modified)")
+    names = [v.value for v in Variant]
+    p.add_argument("--variant", type=variant, default="modified", choices=names,
+                   metavar="{" + ",".join(names) + "}",
+                   help=f"BuiltDR's sweep (docs/model.md §4): {', '.join(names[:-1])} or "
+                        f"{names[-1]} (default: modified)")
 
 
 def kernel_argument(p: argparse.ArgumentParser) -> None:
@@ -204,6 +208,16 @@ def check_output(option: str, value: Any, kind: str) -> None:
         raise refuse(f"cannot be written: {str(here)!r} is a file, not a folder")
     if not os.access(here, os.W_OK | os.X_OK):
         raise refuse(f"cannot be written: this user may not write in the folder {str(here)!r}")
+
+
+def check_log_output(option: str, value: Any) -> None:
+    """InputError for simulate's --out that cannot be written: the kind of log its name asks for
+    (``runs.log_output_kind``: a bag file, a bag folder, CSV), then ``check_output`` as a folder
+    or a file."""
+    from .runs import log_output_kind
+
+    kind = log_output_kind(str(value))
+    check_output(option, value, FOLDER if kind == "folder" else FILE)
 
 
 def engine_arguments(p: argparse.ArgumentParser) -> None:

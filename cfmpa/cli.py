@@ -13,17 +13,50 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from . import __version__
 from . import _arguments as opt
-from .errors import InputError, handled
-from .scenarios import resolve
+from .errors import MISSING, InputError, handled
+from .scenarios import bundled_names
+from .scenarios import resolve as _resolve
 
 __all__ = ["main"]
 
 
 # --- the commands: options -> one run_* call ---------------------------------------------------
+
+
+def resolve(arg: str | Path) -> Path:
+    """The scenario file of ``arg`` (``scenarios.resolve``: a bundled name or a path); a bare
+    name that is neither a file nor a bundled scenario is refused here, pointing to
+    `cfmpa scenarios`, rather than reported as a file that cannot be read."""
+    p = _resolve(arg)
+    if not p.exists() and p.suffix != ".toml" and len(p.parts) == 1:
+        raise InputError("SCENARIO", str(arg), "is neither a file nor a bundled scenario (`cfmpa "
+                         f"scenarios` lists them: {', '.join(bundled_names())})")
+    return p
+
+
+def model_doc() -> Path | None:
+    """docs/model.md, the model the help cites: in an installed wheel the package's copy
+    (cfmpa/docs/model.md, setup.py), in a checkout the checkout's; None when neither exists."""
+    here = Path(__file__).resolve().parent
+    for path in (here / "docs" / "model.md", here.parent / "docs" / "model.md"):
+        if path.is_file():
+            return path
+    return None
+
+
+def cmd_docs(args: argparse.Namespace) -> int:
+    """Print where docs/model.md is (exit 2 when this installation has none)."""
+    path = model_doc()
+    if path is None:
+        raise InputError("docs/model.md", MISSING, "is not installed with this package "
+                         f"({Path(__file__).resolve().parent})")
+    print(path)
+    return 0
 
 
 def cmd_dr(args: argparse.Namespace) -> int:
@@ -35,8 +68,9 @@ def cmd_dr(args: argparse.Namespace) -> int:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy and DIR/plan.json (exit 1 on
-    a violation, the files written all the same as the evidence)."""
+    """Plan: BuiltDR, searchoptpath, certificate; write DIR/dr.npy, DIR/plan.json and, for a
+    found path, DIR/traj.csv (exit 1 on a violation, the files written all the same as the
+    evidence)."""
     from .runs import run_plan
 
     return run_plan(resolve(args.scenario), args.variant, args.out, contracts=args.contracts,
@@ -47,8 +81,6 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     """Check another planner's dr.npy and plan.json against the spec; with --batch DIR, every
     plan folder under DIR, one task each (0 all pass, 1 any fails, 2 bad input)."""
-    from .errors import MISSING
-
     if args.batch is not None:
         from .runs import run_batch
 
@@ -151,7 +183,8 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     from .runs import run_monitor
 
     return run_monitor(resolve(args.scenario), args.traj, args.log, json_out=args.json,
-                       allow_speed=args.allow_speed, max_speed=args.max_speed, bag=_bag(args))
+                       allow_speed=args.allow_speed, max_speed=args.max_speed, bag=_bag(args),
+                       allow_gaps=args.allow_gaps)
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
@@ -205,6 +238,7 @@ a first command:
   cfmpa plan default --out plan    plan the bundled default workcell into the folder plan/
   cfmpa scenarios                  list the bundled workcells (or give a TOML file instead)
   cfmpa COMMAND --help             a command's options and an example
+  cfmpa docs                       print where docs/model.md, which the help cites, is
 
 exit codes:
   0    success (a plan that finds no path is an answer: exit 0)
@@ -245,7 +279,8 @@ def _parser() -> argparse.ArgumentParser:
     opt.out_argument(d, "output folder (dr.npy is written there)")
     opt.kernel_argument(d)
 
-    pl = _command(sub, "plan", "plan the subordinate's path; write dr.npy and plan.json",
+    pl = _command(sub, "plan", "plan the subordinate's path; write dr.npy, plan.json and "
+                               "traj.csv",
                   "cfmpa plan default --out plan", cmd_plan)
     opt.scenario_argument(pl)
     opt.variant_argument(pl)
@@ -329,6 +364,8 @@ def _parser() -> argparse.ArgumentParser:
 
     _command(sub, "scenarios", "list the bundled scenarios and their purposes",
                   "cfmpa scenarios", cmd_scenarios)
+    _command(sub, "docs", "print where docs/model.md (the model the help cites) is installed",
+             "cfmpa docs", cmd_docs)
 
     co = _command(sub, "compare", "original vs modified vs tight on random workcells",
                   "cfmpa compare --n 20 --workers 0 --out build/compare", cmd_compare)
@@ -362,13 +399,19 @@ def _parser() -> argparse.ArgumentParser:
                          "joint (default: the scenario's omega; docs/model.md §12)")
     opt.json_argument(mo)
     opt.bag_arguments(mo)
+    mo.add_argument("--allow-gaps", action="store_true",
+                    help="a --log bag with fewer messages than it declares: monitor the rest, "
+                         "the time of the missing ones unobserved (default: exit 2)")
 
     si = _command(sub, "simulate", "write a simulated measured log of a trajectory",
                   "cfmpa simulate default --traj plan/traj.csv --out log.csv --noise 0.001",
                   cmd_simulate)
     opt.trajectory_arguments(si)
-    opt.out_argument(si, "the log file to write: CSV, or a ROS 2 bag if it ends in .mcap",
-                     metavar="LOG", kind=opt.FILE)
+    si.add_argument("--out", required=True, metavar="LOG",
+                    help="the log to write: a ROS 2 bag for a name ending in .mcap or .db3 (that "
+                         "storage file) or for a folder (a new one ending in /, or a bag "
+                         "folder, replaced: metadata.yaml and an mcap file), else CSV")
+    opt.checked(si, "out", "--out", opt.check_log_output)
     opt.number(si, "--lag", b["lag"], type=float, default=0.0,
                help="tracking lag in s (default 0)")
     opt.number(si, "--noise", b["noise"], type=float, default=0.0,

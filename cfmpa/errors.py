@@ -18,6 +18,8 @@ __all__ = [
     "exit_code",
     "error_text",
     "handled",
+    "one_line",
+    "value_text",
 ]
 
 
@@ -57,7 +59,7 @@ class InputError(CfmpaError):
         if self.source is not None:
             where = f"{self.source}:{self.line}: " if self.line is not None else f"{self.source}: "
         got = "" if self.value is MISSING else f", got {self.value!r}"
-        return f"{where}error: {self.field} {self.message}{got}"
+        return one_line(f"{where}error: {self.field} {self.message}{got}")
 
 
 class ContractViolation(CfmpaError):
@@ -82,6 +84,12 @@ class ContractViolation(CfmpaError):
         lines = [f"{triple}: {condition}"]
         lines += [f"{name} was {value!r}" for name, value in self.values.items()]
         super().__init__("\n".join(lines))
+
+    def one_line(self) -> str:
+        """The violation in one line, as the command line prints it: the triple, the condition,
+        then the values in parentheses (a length named ``*_m`` in mm)."""
+        values = "; ".join(value_text(name, value) for name, value in self.values.items())
+        return one_line(f"{self.triple}: {self.condition}" + (f" ({values})" if values else ""))
 
 
 class CertificateViolation(ContractViolation):
@@ -118,18 +126,46 @@ def exit_code(exc: BaseException) -> int | None:
     return None
 
 
+def one_line(text: str) -> str:
+    """``text`` on one line: its line breaks (a library's multi-line cause) become "; "."""
+    parts = [x.strip() for x in str(text).splitlines() if x.strip()]
+    return "; ".join(parts)
+
+
+def value_text(name: str, value: Any) -> str:
+    """``name was value`` as a person reads it: a number whose name ends in ``_m`` (metres) in
+    mm, one (or a list of them) whose name ends in ``_rad`` in rad with its degrees, under the
+    name without the unit (docs/contributing.md, "Standards")."""
+    import math
+
+    def number(x: Any) -> bool:
+        return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+    if name.endswith("_m") and number(value):
+        return f"{name[:-2]} was {value * 1000:.6g} mm"
+    if name.endswith("_rad") and number(value):
+        return f"{name[:-4]} was {value!r} rad ({math.degrees(value):.4g} deg)"
+    if (name.endswith("_rad") and isinstance(value, (list, tuple)) and value
+            and all(number(x) for x in value)):
+        deg = ", ".join(f"{math.degrees(x):.4g}" for x in value)
+        return f"{name[:-4]} was {list(value)!r} rad ([{deg}] deg)"
+    return f"{name} was {value!r}"
+
+
 def error_text(exc: BaseException) -> str:
     """The one line said on stderr for an exception that ``exit_code`` maps."""
     if isinstance(exc, InputError):
         return exc.render()
+    if isinstance(exc, ContractViolation):
+        return f"error: {exc.one_line()}"
     if isinstance(exc, CfmpaError):
-        return f"error: {exc}"
+        return one_line(f"error: {exc}")
     if isinstance(exc, OSError):
         name = exc.filename if exc.filename is not None else "file"
-        return f"{name}: error: {exc.strerror or exc}"
+        return one_line(f"{name}: error: {exc.strerror or exc}")
     if isinstance(exc, KeyboardInterrupt):
         return "interrupted"
-    return f"error: {exc}"
+    return one_line(f"error: {exc}")
 
 
 def handled(run: Callable[[], int], stderr: TextIO | None = None) -> int:

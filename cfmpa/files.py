@@ -22,9 +22,10 @@ import numpy as np
 
 from .errors import MISSING, InputError
 
-__all__ = ["ECHO_CHARS", "LIMITS", "JsonStyle", "Limit", "bounded_lines", "check_file_size",
-           "dumps_json", "echo", "jsonable", "npy_bytes", "read_bounded", "save_npy_atomic",
-           "write_atomic_with", "write_bytes_atomic", "write_json"]
+__all__ = ["ECHO_CHARS", "LIMITS", "JsonStyle", "Limit", "angle_text", "bounded_lines",
+           "cause_text", "check_file_size", "dumps_json", "echo", "jsonable", "mm_text",
+           "npy_bytes", "read_bounded", "save_npy_atomic", "write_atomic_with",
+           "write_bytes_atomic", "write_json"]
 
 #: An echoed value (a row, a field) longer than this in a message is cut to it.
 ECHO_CHARS = 80
@@ -85,6 +86,27 @@ def echo(value: Any) -> Any:
     repr is the first ECHO_CHARS of it, then ``...``: a 100 MB row is not echoed whole."""
     text = repr(value)
     return value if len(text) <= ECHO_CHARS else _Cut(text[:ECHO_CHARS] + "...")
+
+
+def mm_text(metres: float, digits: int = 6) -> str:
+    """A length as a person reads it (docs/contributing.md, "Standards"): in mm, ``digits``
+    significant digits."""
+    return f"{metres * 1000:.{digits}g} mm"
+
+
+def angle_text(rad: float, digits: int = 6) -> str:
+    """An angle as a person reads it: in rad, with its degrees."""
+    return f"{rad:.{digits}g} rad ({math.degrees(rad):.{min(digits, 4)}g} deg)"
+
+
+def cause_text(exc: BaseException, chars: int = ECHO_CHARS) -> str:
+    """A library's exception as the cause in a one-line message: its type and the first line of
+    its text, cut to ``chars`` characters (a YAML parser's five lines, a 200-digit integer)."""
+    lines = str(exc).strip().splitlines()
+    text = lines[0].strip() if lines else ""
+    if len(text) > chars:
+        text = text[:chars] + "..."
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 def _too_long(source: str | None, line: int) -> InputError:

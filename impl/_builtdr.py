@@ -2,13 +2,16 @@
 
 Read next to the paper: for every layer k, cell (i, j): P[k, i, j] = 0 iff the principal's region
 S_LArm[k] and the subordinate's region S_RArm[i][j] are apart (distance > eps), else 1. The loops
-over i and j are vectorised; the loop over k and the links is written out.
+over i and j are vectorised; the loop over k and the links is written out. A region is one per
+part (link 1, link 2, the tool if any); only pairs of parts whose heights overlap are tested
+(``spec.pairs_to_test``, docs/model.md §2 "Tools and heights").
 """
 
 from __future__ import annotations
 
 import hashlib
 from collections.abc import Callable, Sequence
+from typing import Any
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -16,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..spec import (EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid,
-                    rest_box)
+                    pairs_to_test, parts, rest_box)
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._kinematics import link_rectangles
 from ._regions import Angles, Box, Polygon, convex_hull, swept_lattice, swept_points
@@ -42,18 +45,25 @@ DR = npt.NDArray[np.uint8]  # (N + 1, m, n)
 
 @dataclass(frozen=True)
 class LeftRegions:
-    """The principal's region per layer: ``links[k] = (link 1, link 2)``, k = 0..N (N: rest)."""
+    """The principal's region per layer: ``links[k] = (link 1, link 2[, tool])``, k = 0..N (N:
+    rest), a polygon per part (``spec.parts``)."""
 
     variant: Variant
-    links: tuple[tuple[Polygon, Polygon], ...]
+    links: tuple[tuple[Polygon, ...], ...]
 
 
 @dataclass(frozen=True)
 class RightRegions:
-    """The subordinate's regions: link 1 per i (m, V, 2); link 2 per (i, j) (m, n, V, 2)."""
+    """The subordinate's regions: link 1 per i (m, V, 2); link 2 per (i, j) (m, n, V, 2); the
+    tool's per (i, j) (m, n, V, 2), or None without a tool."""
 
     link1: npt.NDArray[np.float64]
     link2: npt.NDArray[np.float64]
+    tool: npt.NDArray[np.float64] | None = None
+
+    def per_cell(self) -> list[npt.NDArray[np.float64]]:
+        """The regions that depend on the cell, in part order: link 2, then the tool if any."""
+        return [self.link2] if self.tool is None else [self.link2, self.tool]
 
 
 def left_spacing(s: Scenario) -> tuple[float, float]:
@@ -84,13 +94,13 @@ def left_regions_by(hull: Callable[[npt.NDArray[np.float64]], Polygon], s: Scena
     for k in range(g.N):
         box = left_box(s, v, k)
         anchor = left_angles(s, k * s.dt)
-        out.append(tuple(region(link, box, anchor) for link in (0, 1)))
+        out.append(tuple(region(link, box, anchor) for link in parts(s.left)))
     if v.rest_at_goal:
         goal = tuple(s.left.goal)
-        out.append(tuple(region(link, rest_box(s, v, g.N), goal) for link in (0, 1)))
+        out.append(tuple(region(link, rest_box(s, v, g.N), goal) for link in parts(s.left)))
     else:
         out.append(out[-1])
-    return LeftRegions(variant=v, links=tuple(out))  # type: ignore[arg-type]
+    return LeftRegions(variant=v, links=tuple(out))
 
 
 def _rotate(poly: npt.NDArray[np.float64], angles: npt.NDArray[np.float64],
@@ -116,40 +126,55 @@ def right_regions(s: Scenario, grid: Grid | None = None, *, margin_scale: float 
                                        margin_scale=margin_scale))
 
 
-def rotate_row(s: Scenario, g: Grid, link1: Polygon, link2: npt.NDArray[np.float64]
-               ) -> RightRegions:
+def rotate_row(s: Scenario, g: Grid, link1: Polygon, link2: npt.NDArray[np.float64],
+               tool: npt.NDArray[np.float64] | None = None) -> RightRegions:
     """right_row's regions turned by every t_i about the subordinate's base."""
     t_i = np.asarray(g.angle(0, np.arange(g.m)), dtype=float)
     return RightRegions(link1=_rotate(link1, t_i, s.right.base),
-                        link2=_rotate(link2, t_i, s.right.base))
+                        link2=_rotate(link2, t_i, s.right.base),
+                        tool=None if tool is None else _rotate(tool, t_i, s.right.base))
 
 
 def right_row(s: Scenario, g: Grid,
               hulls: Callable[[list[npt.NDArray[np.float64]]], Sequence[Polygon]], *,
-              margin_scale: float = 1.0) -> tuple[Polygon, npt.NDArray[np.float64]]:
-    """The subordinate's regions at t_i = 0, base at the origin: link 1 (V, 2) and link 2 per j
-    (n, V, 2), padded; ``hulls`` takes the convex hull of each point set (as convex_hull)."""
+              margin_scale: float = 1.0
+              ) -> tuple[Polygon, npt.NDArray[np.float64], npt.NDArray[np.float64] | None]:
+    """The subordinate's regions at t_i = 0, base at the origin: link 1 (V, 2), link 2 per j
+    (n, V, 2), padded, and the tool's per j likewise (None without a tool); ``hulls`` takes the
+    convex hull of each point set (as convex_hull)."""
     arm = s.right
     origin = type(arm)(**{**arm.__dict__, "base": (0.0, 0.0)})
     h1, h2 = g.h
     t_j = np.asarray(g.angle(1, np.arange(g.n)), dtype=float)
     points = [swept_points(origin, 0, ((-h1, h1), (0.0, 0.0)), (0.0, 0.0), (h1, h2),
                            margin_scale=margin_scale)]
-    # Link 2's rectangles for all j in one call per lattice shape and margin (elementwise the
-    # same operations as one call per j, so the same doubles).
-    lattices = [swept_lattice(origin, 1, ((-h1, h1), (tj - h2, tj + h2)), (0.0, tj), (h1, h2),
+    per_cell = [p for p in parts(arm) if p > 0]
+    for part in per_cell:
+        points += _row_points(origin, part, t_j, (h1, h2), margin_scale)
+    polys = hulls(points)
+    n = len(t_j)
+    out = [pad_polygons(list(polys[1 + c * n:1 + (c + 1) * n])) for c in range(len(per_cell))]
+    return polys[0], out[0], out[1] if len(out) > 1 else None
+
+
+def _row_points(origin: Any, part: int, t_j: npt.NDArray[np.float64], h: tuple[float, float],
+                margin_scale: float) -> list[npt.NDArray[np.float64]]:
+    """The points of the part's region per j at t_i = 0 (link 2's or the tool's), in one call
+    per lattice shape and margin (elementwise the same operations as one call per j, so the
+    same doubles)."""
+    h1, h2 = h
+    lattices = [swept_lattice(origin, part, ((-h1, h1), (tj - h2, tj + h2)), (0.0, tj), (h1, h2),
                               margin_scale=margin_scale) for tj in t_j]
     groups: dict[tuple[tuple[int, ...], float], list[int]] = {}
     for j, (t1, _, grow) in enumerate(lattices):
         groups.setdefault((t1.shape, grow), []).append(j)
-    link2: list[npt.NDArray[np.float64]] = [np.empty(0)] * len(lattices)
+    out: list[npt.NDArray[np.float64]] = [np.empty(0)] * len(lattices)
     for (_, grow), js in groups.items():
         corners = link_rectangles(origin, np.stack([lattices[j][0] for j in js]),
-                                  np.stack([lattices[j][1] for j in js]), 1, grow=grow)
+                                  np.stack([lattices[j][1] for j in js]), part, grow=grow)
         for j, c in zip(js, corners):
-            link2[j] = c.reshape(-1, 2)
-    polys = hulls(points + link2)
-    return polys[0], pad_polygons(list(polys[1:]))
+            out[j] = c.reshape(-1, 2)
+    return out
 
 
 def build_dr(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,
@@ -159,14 +184,17 @@ def build_dr(s: Scenario, variant: Variant | str, grid: Grid | None = None, *,
     rr = right or right_regions(s, g, margin_scale=margin_scale)
     left = left_regions(s, variant, g, margin_scale=margin_scale)
     m, n = g.m, g.n
-    set1 = PolygonSet.of(rr.link1)
-    set2 = PolygonSet.of(rr.link2.reshape(m * n, *rr.link2.shape[2:]))
+    sets = [PolygonSet.of(rr.link1)] + [PolygonSet.of(r.reshape(m * n, *r.shape[2:]))
+                                        for r in rr.per_cell()]
+    pairs = pairs_to_test(s.left, s.right)               # the parts whose heights overlap
     P = np.zeros(g.shape, dtype=np.uint8)
-    for k, (a1, a2) in enumerate(left.links):            # For all k = 0 to N (N: rest layer)
+    for k, regions in enumerate(left.links):             # For all k = 0 to N (N: rest layer)
         blocked = np.zeros((m, n), dtype=bool)
-        for a in (a1, a2):                                # S_LArm[k] = link 1 ∪ link 2
-            blocked |= blocked_against(a, set1, eps)[:, None]
-            blocked |= blocked_against(a, set2, eps).reshape(m, n)
+        for a, b in pairs:                                # S_LArm[k] = the union of its parts
+            if b == 0:
+                blocked |= blocked_against(regions[a], sets[0], eps)[:, None]
+            else:
+                blocked |= blocked_against(regions[a], sets[b], eps).reshape(m, n)
         P[k] = blocked                                    # if S_LArm ∩ S_RArm = Φ then 0 else 1
     return P
 
@@ -215,6 +243,9 @@ def containment_slack(inner: Polygon, outer: Polygon) -> float:
     return float(-out.max())
 
 
+_PART = {0: "link 1", 1: "link 2", 2: "tool"}
+
+
 def check_containment(s: Scenario, grid: Grid | None = None) -> ContainmentReport:
     """Check region_tight within region_modified within region_original at every layer and R."""
     g = grid or make_grid(s)
@@ -223,14 +254,14 @@ def check_containment(s: Scenario, grid: Grid | None = None) -> ContainmentRepor
     where = ""
     outside = []
     for k in range(g.N + 1):
-        for link in (0, 1):
+        for link in parts(s.left):
             for inner, outer in ((Variant.TIGHT, Variant.MODIFIED), (Variant.MODIFIED, Variant.ORIGINAL)):
                 a, b = regs[inner].links[k][link], regs[outer].links[k][link]
                 sl = containment_slack(a, b)
                 if sl < worst:
-                    worst, where = sl, f"layer {k} link {link + 1}: {inner} within {outer}"
+                    worst, where = sl, f"layer {k} {_PART[link]}: {inner} within {outer}"
                 if not contained_exactly(a, b):
-                    outside.append(f"layer {k} link {link + 1}: {inner} not within {outer}")
+                    outside.append(f"layer {k} {_PART[link]}: {inner} not within {outer}")
     ok = not outside
     digest = hashlib.sha256()
     for v in Variant:
@@ -238,7 +269,7 @@ def check_containment(s: Scenario, grid: Grid | None = None) -> ContainmentRepor
             for poly in pair:
                 digest.update(poly.tobytes())
     layer_word = "rest layer" if where.startswith(f"layer {g.N} ") else "layer"
-    detail = (f"{g.N} layers and the rest layer, both links, decided exactly on the doubles; "
+    detail = (f"{g.N} layers and the rest layer, every part, decided exactly on the doubles; "
               + (f"{len(outside)} not contained, first {outside[0]}; " if outside else "")
               + f"least slack {worst:.3e} m at {where} ({layer_word})")
     return ContainmentReport(ok=ok, layers=g.N + 1, worst_slack_m=float(worst), detail=detail,

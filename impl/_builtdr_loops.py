@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..spec import EPS, Grid, Scenario, Variant, make_grid
+from ..spec import EPS, Grid, Scenario, Variant, make_grid, pairs_to_test
 from ._builtdr import DR, left_regions, right_regions
 from ._collide import PolygonSet, blocked_against
 
@@ -61,7 +61,8 @@ def build_dr_loops(s: Scenario, variant: Variant | str, grid: Grid | None = None
     rr = right_regions(s, g)
     m, n = g.m, g.n
     set1 = PolygonSet.of(rr.link1)
-    set2 = PolygonSet.of(rr.link2.reshape(m * n, *rr.link2.shape[2:]))
+    per_cell = [PolygonSet.of(r.reshape(m * n, *r.shape[2:])) for r in rr.per_cell()]
+    pairs = pairs_to_test(s.left, s.right)
 
     def region_left(k: int) -> tuple[Any, ...]:
         return left.links[k]
@@ -69,12 +70,13 @@ def build_dr_loops(s: Scenario, variant: Variant | str, grid: Grid | None = None
     def region_rest() -> tuple[Any, ...]:
         return left.links[g.N]
 
-    def region_right(i: int, j: int) -> tuple[PolygonSet, PolygonSet]:
-        return set1.take(np.array([i])), set2.take(np.array([i * n + j]))
+    def region_right(i: int, j: int) -> tuple[PolygonSet, ...]:
+        return (set1.take(np.array([i])), *(r.take(np.array([i * n + j])) for r in per_cell))
 
-    def inter(a: tuple[Any, ...], b: tuple[PolygonSet, PolygonSet]) -> bool:
-        # Blocked iff some left link is within eps of some right link (not "distance > eps").
-        return any(bool(blocked_against(poly, part, eps)[0]) for poly in a for part in b)
+    def inter(a: tuple[Any, ...], b: tuple[PolygonSet, ...]) -> bool:
+        # Blocked iff some left part is within eps of some right part whose heights overlap
+        # it (not "distance > eps").
+        return any(bool(blocked_against(a[p], b[q], eps)[0]) for p, q in pairs)
 
     P = np.full(g.shape, 2, dtype=np.uint8)        # 2: never stored (the tests look for it)
     SL: dict[int, Any] = {}

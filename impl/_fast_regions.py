@@ -49,13 +49,15 @@ def left_regions_fast(s: Scenario, variant: Variant | str, grid: Grid | None = N
 def right_regions_fast(s: Scenario, grid: Grid | None = None) -> RightRegions:
     """``right_regions(s, grid)``, the same arrays."""
     g = grid or make_grid(s)
-    link1, link2 = right_row(s, g, convex_hulls)
+    link1, link2, tool = right_row(s, g, convex_hulls)
     t_i = np.asarray(g.angle(0, np.arange(g.m)), dtype=float)
     # _rotate's cosines and sines, of the same array; then its products and sums, compiled.
     c, sn = np.cos(t_i), np.sin(t_i)
     bx, by = (float(v) for v in s.right.base)
     one = parallel(_turn, np.ascontiguousarray(link1[None]), c, sn, bx, by)[:, 0]
-    return RightRegions(link1=one, link2=parallel(_turn, np.ascontiguousarray(link2), c, sn, bx, by))
+    return RightRegions(
+        link1=one, link2=parallel(_turn, np.ascontiguousarray(link2), c, sn, bx, by),
+        tool=None if tool is None else parallel(_turn, np.ascontiguousarray(tool), c, sn, bx, by))
 
 
 # ---------------------------------------------------------------- compiled kernel (numba) ----

@@ -14,7 +14,7 @@ KERNELS: tuple[str, ...] = ("fast", "reference")
 def kernels(name: str = "fast") -> tuple[Callable[..., Any], Callable[..., Any]]:
     """(build, search) of the kernel called ``name``; ValueError for another name. The kernels
     are imported here, not with KERNELS: every command's parser lists KERNELS, and the fast
-    ones load numba (issue 24.6)."""
+    ones load numba (a command imports only what it needs: tests/test_startup.py)."""
     from ._builtdr import build_dr
     from ._fast_builtdr import build_dr_fast
     from ._fast_search import search_opt_path_fast

@@ -1,4 +1,5 @@
-"""Link rectangles for arrays of configurations (docs/model.md §2), vectorised over leading axes."""
+"""Link rectangles and tool polygons for arrays of configurations (docs/model.md §2), vectorised
+over leading axes. Part 0 is link 1, part 1 link 2, part 2 the tool (fixed in link 2's frame)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy.typing as npt
 
 from ..spec import Arm
 
-__all__ = ["link_rectangles", "link_reach"]
+__all__ = ["link_rectangles", "link_reach", "part_polygons"]
 
 FloatArray = npt.NDArray[np.float64]  # shapes noted per function: (...,) angles, (..., 4, 2) corners
 
@@ -25,6 +26,8 @@ def link_rectangles(arm: Arm, theta1: FloatArray, theta2: FloatArray, link: int,
     base = np.asarray(arm.base, dtype=float)
     u1 = np.stack([np.cos(t1), np.sin(t1)], axis=-1)
     elbow = base + arm.links[0] * u1
+    if link == 2:
+        return part_polygons(arm, t1, t2, elbow, grow)
     if link == 0:
         start, along, length = np.broadcast_to(base, elbow.shape), u1, arm.links[0]
     else:
@@ -38,10 +41,36 @@ def link_rectangles(arm: Arm, theta1: FloatArray, theta2: FloatArray, link: int,
                     axis=-2)
 
 
+def part_polygons(arm: Arm, t1: FloatArray, t2: FloatArray, elbow: FloatArray, grow: float
+                  ) -> FloatArray:
+    """The tool's points (..., V, 2) at each configuration (its vertices, counter-clockwise), or
+    with ``grow`` > 0 (..., 4 V, 2): each vertex moved by +-grow along the forearm and its normal,
+    whose hull contains the tool's Minkowski sum with a disc of radius ``grow``."""
+    if arm.tool is None:
+        raise ValueError("the arm has no tool (part 3)")
+    t12 = t1 + t2
+    along = np.stack([np.cos(t12), np.sin(t12)], axis=-1)
+    normal = np.stack([-along[..., 1], along[..., 0]], axis=-1)
+    wrist = elbow + arm.links[1] * along
+    local = np.asarray(arm.tool.polygon, dtype=float)                 # (V, 2), forearm frame
+    if grow > 0:
+        square = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]) * grow
+        local = (local[:, None, :] + square[None]).reshape(-1, 2)
+    x, y = local[:, 0], local[:, 1]
+    return (wrist[..., None, :] + x[:, None] * along[..., None, :]
+            + y[:, None] * normal[..., None, :])
+
+
 def link_reach(arm: Arm, link: int) -> tuple[float, float]:
-    """(R_base, R_elbow): bounds on any point of the link's distance from the base and the elbow."""
+    """(R_base, R_elbow): bounds on any point of the part's distance from the base and the
+    elbow (the tool's: its farthest vertex, docs/model.md §2)."""
     r = arm.width / 2.0
     l1, l2 = arm.links
+    if link == 2:
+        if arm.tool is None:
+            raise ValueError("the arm has no tool (part 3)")
+        far_tool = max(float(np.hypot(l2 + x, y)) for x, y in arm.tool.polygon)
+        return l1 + far_tool, far_tool
     if link == 0:
         return float(np.hypot(l1 + r, r)), 0.0
     far = float(np.hypot(l2 + r, r))

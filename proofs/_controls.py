@@ -40,9 +40,9 @@ import numpy as np
 import z3
 
 from ..scenarios import SELFCHECK_WORKCELLS
-from ..spec import (J1, J2, MOVES, SearchResult, SearchStatus, Witness, arm_corners, certify,
+from ..spec import (J1, J2, MOVES, SearchResult, SearchStatus, Witness, certify,
                     check_witness, dr_cell_failures, is_path, left_angles, make_grid,
-                    parse_scenario, path_violations, polygon_distance)
+                    parse_scenario, path_violations, pose_distance)
 
 __all__ = ["Control", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS", "checker_controls",
            "collect_controls", "premise_controls", "run_control"]
@@ -212,11 +212,10 @@ def _contact() -> tuple[str, str]:
     s, g = c.scenario, c.grid
     m, n = c.dr.shape[1], c.dr.shape[2]
     for k in range(c.dr.shape[0] - 1):
-        left = arm_corners(s.left, tuple(left_angles(s, k * s.dt)))
+        left = tuple(left_angles(s, k * s.dt))
         for i in range(m):
             for j in range(n):
-                right = arm_corners(s.right, g.angles((i, j)))
-                if min(polygon_distance(a, b) for a in left for b in right) == 0.0:
+                if pose_distance(s, left, g.angles((i, j))) == 0.0:
                     path = [(i, j)] * (k + 1)
                     cert = certify(s, g, path)
                     if cert.clear:

@@ -1,5 +1,5 @@
 """The constants the certificate, the tolerance tube and the ball-arithmetic gaps rest on, each
-proved as the code computes it (issue 21 item 5; docs/model.md §2, §7.2, §12).
+proved as the code computes it (docs/model.md §2, §7.2, §12).
 
 Every formula here is the spec's own function run on Z3 terms, never re-written: ``spec.reach``
 (the links' reach R_base, R_elbow), ``spec.link_speeds`` (a link point's speed bound),

@@ -123,8 +123,8 @@ FIXED_IDS: tuple[str, ...] = tuple(EXPECTED_VERDICTS)
 
 #: The bundled scenario files (stems) of ``BUNDLED_DIR``: their checks are expected by name, so
 #: a deleted file is a missing id, not a quietly shorter run. Every scenario check must prove.
-BUNDLED_SCENARIOS: tuple[str, ...] = ("default", "early-arrival", "limited-joints",
-                                      "narrow-gap", "original-fails")
+BUNDLED_SCENARIOS: tuple[str, ...] = ("default", "early-arrival", "gripper", "levels",
+                                      "limited-joints", "narrow-gap", "original-fails")
 
 
 def is_bundled(scenarios_dir: str | Path) -> bool:

@@ -41,7 +41,7 @@ from ..scenarios import BUNDLED_DIR
 from ..impl import left_regions
 from ..runs import Campaign, load_campaign, run_campaign
 from ..spec import (Scenario, SearchStatus, Variant, certify_trajectory, executed_trajectory,
-                    load_scenario, tolerance_rad, tube_lipschitz)
+                    load_scenario, theorem_scope, tolerance_rad, tube_lipschitz)
 from . import _figures as F
 from ._compare import campaign_json, format_campaign
 from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
@@ -250,14 +250,20 @@ def _template_source(name: str) -> str:
     return resources.files("cfmpa.report").joinpath(name).read_text(encoding="utf-8")
 
 
-def render_html(result: AuditResult) -> str:
-    """The self-contained HTML page (CSS inline, pictures as data URIs, no external URL): the
-    page's frame, then each section's template in the order of the result's sections."""
+def template_env() -> jinja2.Environment:
+    """The Jinja environment the page and each section's template are rendered in."""
     env = jinja2.Environment(autoescape=jinja2.select_autoescape(["html"], default=True),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True,
                              loader=jinja2.FunctionLoader(lambda n: _template_source(n)))
     env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, s3=_s3, anchor=_anchor)
+    return env
+
+
+def render_html(result: AuditResult) -> str:
+    """The self-contained HTML page (CSS inline, pictures as data URIs, no external URL): the
+    page's frame, then each section's template in the order of the result's sections."""
+    env = template_env()
     ob = result.doc["obligations"]
     by_id = {r["id"]: r for r in ob["items"]}
     cards = [{**g, "rows": [by_id[i] for i in g["ids"]]} for g in ob["cards"]]
@@ -363,14 +369,18 @@ _NO_PATH_ASSUMPTIONS = ("A1", "A2")
 def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list[dict[str, Any]]:
     """Section 1: a row per (workcell, variant) with its status, the proved clearance (the
     certificate's lower bound, mm; None unless clear), the least sampled clearance (mm, an upper
-    bound on the true minimum), the tolerance in rad, degrees and mm at the tool tip (delta
-    times L, the largest R_base + R_elbow: the most a deviation of delta in every joint moves a
-    link point), the ledger ids it rests on, its verdict and why.
+    bound on the true minimum), the tolerance in rad, degrees and mm at the farthest point of
+    either arm (delta times L, the largest R_base + R_elbow over both arms' parts, the tool tip
+    where there is a tool: the most a deviation of delta in every joint moves any point), the
+    ledger ids it rests on, its verdict and why, and ``scope``: ``spec.theorem_scope``, what the
+    safety theorem does not yet cover of the workcell (a tool, heights), or None.
 
     ``ok`` is True for a found plan certified clear with no contract violation and none of its
     obligations (the Safety.* of its variant, Tolerance.tube, its workcell's checks) other than
     expected; False for a plan not certified clear, a violation or such an obligation; None for
-    "no path" (nothing moves, so nothing is claimed safe)."""
+    "no path" (nothing moves, so nothing is claimed safe). A row that would be "safe" but whose
+    workcell the safety theorem does not yet cover (``scope``) is "certified" instead: certified
+    clear and checked, not proved (docs/model.md §8, §10)."""
     from ..proofs import ASSUMPTIONS
 
     ledger = {a.id.split(".")[0]: a.id for a in ASSUMPTIONS}
@@ -380,6 +390,7 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
     for s, entry in zip(loaded, doc["scenarios"]):
         stem = Path(s.source).stem
         reach = tube_lipschitz(s)
+        scope = theorem_scope(s)
         for v in entry["variants"]:
             name = v["variant"]
             related = [i for k, i in verdicts.items()
@@ -419,7 +430,11 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
                            "as expected" + (f" (not: {', '.join(wrong)})" if wrong else ""))
             else:
                 why.append("its obligations not in this run's proof data")
+            if scope is not None:
+                why.insert(0, scope)
             found = v["status"] == "found" and tol is not None
+            verdict = {True: "safe" if scope is None else "certified", False: "FAILED",
+                       None: "no plan"}[ok]
             rows.append({
                 "scenario": entry["name"], "variant": name, "status": v["status"],
                 "lower_bound_mm": 1000 * cl["lower_bound_m"] if cl and cl["clear"] else None,
@@ -429,7 +444,7 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
                 "tolerance_tip_mm": 1000 * reach * tol if found else None,
                 "reach_m_per_rad": reach,
                 "assumptions": [ledger[a] for a in needs if a in ledger],
-                "ok": ok, "verdict": {True: "safe", False: "FAILED", None: "no plan"}[ok],
+                "ok": ok, "verdict": verdict, "scope": scope,
                 "why": "; ".join(why),
             })
     return rows

@@ -27,7 +27,8 @@ from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch, Polygon as MplPolygon, Rectangle  # noqa: E402
 
-from ..spec import Grid, Scenario, Variant, arm_corners, left_angles  # noqa: E402
+from ..spec import (TOOL, Grid, Scenario, Variant, arm_parts, left_angles, part_height,  # noqa: E402
+                    parts, reach)
 from ._findings import (EarlyArrivalData, InconsistencyData, NaiveHullData, Prop8Data,  # noqa: E402
                         right_angles_at)
 from ._stats import wilson_interval  # noqa: E402
@@ -130,9 +131,11 @@ def legend_overlaps(fig: Any) -> list[str]:
 
 def _draw_arm(ax: Any, arm: Any, theta: Sequence[float], color: str, *, alpha: float = 0.55,
               lw: float = 1.0, ls: str = "-", fill: bool = True, label: str | None = None) -> None:
-    for k, rect in enumerate(arm_corners(arm, (float(theta[0]), float(theta[1])))):
+    for k, rect in enumerate(arm_parts(arm, (float(theta[0]), float(theta[1])))):
+        # The tool (part 3) hatched, so that it reads apart from the forearm it is fixed to.
         ax.add_patch(MplPolygon(rect, closed=True, facecolor=color if fill else "none",
                                 edgecolor=color, alpha=alpha if fill else 1.0, lw=lw, ls=ls,
+                                hatch="////" if k == TOOL else None,
                                 label=label if k == 0 else None))
     ax.plot(*arm.base, marker="o", color="black", ms=3, zorder=5)
 
@@ -148,8 +151,17 @@ def _draw_poly(ax: Any, poly: npt.ArrayLike, color: str, *, alpha: float = 0.25,
 
 
 def _reach(arm: Any) -> float:
-    """Farthest point of the arm from its base (m)."""
-    return math.hypot(arm.links[0] + arm.links[1] + arm.width / 2, arm.width / 2)
+    """Farthest point of the arm (its tool included) from its base (m)."""
+    return max(reach(arm, p)[0] for p in parts(arm))
+
+
+def heights_text(arm: Any) -> str:
+    """The arm's height intervals for a legend: " (z: link 1 0.40-0.46 m, tool 0.22-0.36 m)",
+    or "" for a planar arm (no part has a height)."""
+    names = {0: "link 1", 1: "link 2", TOOL: "tool"}
+    got = [(names[p], part_height(arm, p)) for p in parts(arm)]
+    words = [f"{n} {z[0]:.2f}-{z[1]:.2f} m" for n, z in got if z is not None]
+    return f" (z: {', '.join(words)})" if words else ""
 
 
 def _shared_zone(s: Scenario) -> Any:
@@ -195,8 +207,8 @@ def _motion_bounds(ax: Any, s: Scenario, g: Grid, cells: npt.NDArray[np.int64], 
     """Axes limits around everything both arms cover during the motion (equal aspect)."""
     t = np.linspace(0.0, t_end, 60)
     la, ra = left_angles(s, t), right_angles_at(g, cells, t)
-    pts = [np.asarray(r) for th in la for r in arm_corners(s.left, (th[0], th[1]))]
-    pts += [np.asarray(r) for th in ra for r in arm_corners(s.right, (th[0], th[1]))]
+    pts = [np.asarray(r) for th in la for r in arm_parts(s.left, (th[0], th[1]))]
+    pts += [np.asarray(r) for th in ra for r in arm_parts(s.right, (th[0], th[1]))]
     _zoom(ax, pts, pad=0.05)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
@@ -259,9 +271,10 @@ def workcell_figure(fid: str, s: Scenario, g: Grid, path: Sequence[Sequence[int]
             _zone(ax, s)
             if path:
                 _tip_traces(ax, s, g, path)
-            _draw_arm(ax, s.left, left_angles(s, t), LEFT_COLOR, label="principal (left)")
+            _draw_arm(ax, s.left, left_angles(s, t), LEFT_COLOR,
+                      label="principal (left)" + heights_text(s.left))
             _draw_arm(ax, s.right, right_angles_at(g, cells, np.array([t]))[0], RIGHT_COLOR,
-                      label="subordinate (right)")
+                      label="subordinate (right)" + heights_text(s.right))
             _motion_bounds(ax, s, g, cells, t_end)
             when = ("start" if t == 0 else "principal arrives (Tf)" if abs(t - g.Tf) < 1e-12
                     else "subordinate arrives" if abs(t - t_end) < 1e-12 and path
@@ -292,7 +305,9 @@ def workcell_figure(fid: str, s: Scenario, g: Grid, path: Sequence[Sequence[int]
                  f"({variant.value} variant): four spread over the principal's motion up to "
                  f"Tf = {g.Tf:.3f} s"
                  + (", then the end of the subordinate's motion" if t_end > g.Tf + s.dt / 2
-                    else "") + "; shaded: where both arms can reach; dashed: the tips' paths.",
+                    else "") + "; shaded: where both arms can reach; dashed: the tips' paths"
+                 + ("" if not any(a.tool is not None for a in (s.left, s.right)) else
+                    " (the wrists, where the tools are fixed); hatched: the tools") + ".",
                  f"Workcell of {s.name} with both arms at {len(times)} instants")
 
 

@@ -19,7 +19,7 @@ import shapely
 
 from ..impl import link_rectangles, left_regions, naive_hull, right_regions, swept_region
 from ..spec import (EPS, Grid, Scenario, Variant, certify, is_path_paper, left_angles, left_box,
-                    path_violations, polygon_distance, polygon_distances)
+                    path_violations, polygon_distance, trajectory_distances)
 
 __all__ = [
     "Finding",
@@ -347,7 +347,9 @@ def _straight(a: Cell, b: Cell) -> list[Cell]:
 
 def sample_clearance(s: Scenario, g: Grid, path: Any, per_step: int = 16
                      ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Times and the arms' distance (m) along the executed motion (docs/model.md §7), ``per_step`` per dt.
+    """Times and the arms' distance (m) along the executed motion (docs/model.md §7), ``per_step``
+    per dt: the least over every pair of parts, tools and heights included
+    (``spec.trajectory_distances``, the certificate's own distances).
 
     A picture, not a proof: the certificate bounds the distance between samples.
     """
@@ -356,15 +358,8 @@ def sample_clearance(s: Scenario, g: Grid, path: Any, per_step: int = 16
     steps = max(1, math.ceil(t_end / s.dt - 1e-12))
     t = np.linspace(0.0, steps * s.dt, steps * per_step + 1)
     t = t[t <= t_end + 1e-12]
-    right = right_angles_at(g, cells, t)
-    left = left_angles(s, t)
-    d = np.full(len(t), np.inf)
-    for a in (0, 1):
-        ra = link_rectangles(s.left, left[:, 0], left[:, 1], a)
-        for b in (0, 1):
-            rb = link_rectangles(s.right, right[:, 0], right[:, 1], b)
-            d = np.minimum(d, polygon_distances(ra, rb))
-    return t, d
+    angles = np.concatenate([left_angles(s, t), right_angles_at(g, cells, t)], axis=1)
+    return t, trajectory_distances(s, angles).min(axis=(1, 2))
 
 
 def _pair(a: Any) -> tuple[float, float]:

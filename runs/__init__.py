@@ -48,12 +48,14 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
                         versions, write_plan)
     from ._bundled import run_scenarios
     from ._trajectory_runs import (AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, BLOCK_ROWS, MAX_LOG_SAMPLES,
-                                   MIN_PERIOD_S, LISTED_UNOBSERVED, Excursion, MonitorResult,
+                                   MIN_PERIOD_S, LISTED_UNOBSERVED, MISSING_MESSAGES, Excursion,
+                                   MonitorResult,
                                    Unobserved, certify_json, log_csv, monitor_json, monitor_log,
                                    monitor_rows, parse_excursion, parse_max_speed, run_certify, run_monitor,
                                    run_simulate, simulate_log)
-    from ._rosbag import (DEFAULT_TOPIC, JOINT_STATE, BagOptions, bag_rows, bag_sha256, is_bag,
-                          load_bag_trajectory, parse_joints, write_bag)
+    from ._rosbag import (DEFAULT_TOPIC, JOINT_STATE, LOG_KINDS, BagOptions, BagReading,
+                          bag_rows, bag_sha256, is_bag, load_bag_trajectory, log_output_kind,
+                          parse_joints, write_bag)
     from ._code_mutants import (CODE_CHECKS, CODE_MUTANTS, CodeMutant, CodeRow,
                                 code_mutation_rows, code_mutation_table, imports_copy, mutated_copy,
                                 run_code_selftest)
@@ -124,6 +126,7 @@ _EXPORTS: dict[str, str] = {
     "MAX_LOG_SAMPLES": "._trajectory_runs:MAX_LOG_SAMPLES",
     "MIN_PERIOD_S": "._trajectory_runs:MIN_PERIOD_S",
     "LISTED_UNOBSERVED": "._trajectory_runs:LISTED_UNOBSERVED",
+    "MISSING_MESSAGES": "._trajectory_runs:MISSING_MESSAGES",
     "Excursion": "._trajectory_runs:Excursion",
     "MonitorResult": "._trajectory_runs:MonitorResult",
     "Unobserved": "._trajectory_runs:Unobserved",
@@ -141,6 +144,9 @@ _EXPORTS: dict[str, str] = {
     "DEFAULT_TOPIC": "._rosbag:DEFAULT_TOPIC",
     "JOINT_STATE": "._rosbag:JOINT_STATE",
     "BagOptions": "._rosbag:BagOptions",
+    "BagReading": "._rosbag:BagReading",
+    "LOG_KINDS": "._rosbag:LOG_KINDS",
+    "log_output_kind": "._rosbag:log_output_kind",
     "bag_rows": "._rosbag:bag_rows",
     "bag_sha256": "._rosbag:bag_sha256",
     "is_bag": "._rosbag:is_bag",
@@ -186,7 +192,8 @@ __all__ = [
     "open_store",
     "plan_workcell", "random_workcell", "read_store", "run_campaign", "workcell_task",
     # any planner's trajectory (docs/model.md §12)
-    "AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "LISTED_UNOBSERVED", "Unobserved",
+    "AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "LISTED_UNOBSERVED", "MISSING_MESSAGES",
+    "Unobserved",
     "parse_max_speed",
     "BLOCK_ROWS", "Excursion", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult",
     "certify_json", "log_csv", "monitor_json",
@@ -194,7 +201,8 @@ __all__ = [
     "simulate_log", "monitor_rows",
     # ROS 2 bags as trajectories and logs (docs/model.md §12)
     "BagOptions", "DEFAULT_TOPIC", "JOINT_STATE", "bag_rows", "bag_sha256", "is_bag",
-    "load_bag_trajectory", "parse_joints", "write_bag",
+    "load_bag_trajectory", "parse_joints", "write_bag", "BagReading", "LOG_KINDS",
+    "log_output_kind",
     # seeded faults
     "FAULTS", "Fault", "SAMPLE", "SelftestRow", "WORKCELLS", "run_fault", "run_selftest",
     "selftest_rows", "selftest_table", "workcell",

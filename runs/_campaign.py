@@ -44,8 +44,8 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..errors import CfmpaError, InputError, WorkersLost
-from ..spec import (EPS, Scenario, SearchStatus, Variant, arm_corners, certify, make_grid,
-                    parse_scenario, polygon_distance)
+from ..spec import (EPS, Scenario, SearchStatus, Variant, certify, make_grid,
+                    parse_scenario, pose_distance)
 from ._limits import MAX_DT, MAX_WORKCELLS
 from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
                       error_message)
@@ -448,12 +448,11 @@ def _kernels() -> tuple[Any, Any]:
 def _draw_cell(rng: np.random.Generator, s: Scenario, g: Any, left_pose: list[float]
                ) -> tuple[tuple[int, int], bool]:
     """A uniformly drawn cell whose pose is apart from the principal at ``left_pose``."""
-    left = arm_corners(s.left, (left_pose[0], left_pose[1]))
+    left = (left_pose[0], left_pose[1])
     cell = (0, 0)
     for _ in range(MAX_DRAWS):
         cell = (int(rng.integers(g.m)), int(rng.integers(g.n)))
-        right = arm_corners(s.right, g.angles(cell))
-        if min(polygon_distance(a, b) for a in left for b in right) > EPS:
+        if pose_distance(s, left, g.angles(cell)) > EPS:
             return cell, True
     return cell, False
 

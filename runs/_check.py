@@ -26,7 +26,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, ContractViolation, InputError
-from ..files import LIMITS, read_bounded
+from ..errors import value_text
+from ..files import LIMITS, mm_text, read_bounded
 from ..spec import Grid, Scenario, Variant, load_scenario, make_grid
 from ..spec import certify, require_clear
 from ..spec import SearchResult, SearchStatus
@@ -56,11 +57,14 @@ class PlanDoc:
 
 @dataclass(frozen=True)
 class CheckLine:
-    """One line of the listing: ``ok``, ``FAIL`` or ``skip``, what, and the values if it failed."""
+    """One line of the listing: ``ok``, ``FAIL`` or ``skip``, what, and the values if it failed;
+    ``follows``: for a failure that follows from an earlier one, that one's ``what`` (its
+    condition), which the listing names."""
 
     status: str
     what: str
     values: tuple[tuple[str, Any], ...] = ()
+    follows: str | None = None
 
 
 @dataclass(frozen=True)
@@ -80,11 +84,16 @@ class CheckReport:
     def text(self) -> str:
         out = []
         for line in self.lines:
-            out.append(f"{line.status:<5} {line.what}")
-            out += [f"      {name} was {value!r}" for name, value in line.values]
+            follows = "" if line.follows is None else (
+                f" (follows from the failed {line.follows} above)")
+            out.append(f"{line.status:<5} {line.what}{follows}")
+            out += [f"      {value_text(name, value)}" for name, value in line.values]
         n = len(self.failed)
+        derived = sum(x.follows is not None for x in self.failed)
         out.append("result: all checks hold" if n == 0 else
-                   f"result: {n} of {sum(x.status != 'skip' for x in self.lines)} checks failed")
+                   f"result: {n} of {sum(x.status != 'skip' for x in self.lines)} checks failed"
+                   + (f", {derived} of them following from an earlier failure" if derived
+                      else ""))
         return "\n".join(out)
 
 
@@ -252,15 +261,53 @@ def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc, *,
         try:
             require_clear(cert, name=CERTIFICATE)
             lines.append(CheckLine("ok", f"{CERTIFICATE}: clear, proved lower bound "
-                                   f"{cert.lower_bound_m:.6g} m at every instant; sampled "
-                                   f"minimum {cert.min_clearance_m:.6g} m at t = "
+                                   f"{mm_text(cert.lower_bound_m)} at every instant; sampled "
+                                   f"minimum {mm_text(cert.min_clearance_m)} at t = "
                                    f"{cert.t_min_s:.6g} s ({cert.intervals} intervals)"))
         except ContractViolation as exc:
             lines.append(CheckLine("FAIL", f"{exc.triple}: {exc.condition}",
                                    tuple(exc.values.items())))
     elif found:
         lines.append(CheckLine("skip", f"{CERTIFICATE}: the path leaves the grid"))
-    return CheckReport(tuple(lines))
+    return CheckReport(_consequences(lines))
+
+
+#: A failed condition that follows from another's failure: the condition (its suffix in the
+#: listing's ``what``) -> the conditions it follows from, the first failed one named. D_R that
+#: fails post.cells fails searchoptpath's pre.dr.spec (the same check); a path judged against
+#: such a D_R may be blocked in it (is_path's ``blocked`` clause), and optimality is then judged
+#: against it too (docs/model.md §7.3).
+FOLLOWS: dict[str, tuple[str, ...]] = {
+    "pre.dr.spec": ("post.cells",),
+    "post.is_path": ("post.cells",),
+    "post.optimal": ("post.is_path", "post.cells"),
+}
+
+
+def _condition(line: CheckLine) -> str | None:
+    """The contract condition a line reports (``Theorem 4 post.is_path: ...`` ->
+    ``post.is_path``), or None for another check."""
+    head = line.what.split(":", 1)[0].split()
+    return head[-1] if head and head[-1].startswith(("pre.", "post.")) else None
+
+
+def _consequences(lines: list[CheckLine]) -> tuple[CheckLine, ...]:
+    """``lines`` with each failure that follows from an earlier failure (``FOLLOWS``) marked;
+    an is_path failure follows from a bad D_R only when its clause is ``blocked`` (a jump or a
+    wrong end is the path's own)."""
+    failed: dict[str, str] = {}                   # condition -> the what of its first failure
+    out = []
+    for line in lines:
+        cond = _condition(line)
+        if line.status == "FAIL" and cond is not None:
+            values = dict(line.values)
+            own = cond == "post.is_path" and values.get("clause", "blocked") != "blocked"
+            cause = next((failed[c] for c in FOLLOWS.get(cond, ()) if c in failed), None)
+            if cause is not None and not own:
+                line = CheckLine(line.status, line.what, line.values, follows=cause)
+            failed.setdefault(cond, line.what.split(":", 1)[0])
+        out.append(line)
+    return tuple(out)
 
 
 def _run_lines(run: TripleRun) -> list[CheckLine]:

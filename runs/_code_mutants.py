@@ -73,7 +73,7 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "impl/_builtdr.py",
                (("    for k in range(g.N):\n        box = left_box(s, v, k)\n",
                  "    for k in range(g.N - 1):\n        box = left_box(s, v, k)\n"),)),
-    # --- issue 21 item 9, the witness checker's conditions (helper h21c) ---
+    # --- the witness checker's conditions (docs/model.md §7.3, §11) ---
     CodeMutant("witness_edge_loosened", "the witness checker's edge bound loosened by one "
                "(label[s'] <= label[s] + cost + 1)", "spec/_witness.py",
                (("    return target_key <= bound\n", "    return target_key <= bound + 1\n"),)),
@@ -81,7 +81,7 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "inequality (the path's cost >= the least goal label)", "spec/_witness.py",
                (("    return (cost[0] == least[0]) & (cost[1] == least[1])\n",
                  "    return (cost[0] >= least[0]) & (cost[1] >= least[1])\n"),)),
-    # --- issue 21 item 9: faults in what the safety theorem reads ---
+    # --- faults in what the safety theorem reads (docs/model.md §7.3, §10) ---
     CodeMutant("modified_box_half_step", "the modified variant's layer box covers half its time "
                "step (a + s omega dt / 2)", "spec/_grid.py",
                (("    end = a + if_then(up, 1.0, -1.0) * step\n",
@@ -97,7 +97,7 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "proofs/_obl_safety.py",
                (("         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N, in_box(theta_l, box_k)),\n",
                  "         z3.And([z3.Implies(z3.And(0 <= k, k < at.d.N),\n"),)),
-    # --- issue 21 items 5, 9: the certificate's, the tube's and the ball gap's constants
+    # --- the certificate's, the tube's and the ball gap's constants (docs/model.md §7.3)
     # (proofs/_obl_constants.py; each caught by its obligation under --repin) ---
     CodeMutant("link_speed_halved", "the certificate's link speed bound halved "
      "(0.5 (|w1| R_base + |w2| R_elbow))", "spec/_certificate.py",
@@ -122,8 +122,8 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
        "    if not cert.clear or cert.lower_bound_m <= 0.0:\n"),)),
     CodeMutant("tube_lipschitz_left_only", "the tube's L taken over the principal's links only",
      "spec/_trajectory.py",
-     (("    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in (0, 1))\n",
-       "    return max(sum(reach(arm, link)) for arm in (s.left,) for link in (0, 1))\n"),)),
+     (("    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in parts(arm))\n",
+       "    return max(sum(reach(arm, link)) for arm in (s.left,) for link in parts(arm))\n"),)),
     CodeMutant("gap_without_norm", "the ball-arithmetic gap not divided by |n|", "spec/_exact.py",
      (("    return (lo_b - hi_a) / sqrt_of(nx * nx + ny * ny)\n",
        "    return lo_b - hi_a\n"),)),

@@ -30,7 +30,7 @@ from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
 from ..spec import Certificate, certificate_json, certify, contact_links_text, require_clear
 from ..spec import SearchResult, SearchStatus
 from ..spec import executed_trajectory, tolerance_rad, trajectory_csv
-from ..spec import ExactGaps, exact_path_gaps, save_npz
+from ..spec import ExactGaps, exact_path_gaps, save_npz, theorem_scope
 from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
                          checked_search, contracts_json, violation_json)
 
@@ -90,7 +90,7 @@ def versions() -> dict[str, str]:
 
 def z3_version() -> str:
     """``z3.get_version_string()`` (major.minor.build) without importing Z3, which `cfmpa plan`
-    does not otherwise need (issue 24.6): the z3-solver distribution's version is
+    does not otherwise need (tests/test_startup.py): the z3-solver distribution's version is
     major.minor.build.revision. Imports Z3 only when that metadata is missing."""
     from importlib import metadata
 
@@ -278,6 +278,9 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
         "tolerance_rad": (tolerance_rad(p.scenario, p.certificate)
                           if p.certificate is not None else None),
         "exact_gaps": p.exact.as_json() if p.exact is not None else None,
+        # What the safety theorem does not yet cover here (docs/model.md §10): null, or e.g.
+        # "tool: checked on samples and by the certificate, not yet by the safety theorem".
+        "theorem_scope": theorem_scope(p.scenario),
         "contracts": p.contracts,
         "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
         "versions": versions(),
@@ -385,12 +388,17 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
         print(f"status    {r.status}: {r.reason}", file=so)
     if p.certificate is not None:
         print(clearance_line(p.certificate), file=so)
+    scope = theorem_scope(s)
+    if scope is not None:
+        print(f"scope     {scope}", file=so)
     print(f"contracts {p.settings.mode.value}: {p.checked} checks, {len(violations)} violations",
           file=so)
     print("time      " + "  ".join(f"{k} {v:.3f} s" for k, v in t.items()), file=so)
-    print(f"wrote     {dr_path}, {plan_path}" + (f", {witness}" if witness else ""), file=so)
+    written = [dr_path, plan_path] + ([Path(out) / TRAJ_CSV] if r.status is SearchStatus.FOUND
+                                      else []) + ([Path(witness)] if witness else [])
+    print(f"wrote     {', '.join(str(x) for x in written)}", file=so)
     for v in violations:
-        print(f"violation {v}", file=se)
+        print(f"violation {v.one_line()}", file=se)
     if violations:
         print(f"result    {len(violations)} violation(s): exit 1; the files above are written as "
               f"the evidence", file=se)

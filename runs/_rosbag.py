@@ -12,6 +12,12 @@ is read in bounded memory (a trajectory, which the certificate needs whole, is b
 CSV one). A sample's ``line`` is the one it has in the CSV of the same samples (message k on the
 topic, 1-based, is line k + 1 under the header), so the JSON of `cfmpa monitor` is the same for
 a bag and for its CSV; messages to the user say "message k".
+
+The count read is checked against the count the bag declares on the topic (its metadata.yaml,
+or a bare file's mcap summary): a storage file can lose a message silently (rosbags skips a
+record whose opcode or time a corrupt byte changed). A shortfall is bad input naming both counts;
+with ``allow_gaps`` (monitor --allow-gaps) the log is monitored all the same and the time of
+each missing message is unobserved (``BagReading``), placed by the mcap's message index.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ import sqlite3
 import struct
 import tempfile
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
 from typing import Any
@@ -32,11 +38,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
-from ..files import LIMITS, echo
+from ..files import LIMITS, cause_text, echo
 from ..spec import TRAJECTORY_COLUMNS, Scenario, Trajectory, parse_trajectory_csv
 
-__all__ = ["BagOptions", "DEFAULT_TOPIC", "JOINT_STATE", "bag_rows", "bag_sha256", "is_bag",
-           "load_bag_trajectory", "parse_joints", "write_bag"]
+__all__ = ["BagOptions", "BagReading", "DEFAULT_TOPIC", "JOINT_STATE", "LOG_KINDS", "bag_rows",
+           "bag_sha256", "is_bag", "load_bag_trajectory", "log_output_kind", "parse_joints",
+           "write_bag"]
 
 #: The message type read and written.
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -47,6 +54,32 @@ BAG_SUFFIXES = (".mcap", ".db3")
 JOINTS = TRAJECTORY_COLUMNS[1:]
 FloatArray = npt.NDArray[np.float64]
 NS = 1_000_000_000
+
+
+@dataclass
+class BagReading:
+    """What reading a bag's topic found, filled in as it is read: the count it declares and
+    the count read, the first message's stamp and t0 (ns; ``t0_given``: from --t0) and, with
+    ``allow_gaps``, where declared messages were not read: ``gaps_before`` the lines (k + 1) of
+    the samples a missing message precedes, ``missing_first`` one before the first sample,
+    ``missing_last`` after the last, ``unplaced`` those whose place is unknown (no message
+    index: sqlite3 storage)."""
+
+    topic: str = ""
+    declared: int = 0
+    read: int = 0
+    first_ns: int | None = None
+    t0_ns: int | None = None
+    t0_given: bool = False
+    gaps_before: set[int] = field(default_factory=set)
+    missing_first: bool = False
+    missing_last: bool = False
+    unplaced: int = 0
+
+    @property
+    def missing(self) -> int:
+        """Declared messages not read."""
+        return max(0, self.declared - self.read)
 
 
 @dataclass(frozen=True)
@@ -82,24 +115,27 @@ def _stamp_ns(sec: int, nanosec: int) -> int:
     return int(sec) * NS + int(nanosec)
 
 
-def _seconds_ns(t: float, up: bool = False) -> int:
-    """Seconds as nanoseconds (the nearest, or with ``up`` the next at or above), from the
-    decimal the float prints as (``--t0 1700000000.25`` is exact in ns, which a float product
-    would not be)."""
-    d = Decimal(repr(float(t))).scaleb(9)
-    return int(d.to_integral_value(rounding="ROUND_CEILING")) if up else int(round(d))
+def _seconds_ns(t: float) -> int:
+    """Seconds as the nearest nanoseconds, from the decimal the float prints as
+    (``--t0 1700000000.25`` is exact in ns, which a float product would not be)."""
+    return int(round(Decimal(repr(float(t))).scaleb(9)))
 
 
 def _joint_indices(names: Sequence[str], joints: Sequence[str], where: str,
                    source: str) -> list[int]:
     """The index in the message's ``names`` of each of ``joints``, by name; InputError naming a
-    joint the message lacks."""
+    joint the message lacks or names twice (which position would be its?)."""
     index = {n: i for i, n in enumerate(names)}
     out = []
     for j in joints:
         if j not in index:
             raise InputError("--joints", j, f"is not a joint name of {where} (its names: "
                              f"{echo(list(names))})", source=source)
+        twice = [i for i, n in enumerate(names) if n == j]
+        if len(twice) > 1:
+            raise InputError(f"joint {j!r}", MISSING, f"is named twice in {where} (at positions "
+                             f"{twice[0]} and {twice[1]} of its {len(names)} names)",
+                             source=source)
         out.append(index[j])
     return out
 
@@ -112,24 +148,31 @@ def _reader(path: Path, option: str, source: str) -> Any:
         reader = Reader(path)
         reader.open()
     except FileNotFoundError as exc:
-        raise InputError(option, str(path), f"is not a ROS 2 bag ({exc})", source=source) from None
-    # rosbags 0.11.0 lets sqlite3's own error through for a .db3 that is no database.
+        raise InputError(option, str(path), f"is not a ROS 2 bag ({cause_text(exc)})",
+                         source=source) from None
+    # rosbags 0.11.0 lets sqlite3's own error through for a .db3 that is no database; a YAML
+    # error of a corrupt metadata.yaml is several lines (cause_text keeps its first).
     except (ReaderError, OSError, ValueError, KeyError, TypeError, EOFError, struct.error,
-            sqlite3.Error) as exc:
-        raise InputError(option, str(path), f"is not a readable ROS 2 bag ({exc})",
+            OverflowError, sqlite3.Error) as exc:
+        raise InputError(option, str(path), f"is not a readable ROS 2 bag ({cause_text(exc)})",
                          source=source) from None
     return reader
 
 
-def _samples(path: str | os.PathLike[str], opts: BagOptions, option: str
+def _samples(path: str | os.PathLike[str], opts: BagOptions, option: str,
+             reading: BagReading | None = None, *, allow_gaps: bool = False
              ) -> Iterator[tuple[int, FloatArray]]:
     """(message number, row (5,) in COLUMNS order) for each JointState on the topic, streamed;
     InputError for a topic the bag lacks or that carries another type, a message that cannot be
-    decoded or lacks a joint, a non-finite value, or stamps that do not increase."""
+    decoded, lacks a joint or names one twice, a non-finite value, stamps that do not increase,
+    or (after the last message) fewer messages read than the bag declares on the topic, unless
+    ``allow_gaps``: then ``reading`` records where they are missing (``BagReading``)."""
     from rosbags.typesys import Stores, get_typestore
 
     p = Path(path)
     source = str(p)
+    info = BagReading(topic=opts.topic) if reading is None else reading
+    info.topic = opts.topic
     reader = _reader(p, option, source)
     try:
         conns = [c for c in reader.connections if c.topic == opts.topic]
@@ -141,25 +184,46 @@ def _samples(path: str | os.PathLike[str], opts: BagOptions, option: str
             if c.msgtype != JOINT_STATE:
                 raise InputError("--topic", opts.topic, f"carries {c.msgtype}, not "
                                  f"{JOINT_STATE}", source=source)
+        info.declared = sum(int(c.msgcount) for c in conns)
+        # Where declared messages are missing, by their receive times in the mcap's message
+        # index (only with allow_gaps: 8 bytes a message).
+        declared_times = _declared_log_times(p, opts.topic) if allow_gaps else None
+        at = 0                                  # declared_times[:at] are accounted for
+        placed = 0
         store = get_typestore(Stores.ROS2_HUMBLE)
         t0 = None if opts.t0 is None else _seconds_ns(opts.t0)
+        info.t0_given = t0 is not None
         prev_ns: int | None = None
         names: Sequence[str] | None = None
         idx: list[int] = []
         k = 0
         try:
             messages = reader.messages(connections=conns)
-            for conn, _, raw in messages:
+            for conn, log_time, raw in messages:
                 k += 1
+                info.read = k
                 where = f"message {k} on {opts.topic}"
+                if declared_times is not None:
+                    before = int(np.searchsorted(declared_times, log_time, side="left")) - at
+                    if before > 0:                  # declared earlier, never read
+                        if k == 1:
+                            info.missing_first = True
+                        else:
+                            info.gaps_before.add(k + 1)
+                        placed += before
+                        at += before
+                    if at < len(declared_times) and declared_times[at] == log_time:
+                        at += 1
                 try:
                     msg: Any = store.deserialize_cdr(raw, conn.msgtype)
                 except Exception as exc:    # rosbags raises many kinds on a corrupt payload
                     raise InputError(where, MISSING, f"cannot be decoded as {JOINT_STATE} "
-                                     f"({type(exc).__name__}: {exc})", source=source) from None
+                                     f"({cause_text(exc)})", source=source) from None
                 ns = _stamp_ns(msg.header.stamp.sec, msg.header.stamp.nanosec)
                 if t0 is None:
                     t0 = ns
+                if info.first_ns is None:
+                    info.first_ns, info.t0_ns = ns, t0
                 if prev_ns is not None and ns <= prev_ns:
                     raise InputError("header.stamp", ns / NS, f"of {where} must be later than "
                                      f"the previous message's {prev_ns / NS!r} s (times strictly "
@@ -183,23 +247,121 @@ def _samples(path: str | os.PathLike[str], opts: BagOptions, option: str
         except InputError:
             raise
         except Exception as exc:            # a storage file cut short or corrupt mid-way
-            raise InputError(option, source, f"cannot be read past message {k} on "
-                             f"{opts.topic} ({type(exc).__name__}: {exc})",
-                             source=source) from None
+            where = f"past message {k}" if k else "at its first message"
+            raise InputError(option, MISSING, f"cannot be read {where} on {opts.topic} "
+                             f"({cause_text(exc)})", source=source) from None
         if k == 0:
-            raise InputError("--topic", opts.topic, "has no messages in the bag",
-                             source=source)
+            raise InputError("--topic", opts.topic, "has no messages in the bag" + (
+                f" that can be read (it declares {info.declared:,})" if info.declared else ""),
+                source=source)
+        if info.missing:
+            if not allow_gaps:
+                hint = (" (--allow-gaps monitors the rest, the time of the missing ones "
+                        "unobserved)" if option == "--log" else "")
+                raise InputError(option, MISSING, f"has {k:,} messages on {opts.topic} that can "
+                                 f"be read, of the {info.declared:,} the bag declares "
+                                 f"({_declared_where(p)}): {info.missing:,} skipped or lost"
+                                 + hint, source=source)
+            if declared_times is not None and at < len(declared_times):
+                info.missing_last = True
+                placed += len(declared_times) - at
+            info.unplaced = max(0, info.missing - placed)
     finally:
         reader.close()
 
 
+def _declared_where(p: Path) -> str:
+    """Where a bag declares its counts, as the message says it."""
+    return "its metadata.yaml" if p.is_dir() else (
+        "its mcap summary" if p.suffix.lower() == ".mcap" else "its messages table")
+
+
+#: mcap's magic, and the opcodes of the records the message index is read from (mcap spec).
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+OP_FOOTER, OP_CHANNEL, OP_MESSAGE_INDEX, OP_CHUNK_INDEX = 0x02, 0x04, 0x07, 0x08
+
+
+def _declared_log_times(p: Path, topic: str) -> npt.NDArray[np.int64] | None:
+    """The receive times (ns) of every message the bag's mcap message indexes declare on
+    ``topic``, sorted; None when there is no such index (sqlite3 storage, an unchunked or
+    unindexed mcap, or one whose index cannot be read)."""
+    files = sorted(p.glob("*.mcap")) if p.is_dir() else [p]
+    if not files or any(f.suffix.lower() != ".mcap" for f in files):
+        return None
+    times: list[int] = []
+    try:
+        for f in files:
+            got = _mcap_log_times(f, topic)
+            if got is None:
+                return None
+            times += got
+    except (OSError, struct.error, ValueError, IndexError):
+        return None
+    return np.sort(np.asarray(times, dtype=np.int64))
+
+
+def _mcap_log_times(f: Path, topic: str) -> list[int] | None:
+    """The log times of ``topic``'s messages by one mcap file's summary (its channels and chunk
+    indexes) and the message index records they point to; None without them."""
+    def record(fh: Any) -> tuple[int, bytes]:
+        op, length = struct.unpack("<BQ", fh.read(9))
+        return op, fh.read(length)
+
+    def string(buf: bytes, at: int) -> tuple[str, int]:
+        (n,) = struct.unpack_from("<I", buf, at)
+        return buf[at + 4:at + 4 + n].decode("utf-8", "replace"), at + 4 + n
+
+    with open(f, "rb") as fh:
+        fh.seek(-(len(MCAP_MAGIC) + 29), os.SEEK_END)
+        op, body = record(fh)
+        if op != OP_FOOTER or fh.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+            return None
+        summary_start, _, _ = struct.unpack("<QQI", body)
+        if not summary_start:
+            return None
+        fh.seek(summary_start)
+        channels: set[int] = set()
+        index_offsets: list[tuple[int, int]] = []
+        indexed = False
+        while True:
+            op, body = record(fh)
+            if op == OP_FOOTER:
+                break
+            if op == OP_CHANNEL:
+                cid, _ = struct.unpack_from("<HH", body, 0)
+                name, _ = string(body, 4)
+                if name == topic:
+                    channels.add(cid)
+            elif op == OP_CHUNK_INDEX:
+                indexed = True
+                (size,) = struct.unpack_from("<I", body, 32)
+                for at in range(36, 36 + size, 10):
+                    cid, offset = struct.unpack_from("<HQ", body, at)
+                    index_offsets.append((cid, offset))
+        if not indexed:
+            return None
+        times: list[int] = []
+        for cid, offset in index_offsets:
+            if cid not in channels:
+                continue
+            fh.seek(offset)
+            op, body = record(fh)
+            if op != OP_MESSAGE_INDEX:
+                return None
+            (size,) = struct.unpack_from("<I", body, 2)
+            times += [x[0] for x in struct.iter_unpack("<QQ", body[6:6 + size])]
+        return times
+
+
 def bag_rows(path: str | os.PathLike[str], opts: BagOptions, *, block_rows: int,
-             option: str = "--log") -> Iterator[tuple[int, FloatArray]]:
+             option: str = "--log", reading: BagReading | None = None,
+             allow_gaps: bool = False) -> Iterator[tuple[int, FloatArray]]:
     """The bag's samples in blocks: (the first sample's line, rows (K, 5) in COLUMNS order),
-    at most ``block_rows`` rows each (message k stands at line k + 1, as in its CSV)."""
+    at most ``block_rows`` rows each (message k stands at line k + 1, as in its CSV).
+    ``reading`` is filled in as they are read (a block's gaps before it is handed on)."""
     block: list[FloatArray] = []
     first = 0
-    for k, row in _samples(path, opts, option):
+    for k, row in _samples(path, opts, option, reading, allow_gaps=allow_gaps):
         if not block:
             first = k + 1
         block.append(row)
@@ -213,8 +375,9 @@ def bag_rows(path: str | os.PathLike[str], opts: BagOptions, *, block_rows: int,
 def load_bag_trajectory(path: str | os.PathLike[str], s: Scenario, opts: BagOptions, *,
                         allow_speed: bool = False) -> Trajectory:
     """A trajectory from a bag, read and validated as the CSV of the same samples is
-    (``spec.parse_trajectory_csv``: message k is row k, at line k + 1); at most as many rows as
-    a CSV within LIMITS["trajectory"] can hold (10 bytes a row at the least)."""
+    (``spec.parse_trajectory_csv``: message k is row k, named "message k on TOPIC", no line
+    of the binary bag); at most as many rows as a CSV within LIMITS["trajectory"] can hold
+    (10 bytes a row at the least); every message the bag declares must be read."""
     cap = LIMITS["trajectory"].value() // 10
 
     def lines() -> Iterator[str]:
@@ -227,7 +390,8 @@ def load_bag_trajectory(path: str | os.PathLike[str], s: Scenario, opts: BagOpti
                                  f"{lim.words(lim.value())} can hold)", source=str(path))
             yield ",".join(repr(float(x)) for x in row)     # repr: the same doubles back
 
-    return parse_trajectory_csv(lines(), s, source=str(path), allow_speed=allow_speed)
+    return parse_trajectory_csv(lines(), s, source=str(path), allow_speed=allow_speed,
+                                name_row=lambda k: f"message {k} on {opts.topic}")
 
 
 def bag_sha256(path: str | os.PathLike[str]) -> str:
@@ -245,18 +409,53 @@ def bag_sha256(path: str | os.PathLike[str]) -> str:
     return h.hexdigest()
 
 
+#: How `cfmpa simulate --out` writes its log, by ``log_output_kind``.
+LOG_KINDS = ("csv", "mcap", "db3", "folder")
+
+
+def log_output_kind(path: str | os.PathLike[str]) -> str:
+    """How a log is written to ``path`` (one of LOG_KINDS): a bag for a name ending in .mcap or
+    .db3 (that storage file alone) or for a folder (the rosbag2 layout, metadata.yaml beside an
+    mcap file): a bag folder (replaced), or a path ending in / that is new or an empty folder;
+    CSV otherwise. InputError for any other folder, and for a path ending in / that is a file
+    (a log never replaces those)."""
+    text = os.fspath(path)
+    p = Path(text)
+    slash = text.endswith(("/", os.sep))
+    if p.suffix.lower() in BAG_SUFFIXES and not slash:
+        return p.suffix.lower()[1:]
+    if p.is_dir():
+        if (p / "metadata.yaml").is_file() or (slash and not any(p.iterdir())):
+            return "folder"
+        if slash:
+            raise InputError("--out", text, "is a folder that is not a ROS 2 bag (no "
+                             "metadata.yaml, and not empty): give a new folder for a bag, or a "
+                             "file (.mcap or .db3 for a bag, any other name for CSV)")
+        raise InputError("--out", text, "is a folder, not a file (and no ROS 2 bag: end a new "
+                         "or empty folder's name in / to write a bag folder there)")
+    if slash:
+        if p.exists():
+            raise InputError("--out", text, "ends in / but is a file, not a folder")
+        return "folder"
+    return "csv"
+
+
 def write_bag(path: str | os.PathLike[str], t: FloatArray, angles: FloatArray,
-              opts: BagOptions = BagOptions()) -> Path:
-    """Write samples (t (N,), angles (N, 4) in JOINTS order) as one .mcap file of JointState
-    messages on ``opts.topic``, joints named ``opts.joints``, header.stamp = t to the nearest ns
-    (the last one rounded up) and the same as the bag's receive time. Atomic: built in a
-    temporary folder beside ``path``, then renamed onto it."""
+              opts: BagOptions = BagOptions(), kind: str | None = None) -> Path:
+    """Write samples (t (N,), angles (N, 4) in JOINTS order) as JointState messages on
+    ``opts.topic``, joints named ``opts.joints``, header.stamp = t to the nearest ns (and the
+    same as the bag's receive time): one .mcap or .db3 file, or a rosbag2 folder, by ``kind``
+    (``log_output_kind`` of ``path`` when None). Atomic: built in a temporary folder beside
+    ``path``, then renamed onto it (a bag folder it replaces is moved aside first, then
+    deleted)."""
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
     target = Path(path)
-    if target.suffix.lower() != ".mcap":
-        raise InputError("--out", str(target), "must end in .mcap to be written as a bag")
+    kind = log_output_kind(path) if kind is None else kind
+    if kind not in LOG_KINDS[1:]:
+        raise InputError("--out", str(target), "must end in .mcap or .db3, or name a folder, to "
+                         "be written as a bag")
     store = get_typestore(Stores.ROS2_HUMBLE)
     js = store.types[JOINT_STATE]
     header = store.types["std_msgs/msg/Header"]
@@ -264,23 +463,30 @@ def write_bag(path: str | os.PathLike[str], t: FloatArray, angles: FloatArray,
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
     try:
-        folder = tmp / "bag"
+        folder = tmp / (target.name if kind == "folder" else "bag")
         empty = np.zeros(0)
-        with Writer(folder, version=8, storage_plugin=StoragePlugin.MCAP) as w:
+        plugin = StoragePlugin.SQLITE3 if kind == "db3" else StoragePlugin.MCAP
+        with Writer(folder, version=8, storage_plugin=plugin) as w:
             conn = w.add_connection(opts.topic, JOINT_STATE, typestore=store)
-            last = len(t) - 1
-            for k, (tk, ak) in enumerate(zip(t.tolist(), np.asarray(angles, dtype=float))):
-                # The last stamp rounded up: a log that reaches the trajectory's end still does
-                # (one stopping short of it is unobserved there, docs/model.md §12).
-                ns = _seconds_ns(tk, up=k == last)
+            for tk, ak in zip(t.tolist(), np.asarray(angles, dtype=float)):
+                # To the nearest ns: a log whose last stamp falls short of the trajectory's end
+                # is covered there by the bound from its last sample (docs/model.md §12).
+                ns = _seconds_ns(tk)
                 sec, nanosec = divmod(ns, NS)
                 msg = js(header=header(stamp=stamp(sec=sec, nanosec=nanosec), frame_id=""),
                          name=list(opts.joints), position=np.array(ak, dtype=float),
                          velocity=empty, effort=empty)
                 w.write(conn, max(ns, 0), store.serialize_cdr(msg, JOINT_STATE))
-        inner = folder / "bag.mcap"            # rosbags names the file after its folder
-        os.chmod(inner, 0o644)
-        os.replace(inner, target)
+        for f in [folder, *folder.rglob("*")]:
+            os.chmod(f, 0o755 if f.is_dir() else 0o644)
+        if kind == "folder":
+            old = tmp / "replaced"
+            if target.exists():
+                os.replace(target, old)
+            os.replace(folder, target)
+        else:
+            # rosbags names the storage file after its folder
+            os.replace(folder / f"bag.{kind}", target)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return target

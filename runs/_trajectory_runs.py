@@ -25,16 +25,19 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
-from ..files import bounded_lines, dumps_json, echo, write_bytes_atomic
-from ._rosbag import BagOptions, bag_rows, bag_sha256, is_bag, load_bag_trajectory, write_bag
+from ..files import angle_text, bounded_lines, dumps_json, echo, write_bytes_atomic
+from ._rosbag import (BagOptions, BagReading, bag_rows, bag_sha256, is_bag, load_bag_trajectory,
+                      log_output_kind, write_bag)
 from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
                     TrajectorySummary, between_samples_bound, certify_trajectory,
-                    certify_trajectory_file, closest_links, contact_links_text, csv_column_order,
-                    load_scenario, load_trajectory, tolerance_rad, trajectory_distances,
-                    tube_lipschitz)
+                    certify_trajectory_file, closest_links, contact_links_text, contact_parts,
+                    csv_column_order,
+                    load_scenario, load_trajectory, log_end_bound, tolerance_rad,
+                    trajectory_distances, tube_lipschitz)
 
 __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
-           "LISTED_UNOBSERVED", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MonitorResult", "Unobserved",
+           "LISTED_UNOBSERVED", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MISSING_MESSAGES",
+           "MonitorResult", "Unobserved",
            "certify_json", "log_csv", "monitor_json", "monitor_log", "monitor_rows",
            "parse_excursion", "parse_max_speed", "run_certify", "run_monitor", "run_simulate", "simulate_log"]
 
@@ -91,6 +94,7 @@ def certify_json(s: Scenario, traj: Trajectory | TrajectorySummary, cert: Certif
         k = d.step
         rows = info.contact_rows
         contact = {"t_s": d.t_s, "links": list(d.links), "links_text": contact_links_text(d.links),
+                   "parts": contact_parts(d.links),
                    "left_angles_rad": list(d.left_angles_rad),
                    "right_angles_rad": list(d.right_angles_rad),
                    "row": None if k is None else k,
@@ -107,6 +111,10 @@ def certify_json(s: Scenario, traj: Trajectory | TrajectorySummary, cert: Certif
         "min_m": cert.min_clearance_m,
         "t_s": cert.t_min_s,
         "tolerance_rad": tolerance_rad(s, cert),
+        # The same in degrees, and what it allows in mm: the most a deviation of tolerance_rad
+        # in every joint moves the farthest point of either arm (L tolerance_rad).
+        "tolerance_deg": math.degrees(tolerance_rad(s, cert)),
+        "tolerance_farthest_point_mm": 1000 * tube_lipschitz(s) * tolerance_rad(s, cert),
         "tube_lipschitz_m_per_rad": tube_lipschitz(s),
         "intervals": cert.intervals,
         "samples": cert.samples,
@@ -147,8 +155,10 @@ def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
     if cert.clear:
         print(f"clearance clear: proved >= {cert.lower_bound_m * 1000:.6g} mm at every instant; "
               f"{sampled}")
-        print(f"tolerance {doc['tolerance_rad']:.6f} rad (max norm over the four joints; "
-              f"L = {doc['tube_lipschitz_m_per_rad']:.6g} m/rad)")
+        print(f"tolerance {doc['tolerance_rad']:.6f} rad ({doc['tolerance_deg']:.4g} deg) in "
+              f"every joint (max norm), moving the farthest point of either arm by at most "
+              f"{doc['tolerance_farthest_point_mm']:.3g} mm (L = "
+              f"{doc['tube_lipschitz_m_per_rad']:.6g} m/rad)")
     elif doc["contact"] is not None:
         c = doc["contact"]
         where = "" if c["line"] is None else f" (line {c['line']})"
@@ -172,6 +182,8 @@ LISTED_UNOBSERVED = 20
 BEFORE_LOG = "before the log's first sample"
 BETWEEN_SAMPLES = "between samples, the bound exceeds the tolerance"
 AFTER_LOG = "after the log's last sample"
+#: ... and where a message the bag declares was not read (monitor --allow-gaps).
+MISSING_MESSAGES = "a message the bag declares was not read"
 
 
 @dataclass(frozen=True)
@@ -211,6 +223,7 @@ class MonitorResult:
     unobserved: list[Unobserved] = field(default_factory=list)
     longest_unobserved: Unobserved | None = None
     max_speed_rad_s: tuple[float, ...] = ()
+    missing_messages: int = 0
     timings_s: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -220,6 +233,11 @@ class MonitorResult:
         if self.outside:
             return "outside"
         return "unobserved" if self.unobserved_count else "inside"
+
+    def clear_unobserved(self) -> None:
+        """Forget the unobserved intervals recorded (one covering everything replaces them)."""
+        self.unobserved_count, self.unobserved_s, self.unobserved_in_span_s = 0, 0.0, 0.0
+        self.unobserved, self.longest_unobserved = [], None
 
     def _record(self, u: Unobserved, span: tuple[float, float]) -> None:
         self.unobserved_count += 1
@@ -378,20 +396,46 @@ def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str]
                         max_speed=max_speed)
 
 
+def _end_reach(d: FloatArray, h: float, w_robot: FloatArray, w_ref: FloatArray,
+               tol: float) -> float:
+    """How far (s, at most ``h``) from a sample with deviations ``d`` (4,), on the side where
+    the log has no further sample, ``spec.log_end_bound`` stays within ``tol`` for every joint:
+    ``h`` when it does over all of it, else the least (tol - d_q) / (w_robot_q + w_ref_q) (0 for
+    a sample outside)."""
+    if np.all(log_end_bound(d, h, w_robot, w_ref) <= tol):
+        return h
+    # The bound's inverse, then confirmed by the bound itself (a rounding step down at most).
+    w = w_robot + w_ref
+    room = np.maximum(tol - d, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        each = np.where(w > 0, room / np.where(w > 0, w, 1.0), np.where(d <= tol, np.inf, 0.0))
+    reach = min(float(each.min()), h)
+    for _ in range(4):
+        if np.all(log_end_bound(d, reach, w_robot, w_ref) <= tol):
+            return reach
+        reach = float(np.nextafter(reach, 0.0))
+    return 0.0
+
+
 def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
                  blocks: Iterable[tuple[int, FloatArray]], *, source: str = "<log>",
-                 max_speed: npt.ArrayLike | None = None) -> MonitorResult:
+                 max_speed: npt.ArrayLike | None = None,
+                 reading: BagReading | None = None) -> MonitorResult:
     """Check the log against the tube of radius ``tol`` around ``traj``, at every instant.
 
     At a sample: inside when each joint is within ``tol`` of the trajectory at its time (at
     rest before its first and after its last row). Between consecutive samples (docs/model.md
     §12): covered when ``between_samples_bound`` (from both ends' deviations, the gap, the
     robot's speed bound ``max_speed`` (4,), default ``parse_max_speed(None, ...)``, and the
-    trajectory's speed on the gap) is within ``tol`` for every joint; a gap not covered, and
-    the trajectory's time before the log's first or after its last sample, is unobserved.
+    trajectory's speed on the gap) is within ``tol`` for every joint; a gap not covered is
+    unobserved. The trajectory's time before the log's first sample and after its last is
+    covered from that sample alone, as far as ``spec.log_end_bound`` (its deviation plus the
+    two speeds times the distance to it) is within ``tol``, and unobserved beyond.
     ``blocks``: the samples as (the first one's line, rows (K, 5) in COLUMNS order), a CSV's
     (``monitor_log``) or a bag's (``bag_rows``); times must strictly increase. One block at a
     time (constant memory; the last sample is carried into the next block's first gap).
+    ``reading``: a bag's, read with allow_gaps: where a declared message was not read, the
+    time around it is unobserved, whatever the bounds (MISSING_MESSAGES).
     """
     res = MonitorResult()
     w_robot = (parse_max_speed(None, s, traj) if max_speed is None else
@@ -424,12 +468,21 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
             raise InputError("t", float(t[k]), f"must be greater than the previous sample's time "
                              f"{before!r} (times strictly increase)", source=source,
                              line=start + k)
-        if res.t_first_s is None:
-            res.t_first_s = float(t[0])
-            if t[0] > span0:
-                extend(span0, float(t[0]), None, BEFORE_LOG)
         res.t_last_s = float(t[-1])
         dev = np.abs(arr[:, 1:] - traj.at(t))
+        if res.t_first_s is None:
+            res.t_first_s = t1 = float(t[0])
+            if reading is not None and reading.missing_first and t1 > span0:
+                extend(span0, t1, None, MISSING_MESSAGES)
+            elif t1 > span0:
+                # Covered back from the first sample as far as the one-sided bound holds.
+                reach = _end_reach(dev[0], t1 - span0, w_robot,
+                                   ref.over(np.array([span0]), np.array([t1]))[0], tol)
+                cut = t1 - reach
+                if cut > span0:
+                    extend(span0, cut, None, BEFORE_LOG)
+                else:
+                    span_seen = True
         worst = dev.max(axis=1)
         res.max_deviation_rad = max(res.max_deviation_rad, float(worst.max()))
         out = np.flatnonzero(worst > tol)
@@ -448,12 +501,17 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
             bound = between_samples_bound(gd[:-1], gd[1:], h[:, None], w_robot[None, :],
                                           ref.over(a, b))
             ok = np.all(bound <= tol, axis=1)
+            # A gap a declared message was lost from (--allow-gaps) is not vouched for.
+            lost = (np.isin(gl[1:], list(reading.gaps_before)) if reading is not None
+                    and reading.gaps_before else np.zeros(len(ok), dtype=bool))
+            ok &= ~lost
             span_seen = span_seen or bool(np.any(ok & (a <= span0) & (span0 <= b)))
             # Runs of uncovered gaps, each one interval (merged with the open one if they meet).
             nb = ~ok
             edges = np.diff(np.concatenate([[False], nb, [False]]).astype(np.int8))
             for r0, r1 in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-                extend(float(a[r0]), float(b[r1 - 1]), int(gl[r0]), BETWEEN_SAMPLES)
+                extend(float(a[r0]), float(b[r1 - 1]), int(gl[r0]),
+                       MISSING_MESSAGES if lost[r0] else BETWEEN_SAMPLES)
         prev_t, prev_dev, prev_line = float(t[-1]), dev[-1].copy(), start + len(t) - 1
         res.samples += len(t)
         if len(out):
@@ -470,14 +528,33 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
                              "angles_rad": [float(x) for x in arr[k, 1:]],
                              "in_contact": bool(touching[0]),
                              "distance_m": float(d[0].min()),
-                             "links": list(links), "links_text": contact_links_text(links)}
+                             "links": list(links), "links_text": contact_links_text(links),
+                             "parts": contact_parts(links)}
             res.outside += len(out)
     if res.samples == 0:
         raise InputError("log", MISSING, "has no samples", source=source)
-    if prev_t < span1:
-        extend(prev_t, span1, prev_line, AFTER_LOG)
+    if reading is not None and reading.missing_last and prev_t < span1:
+        extend(prev_t, span1, prev_line, MISSING_MESSAGES)
+    elif prev_t < span1 and prev_dev is not None:
+        # Covered on from the last sample as far as the one-sided bound holds.
+        reach = _end_reach(prev_dev, span1 - prev_t, w_robot,
+                           ref.over(np.array([prev_t]), np.array([span1]))[0], tol)
+        cut = prev_t + reach
+        if cut < span1:
+            extend(max(cut, prev_t), span1, prev_line, AFTER_LOG)
+        elif prev_t <= span0:
+            span_seen = True
     if run is not None:
         res._record(run.closed(), (span0, span1))
+    if reading is not None and reading.unplaced:
+        # Declared messages not read, and no index says when: nothing is vouched for.
+        res.clear_unobserved()
+        res._record(Unobserved(span0, span1 - span0, None,
+                               f"{reading.unplaced} message(s) the bag declares were not read, "
+                               "and no message index says when"), (span0, span1))
+        span_seen = False
+    if reading is not None:
+        res.missing_messages = reading.missing
     # The trajectory's time not unobserved is covered (by gaps whose bound is within the tube,
     # and sample instants); computed from the merged intervals, so blocks do not change it.
     res.covered_fraction = (max(0.0, 1.0 - res.unobserved_in_span_s / (span1 - span0))
@@ -503,13 +580,14 @@ def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
         "first_outside_deviation_rad": None if f is None else f["deviation_rad"],
         "contact": None if f is None else {
             "in_contact": f["in_contact"], "distance_m": f["distance_m"], "links": f["links"],
-            "links_text": f["links_text"],
+            "links_text": f["links_text"], "parts": f["parts"],
             "angles_rad": f["angles_rad"],
             "meaning": ("the sampled configuration is in contact" if f["in_contact"] else
                         "not in contact, but outside what the certificate covers")},
         "max_gap_s": res.max_gap_s,
         "covered_fraction": res.covered_fraction,
         "max_speed_rad_s": list(res.max_speed_rad_s),
+        "missing_messages": res.missing_messages,
         "unobserved": None if not res.unobserved_count else {
             "count": res.unobserved_count, "total_s": res.unobserved_s,
             "first": res.unobserved[0].json(),
@@ -522,14 +600,20 @@ def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
 def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str | Path, *,
                 json_out: str | Path | None = None, allow_speed: bool = False,
                 stdin: IO[str] | None = None, max_speed: str | None = None,
-                bag: BagOptions | None = None) -> int:
+                bag: BagOptions | None = None, allow_gaps: bool = False) -> int:
     """Monitor a measured log (a file, or ``-`` for standard input) against the certified tube
     at every instant: 0 inside, 1 some sample outside or some time unobserved (or the trajectory
     is not certified clear: no JSON then), 2 bad input (InputError). ``max_speed``: the
     robot's joint speed bound as ``--max-speed`` gives it (``parse_max_speed``). The log (and
-    the trajectory) may be a ROS 2 bag, read with ``bag`` (``runs._rosbag``)."""
+    the trajectory) may be a ROS 2 bag, read with ``bag`` (``runs._rosbag``); a log bag with
+    fewer messages than it declares is bad input unless ``allow_gaps`` (their time is then
+    unobserved). The verdict and its details are printed on standard output, one line each."""
     s = _scenario(scenario)
     opts = _bag_options(bag, traj_path, log)
+    in_bag = str(log) != "-" and is_bag(log)
+    if allow_gaps and not in_bag:
+        raise InputError("--allow-gaps", MISSING, f"applies to a ROS 2 bag log only, and --log "
+                         f"{log} is none")
     t0 = time.perf_counter()
     traj = _trajectory(traj_path, s, allow_speed, opts)
     w_robot = parse_max_speed(max_speed, s, traj)
@@ -543,10 +627,11 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
     tol = tolerance_rad(s, cert)
     source = "<stdin>" if str(log) == "-" else str(log)
     # Lines within LIMITS["line"] (docs/model.md §12): /dev/zero ends at its first line's limit.
-    in_bag = str(log) != "-" and is_bag(log)
+    reading = BagReading()
     if in_bag:
-        res = monitor_rows(s, traj, tol, bag_rows(log, opts, block_rows=BLOCK_ROWS),
-                           source=source, max_speed=w_robot)
+        res = monitor_rows(s, traj, tol, bag_rows(log, opts, block_rows=BLOCK_ROWS,
+                                                  reading=reading, allow_gaps=allow_gaps),
+                           source=source, max_speed=w_robot, reading=reading)
     elif str(log) == "-":
         res = monitor_log(s, traj, tol, bounded_lines(stdin if stdin is not None else sys.stdin,
                                                       source), source=source, max_speed=w_robot)
@@ -564,31 +649,63 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
     res.timings_s = {"certificate": t1 - t0, "monitor": t2 - t1,
                      "monitor_cpu": time.process_time() - c1}
     rate = res.samples / (t2 - t1) if t2 > t1 else float("inf")
+    intervals = (f"{res.unobserved_count} interval(s), {res.unobserved_s:.6g} s in all")
+    verdict = {"inside": "inside",
+               "outside": f"outside ({res.outside} of {res.samples} samples)",
+               "unobserved": f"unobserved ({intervals})"}[res.status]
     print(f"monitor   {res.samples} samples of {source} against {traj_path} "
-          f"(tolerance {tol:.6f} rad): {res.status}, {res.outside} outside; largest gap "
-          f"{res.max_gap_s:.6g} s, {100 * res.covered_fraction:.4g}% of the trajectory's time "
-          f"covered ({rate:,.0f} samples/s)")
+          f"(tolerance {angle_text(tol)}): {verdict}; largest gap {res.max_gap_s:.6g} s, "
+          f"{100 * res.covered_fraction:.4g}% of the trajectory's time covered "
+          f"({rate:,.0f} samples/s)")
     # A bag's sample k stands at line k + 1 (its CSV's line); the user is told its message.
     def at(line: int) -> str:
         return f"message {line - 1} on {opts.topic}" if in_bag else f"line {line}"
 
+    # The details, on the verdict's stream: the first sample outside, the first time no sample
+    # vouches for, what a bag lacked.
     if res.first is not None:
         f = res.first
         kind = (f"IN CONTACT ({f['links_text']})" if f["in_contact"] else
                 "not in contact, outside the certified tube")
         print(f"first     outside at t={f['t_s']!r} s ({at(f['line'])}): {f['joint']} off by "
-              f"{f['deviation_rad']:.6g} rad; {kind}", file=sys.stderr)
+              f"{angle_text(f['deviation_rad'])}; {kind}")
     if res.unobserved_count:
         u = res.unobserved[0]
         where = "" if u.line is None else f" ({at(u.line)})"
-        print(f"unobserved {res.unobserved_count} interval(s), {res.unobserved_s:.6g} s in all; "
-              f"first from t={u.t_s!r} s for {u.length_s:.6g} s{where}: {u.why} (no sample vouches "
-              "for the robot then)", file=sys.stderr)
+        print(f"first     unobserved from t={u.t_s!r} s for {u.length_s:.6g} s{where}: {u.why}"
+              + ("" if res.status == "unobserved" else f" ({intervals})"))
+    if in_bag and res.missing_messages:
+        print(f"missing   {res.missing_messages} message(s) the bag declares on {opts.topic} "
+              f"were not read (--allow-gaps): their time is unobserved")
+    hint = _t0_hint(res, reading, traj) if in_bag else None
+    if hint is not None:
+        print(f"hint      {hint}")
     doc = monitor_json(s, traj, tol, res, source)
     if json_out is not None:
         write_bytes_atomic(json_out, dumps_json(doc).encode())
         print(f"wrote     {json_out}")
     return 0 if res.status == "inside" else 1
+
+
+#: How far past the trajectory's start (s) a bag's first stamp must be, beyond the largest gap
+#: between samples, for a log whose every sample is outside to suggest --t0.
+T0_HINT_S = 1e-3
+
+
+def _t0_hint(res: MonitorResult, reading: BagReading, traj: Trajectory) -> str | None:
+    """When every sample of a bag is outside and t counted from its first stamp (no --t0),
+    which is well past the trajectory's start: the suggestion of --t0; else None."""
+    if (res.samples == 0 or res.outside < res.samples or reading.t0_given
+            or reading.first_ns is None):
+        return None
+    first = reading.first_ns / 1e9
+    past = first - float(traj.t[0])
+    if past <= T0_HINT_S + res.max_gap_s:
+        return None
+    return (f"every sample is outside, and t counts from the bag's first stamp, {first:.9g} s, "
+            f"{past:.6g} s past the trajectory's start at {float(traj.t[0]):.6g} s: if the log "
+            "began after the trajectory did, give --t0 the stamp at its start (--t0 0 when "
+            "the stamps are on the trajectory's clock)")
 
 
 # --- simulate ---------------------------------------------------------------------------------
@@ -685,21 +802,26 @@ def run_simulate(scenario: Scenario | str | Path, traj_path: str | Path, out: st
                  excursions: Sequence[Excursion] = (), period: float | None = None,
                  samples: int | None = None, tail: float = 0.0,
                  allow_speed: bool = False, bag: BagOptions | None = None) -> int:
-    """Write a simulated measured log of the trajectory to ``out`` (atomically): CSV, or a ROS 2
-    bag (one .mcap file: JointState on ``bag``'s topic and joint names, header.stamp = t) when
-    ``out`` ends in .mcap; 0 on success."""
+    """Write a simulated measured log of the trajectory to ``out`` (atomically): a ROS 2 bag
+    (JointState on ``bag``'s topic and joint names, header.stamp = t to the nearest ns) when
+    ``out`` ends in .mcap or .db3 (that storage file) or names a folder (``runs._rosbag.
+    log_output_kind``: the rosbag2 layout), CSV otherwise; 0 on success."""
     s = _scenario(scenario)
-    as_bag = Path(out).suffix.lower() == ".mcap"
-    if bag is not None and not as_bag:
-        raise InputError("--topic/--joints", MISSING, f"apply to a bag only: --out {out} does "
-                         "not end in .mcap")
+    kind = log_output_kind(out)
+    if bag is not None and kind == "csv":
+        raise InputError("--topic/--joints", MISSING, f"apply to a bag only: --out {out} is "
+                         "written as CSV (a bag is a name ending in .mcap or .db3, or a folder "
+                         "ending in /)")
     traj = _trajectory(traj_path, s, allow_speed, BagOptions() if bag is None else bag)
     t, a = simulate_log(traj, lag=lag, noise=noise, seed=seed, excursions=excursions,
                         period=period, samples=samples, tail=tail)
-    if as_bag:
-        write_bag(out, t, a, BagOptions() if bag is None else bag)
-    else:
+    if kind == "csv":
         write_bytes_atomic(out, log_csv(t, a))
+    else:
+        write_bag(out, t, a, BagOptions() if bag is None else bag, kind=kind)
+    what = {"csv": "CSV", "mcap": "ROS 2 bag, mcap", "db3": "ROS 2 bag, sqlite3",
+            "folder": "ROS 2 bag folder, mcap"}[kind]
     print(f"simulate  {len(t)} samples of {traj_path} (lag {lag:g} s, noise {noise:g} rad, seed "
-          f"{seed}, {len(excursions)} excursion(s)) -> {out}")
+          f"{seed}, {len(excursions)} excursion(s))")
+    print(f"wrote     {out} ({what})")
     return 0

@@ -17,20 +17,27 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
                         rule_of)
     from ._certificate import (Certificate, ContactDetail, certificate_json, certify, closest_links,
                                contact_links_text, interval_bound, link_speeds, pair_lipschitz,
-                               require_clear)
+                               part_distances, pose_distance, require_clear)
+    from ._certificate import contact_parts
+    from ._certificate import _Motion as GridMotion
+    from ._trajectory import _TrajectoryMotion as TrajectoryMotion
+    from ._scope import SCOPE_CHECKED, theorem_scope
     from ._exact import ExactCell, ExactGaps, exact_path_gaps, gap_over_norm, projection_bounds
     from ._trajectory import (CHUNK_ROWS, ReferenceSpeeds, Trajectory, TrajectorySummary,
                               certify_trajectory_file, between_samples_bound, certify_trajectory,
+                              log_end_bound,
                               csv_column_order, executed_trajectory,
                               load_trajectory, parse_trajectory_csv, parse_trajectory_json,
                               tolerance_rad, trajectory_csv, trajectory_distances, tube_lipschitz)
     from ._trajectory import COLUMNS as TRAJECTORY_COLUMNS
-    from ._kinematics import LINK_WORDS, arm_corners, joints, link_corners, link_name, reach
+    from ._kinematics import (LINK_WORDS, TOOL, arm_corners, arm_parts, height_gap,
+                              heights_overlap, joints, link_corners, link_name, pairs_to_test,
+                              part_height, part_points, parts, reach)
     from ._paths import (J1, J2, MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
                          Cell, PathViolation, SearchResult, SearchStatus, check_search_inputs,
                          is_opt_path, is_path, is_path_paper, opt_path, path_violations)
     from ._polygon import polygon_distance, polygon_distances
-    from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario,
+    from ._scenario import (ANGLE_TOLERANCE, DEFAULT_MAX_CELLS, Arm, LeftArm, RightArm, Scenario, Tool,
                             load_scenario, max_cells, parse_scenario)
     from ._triples import (TRIPLES, Failure, Triple, builtdr_triple, cells_failures, cost_failures,
                            dr_cell_failures, dr_shape_failures, grid_failures, path_cells,
@@ -89,11 +96,18 @@ _EXPORTS: dict[str, str] = {
     "certificate_json": "._certificate:certificate_json",
     "certify": "._certificate:certify",
     "closest_links": "._certificate:closest_links",
+    "part_distances": "._certificate:part_distances",
+    "pose_distance": "._certificate:pose_distance",
     "contact_links_text": "._certificate:contact_links_text",
+    "contact_parts": "._certificate:contact_parts",
+    "SCOPE_CHECKED": "._scope:SCOPE_CHECKED",
+    "theorem_scope": "._scope:theorem_scope",
     "interval_bound": "._certificate:interval_bound",
     "link_speeds": "._certificate:link_speeds",
     "pair_lipschitz": "._certificate:pair_lipschitz",
     "require_clear": "._certificate:require_clear",
+    "GridMotion": "._certificate:_Motion",
+    "TrajectoryMotion": "._trajectory:_TrajectoryMotion",
     "ExactCell": "._exact:ExactCell",
     "ExactGaps": "._exact:ExactGaps",
     "exact_path_gaps": "._exact:exact_path_gaps",
@@ -102,6 +116,7 @@ _EXPORTS: dict[str, str] = {
     "ReferenceSpeeds": "._trajectory:ReferenceSpeeds",
     "Trajectory": "._trajectory:Trajectory",
     "between_samples_bound": "._trajectory:between_samples_bound",
+    "log_end_bound": "._trajectory:log_end_bound",
     "certify_trajectory": "._trajectory:certify_trajectory",
     "csv_column_order": "._trajectory:csv_column_order",
     "executed_trajectory": "._trajectory:executed_trajectory",
@@ -119,6 +134,14 @@ _EXPORTS: dict[str, str] = {
     "link_corners": "._kinematics:link_corners",
     "link_name": "._kinematics:link_name",
     "reach": "._kinematics:reach",
+    "TOOL": "._kinematics:TOOL",
+    "arm_parts": "._kinematics:arm_parts",
+    "height_gap": "._kinematics:height_gap",
+    "heights_overlap": "._kinematics:heights_overlap",
+    "pairs_to_test": "._kinematics:pairs_to_test",
+    "part_height": "._kinematics:part_height",
+    "part_points": "._kinematics:part_points",
+    "parts": "._kinematics:parts",
     "J1": "._paths:J1",
     "J2": "._paths:J2",
     "MOVES": "._paths:MOVES",
@@ -143,6 +166,7 @@ _EXPORTS: dict[str, str] = {
     "LeftArm": "._scenario:LeftArm",
     "RightArm": "._scenario:RightArm",
     "Scenario": "._scenario:Scenario",
+    "Tool": "._scenario:Tool",
     "load_scenario": "._scenario:load_scenario",
     "max_cells": "._scenario:max_cells",
     "parse_scenario": "._scenario:parse_scenario",
@@ -186,7 +210,7 @@ _EXPORTS: dict[str, str] = {
 __all__ = [
     # scenario, grids and motion (docs/model.md §2-§3)
     "ANGLE_TOLERANCE", "DEFAULT_MAX_CELLS", "DISTANCE_ERROR_M", "EPS", "MAX_COORD_M",
-    "UNIT_ROUNDOFF", "Arm", "Grid", "LeftArm", "RightArm",
+    "UNIT_ROUNDOFF", "Arm", "Grid", "LeftArm", "RightArm", "Tool",
     "Scenario", "Variant", "exact_n", "exact_tf", "joint_points", "left_angles", "left_box",
     "MAX_EXTRA_POINTS", "SPACING_ROUNDING", "SPEED_READING", "SpacingCondition", "Written",
     "decimal", "joint_grid", "spacing_conditions", "written",
@@ -196,8 +220,14 @@ __all__ = [
     "cases", "ceil_of", "floor_of", "hypot_of", "if_then", "max_of", "min_of", "sqrt_of",
     # geometry
     "arm_corners", "joints", "link_corners", "polygon_distance", "polygon_distances",
+    # parts (links and tool) and heights (docs/model.md §2, "Tools and heights")
+    "TOOL", "arm_parts", "height_gap", "heights_overlap", "pairs_to_test", "part_height",
+    "part_points", "parts", "part_distances", "pose_distance",
     # links named 1-based with words, as docs/model.md §2 names them
     "LINK_WORDS", "closest_links", "contact_links_text", "link_name",
+    "contact_parts",
+    # what the safety theorem covers of a workcell (docs/model.md §10)
+    "SCOPE_CHECKED", "theorem_scope",
     # paths (docs/model.md §5)
     "Cell", "J1", "J2", "MOVES", "PathViolation", "REASON_GOAL_BLOCKED", "REASON_START_BLOCKED",
     "REASON_UNREACHABLE", "SearchResult", "SearchStatus", "check_search_inputs", "is_opt_path",
@@ -215,6 +245,8 @@ __all__ = [
     # arrays read one layer at a time (the witness on large grids)
     "SPILL_BYTES", "LayerSpill", "Layers", "npz_layers", "npz_member", "save_npz",
     "spill_wanted",
+    # the motions the certificate samples, read on terms by proofs/_obl_wiring.py
+    "GridMotion", "TrajectoryMotion",
     # the path's cells re-decided in ball arithmetic (docs/model.md §7)
     "ExactCell", "ExactGaps", "exact_path_gaps",
     # trajectories and the tolerance tube (docs/model.md §12)
@@ -222,7 +254,7 @@ __all__ = [
     "executed_trajectory", "load_trajectory", "parse_trajectory_csv", "parse_trajectory_json",
     "tolerance_rad", "trajectory_csv", "trajectory_distances", "tube_lipschitz",
     # the monitor between samples (docs/model.md §12; proofs/_obl_monitor.py)
-    "ReferenceSpeeds", "between_samples_bound",
+    "ReferenceSpeeds", "between_samples_bound", "log_end_bound",
     # certify in one pass (docs/model.md §12)
     "CHUNK_ROWS", "TrajectorySummary", "certify_trajectory_file",
     # the constants the certificate, the tube and the ball gaps rest on (proofs/_obl_constants.py)

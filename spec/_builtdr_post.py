@@ -20,7 +20,7 @@ import numpy.typing as npt
 import shapely
 
 from ._grid import EPS, Grid, Variant
-from ._kinematics import corners
+from ._kinematics import TOOL, pairs_to_test, part_points, parts
 from ._regions import left_region_polygons, margin, right_region_polygons
 from ._scenario import Scenario
 
@@ -55,18 +55,18 @@ class PostReport:
 
 def expected_cells(s: Scenario, variant: Variant | str, grid: Grid, layers: npt.ArrayLike,
                    i: npt.ArrayLike, j: npt.ArrayLike) -> npt.NDArray[np.float64]:
-    """The spec's distance between S_LArm[k] and S_RArm[i][j] for each (k, i, j) given."""
+    """The spec's distance between S_LArm[k] and S_RArm[i][j] for each (k, i, j) given: the
+    least over the pairs of parts whose heights overlap (``pairs_to_test``; inf if none)."""
     layers = np.asarray(layers)
     i = np.asarray(i)
     j = np.asarray(j)
     left = left_region_polygons(s, variant, grid)
-    r1, r2 = right_region_polygons(s, grid, i, j)
+    right = right_region_polygons(s, grid, i, j)
     dist = np.full(layers.shape, np.inf)
     for k in np.unique(layers):
         sel = layers == k
-        for a in left[int(k)]:
-            for rb in (r1[sel], r2[sel]):
-                dist[sel] = np.minimum(dist[sel], shapely.distance(a, rb))
+        for a, b in pairs_to_test(s.left, s.right):
+            dist[sel] = np.minimum(dist[sel], shapely.distance(left[int(k)][a], right[b][sel]))
     return dist
 
 
@@ -212,26 +212,29 @@ def _block_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, b
     m, n = grid.m, grid.n
     left = left_region_polygons(s, variant, grid)
     rows = np.arange(m)
-    r1, _ = right_region_polygons(s, grid, rows, np.zeros_like(rows))
+    r1 = right_region_polygons(s, grid, rows, np.zeros_like(rows))[0]
     b1 = shapely.bounds(r1)
     free_at = eps + band + SLACK
+    pairs = pairs_to_test(s.left, s.right)
     link1 = []                          # per layer: link 1's distance per row (m,)
     for links in left:
         d1 = np.full(m, np.inf)        # inf: more than free_at (the boxes' gap shows it)
-        for a in links:
+        for a in (links[p] for p, q in pairs if q == 0):
             close = np.flatnonzero(_box_gap(shapely.bounds(a), b1) <= free_at)
             d1[close] = np.minimum(d1[close], shapely.distance(a, r1[close]))   # exact
         link1.append(d1)
     step = max(1, BLOCK_CELLS // n)
     for i0 in range(0, m, step):
         i1 = min(m, i0 + step)
-        link2 = _Link2(s, grid, i0, i1)
+        per_cell = {q: _Link2(s, grid, i0, i1, part=q) for q in parts(s.right) if q > 0}
         for k, links in enumerate(left):
             d1 = link1[k][i0:i1]
             meets = np.repeat(d1 <= eps - band, n)
             unsure = np.repeat(np.abs(d1 - eps) <= band, n)
-            for a in links:
-                hit, open_ = link2.decide(a, free_at, meets)
+            for p, q in pairs:
+                if q == 0:
+                    continue
+                hit, open_ = per_cell[q].decide(links[p], free_at, meets)
                 meets |= hit
                 unsure |= open_
             yield k, i0, i1, meets, unsure & ~meets
@@ -245,13 +248,15 @@ def _box_gap(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDAr
 
 
 class _Link2:
-    """The right link-2 regions of every cell, prepared for the bounds: boxes, the axis of the
-    rectangle at the cell's own angles, the extents along it and its normal, the hull
-    (counter-clockwise) and its edges. Arrays hold cells last, (corners, cells), so that the
-    bounds reduce over the first axis."""
+    """The right link-2 (or tool) regions of every cell, prepared for the bounds: boxes, the
+    axis of the rectangle at the cell's own angles (link 2 only), the extents along the
+    forearm's direction and its normal, the hull (counter-clockwise) and its edges. Arrays hold
+    cells last, (corners, cells), so that the bounds reduce over the first axis."""
 
-    def __init__(self, s: Scenario, grid: Grid, i0: int = 0, i1: int | None = None) -> None:
-        """Rows i0:i1 (all by default); cells are numbered (i - i0) n + j."""
+    def __init__(self, s: Scenario, grid: Grid, i0: int = 0, i1: int | None = None, *,
+                 part: int = 1) -> None:
+        """Rows i0:i1 (all by default) of part ``part`` (1 link 2, TOOL the tool); cells are
+        numbered (i - i0) n + j."""
         n, h = grid.n, grid.h
         i1 = grid.m if i1 is None else i1
         m = i1 - i0
@@ -261,8 +266,9 @@ class _Link2:
         t1 = ti[0] + steps[:, None] * h[0]
         t2 = tj[:, None, None] + steps[None, :] * h[1]
         t1, t2 = np.broadcast_arrays(t1, t2)            # (n, 3, 3): the first row's lattices
-        grow = margin(s.right, 1, h, (3, 3))
-        pts = corners(s.right, t1, t2, 1, s.right.width / 2 + grow).reshape(n, 36, 2)
+        grow = margin(s.right, part, h, (3, 3))
+        pts = part_points(s.right, t1, t2, part, grow)
+        pts = pts.reshape(n, -1, 2)
         order, self.flat = _hull_order(pts)             # (n, L): the first row's hull corners
         hull = np.take_along_axis(pts, order[:, :, None], axis=1)       # (n, L, 2)
         # Row i is row 0 turned about the base by t_i - t_0, and so are its hull corners, axis
@@ -287,8 +293,14 @@ class _Link2:
         self.box = (self.hx.min(axis=0), self.hy.min(axis=0), self.hx.max(axis=0),
                     self.hy.max(axis=0))
         # The rectangle at the cell's own angles (lattice point 4 of 9) lies in the region; its
-        # axis runs between the midpoints of its short sides.
-        ends = np.stack([(pts[:, 16] + pts[:, 19]) / 2, (pts[:, 17] + pts[:, 18]) / 2])
+        # axis runs between the midpoints of its short sides. A tool has no such core (bound 2
+        # is left out for it); its projections use the forearm's axis at the cell's angles.
+        if part == TOOL:
+            phi = ti[0] + tj
+            ends = np.stack([np.broadcast_to(np.array([bx, by]), (n, 2)),
+                             np.stack([bx + np.cos(phi), by + np.sin(phi)], -1)])   # (2, n, 2)
+        else:
+            ends = np.stack([(pts[:, 16] + pts[:, 19]) / 2, (pts[:, 17] + pts[:, 18]) / 2])
         ex, ey = rotate(ends[..., 0], ends[..., 1], True)                    # (2, cells)
         self.q0, self.d = (ex[0], ey[0]), (ex[1] - ex[0], ey[1] - ey[0])
         length = np.hypot(*self.d)
@@ -300,6 +312,7 @@ class _Link2:
         # The rectangle itself in its frame: u from q0 to q1, v within +-(half its width).
         self.core = (ex[0] * self.u[0] + ey[0] * self.u[1], ex[1] * self.u[0] + ey[1] * self.u[1],
                      ex[0] * self.v[0] + ey[0] * self.v[1], s.right.width / 2 + grow)
+        self.has_core = part != TOOL
 
     def decide(self, a: shapely.Geometry, free_at: float, skip: npt.NDArray[np.bool_]
                ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_]]:
@@ -322,15 +335,18 @@ class _Link2:
         if c.size == 0:
             return meets, undecided
         anx, any_, aoff = _edges(ax, ay)                                 # (V, 1) each
-        cross = _crosses(self.q0[0][c], self.q0[1][c], self.d[0][c], self.d[1][c],
-                         anx, any_, aoff)                                # 2. the axis
+        if self.has_core:
+            cross = _crosses(self.q0[0][c], self.q0[1][c], self.d[0][c], self.d[1][c],
+                             anx, any_, aoff)                            # 2. the axis
+        else:
+            cross = np.zeros(c.size, dtype=bool)
         # 3. A's corners on the axis and its normal: a corner inside the rectangle at the
         # cell's angles means they meet; a gap of the projections above the limit, free.
         pu = ax * self.u[0][c] + ay * self.u[1][c]                       # (V, S)
         pv = ax * self.v[0][c] + ay * self.v[1][c]
         u0, u1, v0, half = self.core[0][c], self.core[1][c], self.core[2][c], self.core[3]
         inside = ((pu >= u0) & (pu <= u1) & (np.abs(pv - v0) <= half)).any(axis=0)
-        hit = cross | inside
+        hit = cross | (inside if self.has_core else False)
         meets[c[hit]] = True
         e = [x[c] for x in self.ext]
         gap = np.maximum(np.maximum(e[0] - pu.max(axis=0), pu.min(axis=0) - e[1]),

@@ -47,7 +47,7 @@ import numpy.typing as npt
 
 from ..errors import CertificateViolation, InputError
 from ._grid import EPS, Grid, exact_tf, left_angles
-from ._kinematics import corners, link_name, reach
+from ._kinematics import height_gap, link_name, part_height, part_points, parts, reach
 from ._polygon import polygon_distances
 from ._scenario import Arm, Scenario
 
@@ -57,7 +57,10 @@ __all__ = [
     "certify",
     "certificate_json",
     "closest_links",
+    "part_distances",
+    "pose_distance",
     "contact_links_text",
+    "contact_parts",
     "prove_motion",
     "Prover",
     "require_clear",
@@ -85,10 +88,10 @@ Contact = tuple[float, tuple[int, int]]
 
 @dataclass(frozen=True)
 class ContactDetail:
-    """Where a sampled contact is: the instant, the links (left, right), numbered 1-based as in
-    docs/model.md §2 (1 the upper arm, 2 the forearm), both arms' joint angles then, and the
-    path segment the subordinate was on (``step`` k: moving from cells[0] to cells[1] during
-    [k dt, (k+1) dt]; ``step`` None: resting at its last cell, cells[0] == cells[1])."""
+    """Where a sampled contact is: the instant, the parts (left, right), numbered 1-based as in
+    docs/model.md §2 (1 the upper arm, 2 the forearm, 3 the tool), both arms' joint angles then,
+    and the path segment the subordinate was on (``step`` k: moving from cells[0] to cells[1]
+    during [k dt, (k+1) dt]; ``step`` None: resting at its last cell, cells[0] == cells[1])."""
 
     t_s: float
     links: tuple[int, int]
@@ -112,8 +115,8 @@ class Certificate:
     is THE PROVED figure: a lower bound on the distance between the arms over the whole motion
     (else 0.0). ``min_clearance_m`` / ``t_min_s`` are only the least SAMPLED distance and its
     instant: an upper bound on the true minimum, not a guarantee. ``contact`` is
-    (t, (left link, right link)) for a sampled contact, links numbered 1-based
-    (``closest_links``), and ``contact_detail`` the same with the
+    (t, (left part, right part)) for a sampled contact, parts numbered 1-based
+    (``closest_links``; 3 the tool), and ``contact_detail`` the same with the
     angles and path segment; ``undecided`` lists the merged (t0, t1) intervals left unproved.
     """
 
@@ -287,7 +290,8 @@ def certificate_json(cert: Certificate) -> dict[str, Any]:
     contact = None
     if cert.contact is not None:
         contact = {"t_s": cert.contact[0], "links": list(cert.contact[1]),
-                   "links_text": contact_links_text(cert.contact[1])}
+                   "links_text": contact_links_text(cert.contact[1]),
+                   "parts": contact_parts(cert.contact[1])}
         c = cert.contact_detail
         if c is not None:
             contact.update(left_angles_rad=list(c.left_angles_rad),
@@ -307,16 +311,23 @@ def certificate_json(cert: Certificate) -> dict[str, Any]:
 
 
 def closest_links(d: FloatArray) -> tuple[int, int]:
-    """(left link, right link) of the least of ``d[a, b]`` (2, 2), the distances between left link
-    index a and right link index b: as link NUMBERS, 1-based (docs/model.md §2), the one place
-    an array index becomes a link number."""
-    a, b = np.unravel_index(int(np.argmin(d)), (2, 2))
+    """(left part, right part) of the least of ``d[a, b]`` (parts x parts), the distances between
+    left part index a and right part index b: as part NUMBERS, 1-based (docs/model.md §2: 1 the
+    upper arm, 2 the forearm, 3 the tool), the one place an array index becomes a part number."""
+    a, b = np.unravel_index(int(np.argmin(d)), d.shape)
     return int(a) + 1, int(b) + 1
 
 
+def contact_parts(links: Sequence[int]) -> list[str]:
+    """``["left tool", "right link 2 (forearm)"]``: the left and the right part of a contact or
+    closest pair, 1-based part numbers (``closest_links``) in words (``link_name``,
+    docs/model.md §2); the JSON's ``parts``."""
+    return [link_name("left", int(links[0])), link_name("right", int(links[1]))]
+
+
 def contact_links_text(links: Sequence[int]) -> str:
-    """``left link 2 (forearm) and right link 2 (forearm)`` for 1-based link numbers."""
-    return f"{link_name('left', int(links[0]))} and {link_name('right', int(links[1]))}"
+    """``left link 2 (forearm) and right tool`` for 1-based part numbers (3 the tool)."""
+    return " and ".join(contact_parts(links))
 
 
 def require_clear(cert: Certificate, *, name: str = "continuous-time certificate") -> None:
@@ -333,7 +344,10 @@ def require_clear(cert: Certificate, *, name: str = "continuous-time certificate
                            "right angles_rad": list(c.right_angles_rad),
                            "path segment": c.segment,
                            "cells": [list(x) for x in c.cells]})
-        text = "the arms' link rectangles touch during the motion"
+        # A tool is a polygon, not a link rectangle (docs/model.md §2): say "parts" then. The
+        # parts are named in the one line too (a batch listing shows that line alone).
+        text = ("the arms' link rectangles touch during the motion" if max(a, b) <= 2 else
+                "the arms' parts touch during the motion") + f": {contact_links_text((a, b))}"
         raise CertificateViolation(name, text, values, condition_id="certificate.contact",
                                    message=text)
     first = cert.undecided[0] if cert.undecided else None
@@ -437,7 +451,7 @@ class _Motion:
         return cast(FloatArray, t0), cast(FloatArray, t1), seg, t0 < tf
 
     def lipschitz(self, seg: IntArray, moving: npt.NDArray[np.bool_]) -> FloatArray:
-        """L_ab = v_a (left link a) + v_b (right link b) per piece, shape (K, 2, 2)."""
+        """L_ab = v_a (left part a) + v_b (right part b) per piece, shape (K, parts, parts)."""
         s = self.scenario
         left_w = np.abs(np.subtract(s.left.goal, s.left.start)) / self.tf if self.tf > 0 else np.zeros(2)
         wl = np.where(moving[:, None], left_w[None, :], 0.0)
@@ -475,11 +489,12 @@ class _Motion:
         return (int(self.cells[k, 0]), int(self.cells[k, 1]))
 
     def distances(self, t: FloatArray, seg: IntArray) -> FloatArray:
-        """d[k, a, b]: distance between left link a and right link b at time t[k]."""
+        """d[k, a, b]: distance between left part a and right part b at time t[k] (3-D, with
+        the heights: ``part_distances``)."""
         s = self.scenario
-        left = link_rects(s.left, left_angles(s, t))                     # (K, 2, 4, 2)
+        left = link_rects(s.left, left_angles(s, t))                     # (K, parts, V, 2)
         right = link_rects(s.right, self.right_angles(t, seg))
-        return polygon_distances(left[:, :, None], right[:, None, :])
+        return part_distances(s, polygon_distances(left[:, :, None], right[:, None, :]))
 
 
 def _merge(parts: list[tuple[FloatArray, FloatArray]]) -> tuple[tuple[float, float], ...]:
@@ -501,9 +516,31 @@ def _merge(parts: list[tuple[FloatArray, FloatArray]]) -> tuple[tuple[float, flo
 # --- pure numpy -------------------------------------------------------------------------------
 
 
+def part_distances(s: Scenario, planar: FloatArray) -> FloatArray:
+    """The 3-D distances (..., left parts, right parts) between the parts as prisms over their
+    height intervals, from their planar distances: hypot(planar, height gap) where the heights
+    are apart, the planar distance where they overlap (docs/model.md §2, "Tools and heights").
+    Each is Lipschitz with the same constant as the planar one (the heights do not move)."""
+    gap = np.array([[height_gap(part_height(s.left, a), part_height(s.right, b))
+                     for b in parts(s.right)] for a in parts(s.left)])
+    if not np.any(gap > 0):
+        return planar
+    return np.where(gap > 0, np.hypot(planar, gap), planar)
+
+
+def pose_distance(s: Scenario, left: tuple[float, float], right: tuple[float, float]) -> float:
+    """The least 3-D distance between a part of the principal at joint angles ``left`` and a part
+    of the subordinate at ``right`` (``part_distances`` of the planar distances); 0.0 when two
+    parts whose heights overlap touch."""
+    la = np.asarray(left, dtype=float)[None]
+    ra = np.asarray(right, dtype=float)[None]
+    planar = polygon_distances(link_rects(s.left, la)[:, :, None], link_rects(s.right, ra)[:, None, :])
+    return float(part_distances(s, planar).min())
+
+
 def _reach(arm: Arm) -> tuple[FloatArray, FloatArray]:
-    """(R_base, R_elbow) per link, as arrays over the two links."""
-    per_link = [reach(arm, link) for link in (0, 1)]
+    """(R_base, R_elbow) per part, as arrays over the parts (links, then the tool)."""
+    per_link = [reach(arm, link) for link in parts(arm)]
     return np.array([r[0] for r in per_link]), np.array([r[1] for r in per_link])
 
 
@@ -521,7 +558,7 @@ def pair_lipschitz(v_left: Any, v_right: Any) -> Any:
 
 
 def link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
-    """Upper bound on any link point's speed, |w1| R_base + |w2| R_elbow; w (K, 2) -> (K, 2).
+    """Upper bound on any part point's speed, |w1| R_base + |w2| R_elbow; w (K, 2) -> (K, parts).
 
     Runs on object arrays of Z3 terms as well (``reach`` does, ``abs`` is an If there)."""
     r_base, r_elbow = _reach(arm)
@@ -530,9 +567,15 @@ def link_speeds(arm: Arm, w: FloatArray) -> FloatArray:
 
 
 def link_rects(arm: Arm, theta: FloatArray) -> FloatArray:
-    """Corners of both links at each configuration, (K, 2) -> (K, 2 links, 4, 2)."""
-    r = arm.width / 2.0
-    return np.stack([corners(arm, theta[:, 0], theta[:, 1], link, r) for link in (0, 1)], axis=1)
+    """Outlines of every part at each configuration, (K, 2) -> (K, parts, V, 2): the links'
+    rectangles and the tool's polygon, padded to one vertex count by repeating the last vertex
+    (a zero-length edge, harmless to ``polygon_distances``)."""
+    outlines = [part_points(arm, theta[:, 0], theta[:, 1], p) for p in parts(arm)]
+    size = max(o.shape[-2] for o in outlines)
+    padded = [o if o.shape[-2] == size else
+              np.concatenate([o, np.repeat(o[..., -1:, :], size - o.shape[-2], axis=-2)], axis=-2)
+              for o in outlines]
+    return np.stack(padded, axis=1)
 
 
 # The former private names, kept for callers that used them.

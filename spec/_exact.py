@@ -27,6 +27,7 @@ from flint import arb, ctx
 
 from ._arith import is_term, max_of, min_of, sqrt_of
 from ._grid import EPS, Grid, Variant, left_angles, left_box, rest_box
+from ._kinematics import TOOL, pairs_to_test, parts
 from ._regions import SNAP, lattice
 from ._scenario import Arm, Scenario
 
@@ -104,10 +105,29 @@ def _corners(arm: Arm, t1: float, t2: float, link: int, r: arb) -> Points:
             (qx + ux - uy, qy + uy + ux), (px - ux - uy, py - uy + ux)]
 
 
+def _tool_points(arm: Arm, t1: float, t2: float, grow: arb) -> Points:
+    """The tool's vertices each moved by +-grow along the forearm and its normal, at the float
+    angles (t1, t2), enclosed in balls (the spec's ``part_points`` for the tool, term for term)."""
+    assert arm.tool is not None
+    a1, phi = arb(t1), arb(t1) + arb(t2)
+    c, s = phi.cos(), phi.sin()
+    wx = arb(arm.base[0]) + arb(arm.links[0]) * a1.cos() + arb(arm.links[1]) * c
+    wy = arb(arm.base[1]) + arb(arm.links[0]) * a1.sin() + arb(arm.links[1]) * s
+    steps = [(-grow, -grow), (grow, -grow), (grow, grow), (-grow, grow)]
+    return [(wx + (arb(x) + dx) * c - (arb(y) + dy) * s, wy + (arb(x) + dx) * s + (arb(y) + dy) * c)
+            for x, y in arm.tool.polygon for dx, dy in steps]
+
+
 def _margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int]) -> arb:
     """delta of the spec's regions (``_regions.margin``) in balls, with R as the exact hypot."""
     r = arb(arm.width) / 2
-    if link == 0:
+    if link == TOOL:
+        assert arm.tool is not None
+        # arb.max: a ball holding the max of any points of the balls (the exact farthest vertex).
+        far = functools.reduce(arb.max, (((arb(arm.links[1]) + arb(x)) ** 2 + arb(y) ** 2).sqrt()
+                                         for x, y in arm.tool.polygon))
+        R = arb(arm.links[0]) + far, far
+    elif link == 0:
         R = ((arb(arm.links[0]) + r) ** 2 + r ** 2).sqrt(), arb(0)
     else:
         far = ((arb(arm.links[1]) + r) ** 2 + r ** 2).sqrt()
@@ -124,11 +144,13 @@ def _margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int])
 def _region_points(arm: Arm, link: int, axes: tuple[np.ndarray, np.ndarray],
                    g: tuple[float, float]) -> tuple[Points, np.ndarray]:
     """(ball corner points, float corner points) of a region over the lattice ``axes``."""
-    r = arb(arm.width) / 2 + _margin(arm, link, g, (len(axes[0]), len(axes[1])))
+    grow = _margin(arm, link, g, (len(axes[0]), len(axes[1])))
+    r = arb(arm.width) / 2 + grow
     balls: Points = []
     for t1 in axes[0]:
         for t2 in axes[1]:
-            balls += _corners(arm, float(t1), float(t2), link, r)
+            balls += (_tool_points(arm, float(t1), float(t2), grow) if link == TOOL
+                      else _corners(arm, float(t1), float(t2), link, r))
     floats = np.array([[float(x.mid()), float(y.mid())] for x, y in balls])
     return balls, floats
 
@@ -184,9 +206,11 @@ def _lower_float(x: arb) -> float:
 
 def exact_path_gaps(s: Scenario, variant: Variant | str, grid: Grid,
                     path: Sequence[Sequence[int]]) -> ExactGaps:
-    """Every (layer, cell) of ``path`` re-decided in ball arithmetic against eps."""
+    """Every (layer, cell) of ``path`` re-decided in ball arithmetic against eps, over the part
+    pairs whose heights overlap (``pairs_to_test``); a cell with no such pair is free."""
     v = Variant(variant)
     gl = (s.left.omega[0] * s.dt, s.left.omega[1] * s.dt)
+    pairs = pairs_to_test(s.left, s.right)
     old = ctx.prec
     ctx.prec = EXACT_PREC_BITS
     try:
@@ -198,8 +222,11 @@ def exact_path_gaps(s: Scenario, variant: Variant | str, grid: Grid,
                 left[layer] = _left_points(s, v, grid, layer, gl)
             if cell not in right:
                 right[cell] = _right_points(s, grid, cell)
-            gap = min((_gap(a, b) for a in left[layer] for b in right[cell]),
-                      key=lambda x: _lower_float(x))
+            gaps = [_gap(left[layer][a], right[cell][b]) for a, b in pairs]
+            if not gaps:
+                out.append(ExactCell(layer, cell, math.inf, True))
+                continue
+            gap = min(gaps, key=lambda x: _lower_float(x))
             out.append(ExactCell(layer, cell, _lower_float(gap), bool(gap > arb(EPS))))
     finally:
         ctx.prec = old
@@ -210,7 +237,7 @@ def exact_path_gaps(s: Scenario, variant: Variant | str, grid: Grid,
 
 def _left_points(s: Scenario, v: Variant, grid: Grid, layer: int, g: tuple[float, float]
                  ) -> list[tuple[Points, np.ndarray]]:
-    """The principal's two regions of ``layer`` (the rest layer is N), as the spec builds them."""
+    """The principal's regions (one per part) of ``layer`` (the rest layer is N), as the spec builds them."""
     if layer == grid.N:
         if v.rest_at_goal:
             goal = (float(s.left.goal[0]), float(s.left.goal[1]))
@@ -223,14 +250,14 @@ def _left_points(s: Scenario, v: Variant, grid: Grid, layer: int, g: tuple[float
         box = left_box(s, v, layer)
     axes = (lattice(box[0][0], box[0][1], anchor[0], g[0]),
             lattice(box[1][0], box[1][1], anchor[1], g[1]))
-    return [_region_points(s.left, link, axes, g) for link in (0, 1)]
+    return [_region_points(s.left, link, axes, g) for link in parts(s.left)]
 
 
 def _right_points(s: Scenario, grid: Grid, cell: Cell) -> list[tuple[Points, np.ndarray]]:
-    """The subordinate's two regions at ``cell``: the 3 x 3 lattice of its box."""
+    """The subordinate's regions (one per part) at ``cell``: the 3 x 3 lattice of its box."""
     h = grid.h
     ti = grid.lo[0] + cell[0] * h[0]
     tj = grid.lo[1] + cell[1] * h[1]
     steps = np.array([-1.0, 0.0, 1.0])
     axes = (ti + steps * h[0], tj + steps * h[1])
-    return [_region_points(s.right, link, axes, h) for link in (0, 1)]
+    return [_region_points(s.right, link, axes, h) for link in parts(s.right)]

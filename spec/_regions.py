@@ -1,9 +1,10 @@
 """The swept regions S_LArm[k] and S_RArm[i][j] as docs/model.md §4 defines them (the spec's own code).
 
-A region is the convex hull of the link rectangles, grown by the margin delta, at the lattice
-points of the joint box (lattice anchored at the box's anchor, spacing g per joint, the box rounded
-outward). delta = sum over joints with more than one lattice point of g_q^2/8 * R_q, plus
-SNAP * g_q * R_q for rounding box ends onto the lattice (R_1 = R_base, R_2 = R_elbow).
+A region is the convex hull of a part (link rectangle or tool polygon), grown by the margin
+delta, at the lattice points of the joint box (lattice anchored at the box's anchor, spacing g
+per joint, the box rounded outward). delta = sum over joints with more than one lattice point
+of g_q^2/8 * R_q, plus SNAP * g_q * R_q for rounding box ends onto the lattice (R_1 = R_base,
+R_2 = R_elbow; a tool's from its farthest vertex).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy.typing as npt
 import shapely
 
 from ._grid import Grid, Variant, left_angles, left_box, rest_box
-from ._kinematics import corners, reach
+from ._kinematics import part_points, parts, reach
 from ._scenario import Arm, Scenario
 
 __all__ = ["SNAP", "margin", "lattice", "left_region_polygons", "right_region_polygons"]
@@ -51,13 +52,14 @@ def _region(arm: Arm, link: int, box: tuple[tuple[float, float], tuple[float, fl
     axes = [lattice(box[q][0], box[q][1], anchor[q], g[q]) for q in range(2)]
     grow = margin(arm, link, g, (len(axes[0]), len(axes[1])))
     t1, t2 = np.meshgrid(*axes, indexing="ij")
-    pts = corners(arm, t1, t2, link, arm.width / 2 + grow).reshape(-1, 2)
+    pts = part_points(arm, t1, t2, link, grow).reshape(-1, 2)
     return _hulls(pts[None])[0]
 
 
 def left_region_polygons(s: Scenario, variant: Variant | str, grid: Grid
-                         ) -> list[tuple[shapely.Geometry, shapely.Geometry]]:
-    """S_LArm for layers 0..N-1 and the rest layer R (index N), per variant."""
+                         ) -> list[tuple[shapely.Geometry, ...]]:
+    """S_LArm for layers 0..N-1 and the rest layer R (index N), per variant: a region per part
+    of the principal (``parts``: link 1, link 2, then the tool if any)."""
     v = Variant(variant)
     g = (s.left.omega[0] * s.dt, s.left.omega[1] * s.dt)
     out = []
@@ -65,19 +67,20 @@ def left_region_polygons(s: Scenario, variant: Variant | str, grid: Grid
         a = left_angles(s, k * s.dt)
         anchor = (float(a[0]), float(a[1]))
         box = left_box(s, v, k)
-        out.append((_region(s.left, 0, box, anchor, g), _region(s.left, 1, box, anchor, g)))
+        out.append(tuple(_region(s.left, p, box, anchor, g) for p in parts(s.left)))
     if v.rest_at_goal:
         goal = (float(s.left.goal[0]), float(s.left.goal[1]))
         box = rest_box(s, v, grid.N)
-        out.append((_region(s.left, 0, box, goal, g), _region(s.left, 1, box, goal, g)))
+        out.append(tuple(_region(s.left, p, box, goal, g) for p in parts(s.left)))
     else:
         out.append(out[-1])
     return out
 
 
 def right_region_polygons(s: Scenario, grid: Grid, i: npt.ArrayLike, j: npt.ArrayLike
-                          ) -> tuple[npt.NDArray[np.object_], npt.NDArray[np.object_]]:
-    """S_RArm at cells (i, j) (arrays of equal shape): link 1 and link 2 geometries."""
+                          ) -> tuple[npt.NDArray[np.object_], ...]:
+    """S_RArm at cells (i, j) (arrays of equal shape): a geometry array per part of the
+    subordinate (``parts``: link 1, link 2, then the tool if any)."""
     i = np.asarray(i)
     j = np.asarray(j)
     h = grid.h
@@ -89,8 +92,8 @@ def right_region_polygons(s: Scenario, grid: Grid, i: npt.ArrayLike, j: npt.Arra
     t2 = tj[..., None, None] + steps[None, :] * h[1]
     t1, t2 = np.broadcast_arrays(t1, t2)
     out = []
-    for link in (0, 1):
+    for link in parts(s.right):
         grow = margin(s.right, link, h, (3, 3))
-        pts = corners(s.right, t1, t2, link, s.right.width / 2 + grow)
-        out.append(_hulls(pts.reshape(*i.shape, 36, 2)).reshape(i.shape))
-    return out[0], out[1]
+        pts = part_points(s.right, t1, t2, link, grow)
+        out.append(_hulls(pts.reshape(*i.shape, 9 * pts.shape[-2], 2)).reshape(i.shape))
+    return tuple(out)

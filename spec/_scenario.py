@@ -34,6 +34,7 @@ from ._counts import (MAX_SPACING, GridRefused, joint_grid, min_points, spacing_
 
 __all__ = [
     "Arm",
+    "Tool",
     "LeftArm",
     "RightArm",
     "Scenario",
@@ -46,6 +47,7 @@ __all__ = [
     "MAX_LENGTH_M",
     "MAX_ANGLE_RAD",
     "MAX_STEP_RAD",
+    "MAX_TOOL_VERTICES",
 ]
 
 #: Cells of D_R, (N + 1) * m * n, allowed before any work starts: what fits in 6 GiB at the
@@ -63,6 +65,8 @@ MAX_LENGTH_M = 100.0
 MAX_ANGLE_RAD = 1000.0
 #: omega_q * dt <= MAX_STEP_RAD per joint: the margin lemma holds for spacings g <= 3.14 rad.
 MAX_STEP_RAD = 3.14
+#: A tool polygon has 3 to MAX_TOOL_VERTICES vertices (docs/model.md §2, "Tools and heights").
+MAX_TOOL_VERTICES = 16
 #: Cells beyond this are refused even with check_budget=False: no machine holds them, and
 #: counts this large no longer convert to floats.
 _HARD_MAX_CELLS = 2**53
@@ -73,16 +77,29 @@ Pair = tuple[float, float]
 
 
 @dataclass(frozen=True)
+class Tool:
+    """A rigid convex part fixed to link 2 (docs/model.md §2, "Tools and heights"): its vertices,
+    counter-clockwise, in the forearm's frame (origin at the end of link 2, x along the forearm,
+    y to its left), and its closed height interval (m), or None for every height."""
+
+    polygon: tuple[Pair, ...]
+    z: Pair | None = None
+
+
+@dataclass(frozen=True)
 class Arm:
-    """A planar two-link arm: base position, link lengths, link width, joint speed limits."""
+    """A planar two-link arm: base position, link lengths, link width, joint speed limits; the
+    closed height intervals of link 1 and link 2 (None: every height) and a tool (or None)."""
 
     base: Pair
     links: Pair
     width: float
     omega: Pair
+    z: tuple[Pair, Pair] | None = None
+    tool: Tool | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class LeftArm(Arm):
     """The principal arm, moving point-to-point from ``start`` to ``goal`` (radians)."""
 
@@ -90,7 +107,7 @@ class LeftArm(Arm):
     goal: Pair
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class RightArm(Arm):
     """The subordinate arm: joint limits, and start/goal as grid cells (i, j)."""
 
@@ -122,8 +139,10 @@ class Scenario:
 
 _TOP_KEYS = {"name", "purpose", "dt", "left", "right"}
 _ARM_KEYS = {"base", "links", "width", "omega"}
-_LEFT_KEYS = _ARM_KEYS | {"start", "goal"}
-_RIGHT_KEYS = _ARM_KEYS | {"limits", "start_cell", "goal_cell", "start", "goal"}
+_ARM_OPTIONAL = {"z", "tool"}
+_TOOL_KEYS = {"polygon", "z"}
+_LEFT_KEYS = _ARM_KEYS | _ARM_OPTIONAL | {"start", "goal"}
+_RIGHT_KEYS = _ARM_KEYS | _ARM_OPTIONAL | {"limits", "start_cell", "goal_cell", "start", "goal"}
 
 
 def max_cells() -> int:
@@ -150,14 +169,19 @@ class _Reader:
     def line_of(self, field: str) -> int | None:
         if self.text is None:
             return None
-        key = field.split(".")[-1].split("[")[0]
-        table = field.split(".")[0] if "." in field else None
+        # "right.tool.polygon[2][0]": key polygon in table [right.tool].
+        path = [part.split("[")[0] for part in field.split(".")]
+        key = path[-1]
+        table = ".".join(path[:-1]) if len(path) > 1 else None
+        whole = ".".join(path)
         in_table = table is None
         for n, line in enumerate(self.text.splitlines(), start=1):
             stripped = line.strip()
             if stripped.startswith("["):
                 # A header may carry a comment: `[left]   # principal`.
                 header = stripped.split("#", 1)[0].strip()
+                if header.strip("[] ") == whole:
+                    return n                    # the field is a table: `[left.gadget]`
                 in_table = table is not None and header.strip("[] ") == table
                 if table is None:
                     in_table = False
@@ -361,9 +385,10 @@ def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str 
     purpose = r.string(doc["purpose"], "purpose")
     dt = r.number(doc["dt"], "dt", positive=True)
 
-    ld = r.table(doc, "left", _LEFT_KEYS, _LEFT_KEYS)
+    ld = r.table(doc, "left", _LEFT_KEYS, _LEFT_KEYS - _ARM_OPTIONAL)
     angle: dict[str, Any] = {"bound": MAX_ANGLE_RAD, "unit": " rad"}
-    left = LeftArm(**_arm_common(r, ld, "left", dt), start=r.pair(ld["start"], "left.start", **angle),
+    left = LeftArm(**_arm_common(r, ld, "left", dt), **_arm_parts(r, ld, "left"),
+                   start=r.pair(ld["start"], "left.start", **angle),
                    goal=r.pair(ld["goal"], "left.goal", **angle))
 
     rd = r.table(doc, "right", _RIGHT_KEYS, _ARM_KEYS | {"limits"})
@@ -391,9 +416,73 @@ def parse_scenario(doc: dict[str, Any], *, source: str | None = None, text: str 
     _check_budget(r, N, grids[0][0], grids[1][0], max_cells() if check_budget else None)
     start_cell = _grid_point(r, rd, "start", limits, grids, omega, dt)
     goal_cell = _grid_point(r, rd, "goal", limits, grids, omega, dt)
-    right = RightArm(**common, limits=limits, start_cell=start_cell, goal_cell=goal_cell)
+    right = RightArm(**common, **_arm_parts(r, rd, "right"), limits=limits, start_cell=start_cell,
+                     goal_cell=goal_cell)
     return Scenario(name=name, purpose=purpose, dt=dt, left=left, right=right,
                     source=source or "<memory>", sha256=sha256)
+
+
+def _interval(r: _Reader, value: Any, field: str) -> Pair:
+    """A closed height interval [lo, hi] (m), lo <= hi (a single height is allowed), within the
+    physical range."""
+    lo, hi = r.pair(value, field, bound=MAX_BASE_M, unit=" m")
+    if not lo <= hi:
+        raise r.fail(field, value, "must have lo <= hi (a closed height interval [lo, hi] in "
+                     "metres)")
+    return (float(lo), float(hi))
+
+
+def _arm_parts(r: _Reader, doc: dict[str, Any], side: str) -> dict[str, Any]:
+    """The optional heights of the links (``z``) and the tool (``[side.tool]``)."""
+    out: dict[str, Any] = {}
+    if "z" in doc:
+        z = doc["z"]
+        if not isinstance(z, list) or len(z) != 2:
+            raise r.fail(f"{side}.z", z, "must be a list of 2 [lo, hi] height intervals (m): "
+                         "link 1's and link 2's")
+        out["z"] = (_interval(r, z[0], f"{side}.z[0]"), _interval(r, z[1], f"{side}.z[1]"))
+    if "tool" in doc:
+        td = r.table(doc, "tool", _TOOL_KEYS, {"polygon"}, prefix=f"{side}.")
+        out["tool"] = Tool(polygon=_tool_polygon(r, td["polygon"], f"{side}.tool.polygon"),
+                           z=_interval(r, td["z"], f"{side}.tool.z") if "z" in td else None)
+    return out
+
+
+def _tool_polygon(r: _Reader, value: Any, field: str) -> tuple[Pair, ...]:
+    """A strictly convex polygon of 3 to MAX_TOOL_VERTICES vertices, decided exactly on the
+    doubles (every other vertex strictly to the left of every edge, after orienting it
+    counter-clockwise), returned counter-clockwise."""
+    if not isinstance(value, list) or not 3 <= len(value) <= MAX_TOOL_VERTICES:
+        raise r.fail(field, _short_list(value),
+                     f"must be a list of 3 to {MAX_TOOL_VERTICES} [x, y] vertices (m)")
+    pts = [r.pair(v, f"{field}[{k}]", bound=MAX_LENGTH_M, unit=" m") for k, v in enumerate(value)]
+    pts = [(float(x), float(y)) for x, y in pts]
+    q = [(Fraction(x), Fraction(y)) for x, y in pts]
+    V = len(q)
+    area = sum(q[k][0] * q[(k + 1) % V][1] - q[(k + 1) % V][0] * q[k][1] for k in range(V))
+    (ax, ay), (bx, by) = q[0], q[1]
+    if all((bx - ax) * (cy - ay) - (by - ay) * (cx - ax) == 0 for cx, cy in q):
+        raise r.fail(field, value, "must enclose an area (this polygon is degenerate: its "
+                     "vertices lie on one line)")
+    if area < 0:
+        pts, q = pts[::-1], q[::-1]
+    for k in range(V):
+        (ax, ay), (bx, by) = q[k], q[(k + 1) % V]
+        for c in range(V):
+            if c in (k, (k + 1) % V):
+                continue
+            cx, cy = q[c]
+            if not (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0:
+                raise r.fail(field, value,
+                             "must be a strictly convex polygon (vertices in order, either "
+                             "orientation, no three on a line, no repeated vertex)")
+    return tuple(pts)
+
+
+def _short_list(value: Any) -> Any:
+    """A long list shown by its length only."""
+    return f"<a list of {len(value)} items>" if isinstance(value, list) and len(value) > 20 \
+        else value
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:

@@ -34,7 +34,7 @@ import json
 import math
 import time
 from array import array
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, cast
@@ -46,9 +46,10 @@ from ..errors import MISSING, InputError
 from ..files import LIMITS, bounded_lines, echo, read_bounded
 from ._arith import max_of
 from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
-                           Certificate, ContactDetail, Prover, link_rects, link_speeds)
+                           Certificate, ContactDetail, Prover, link_rects, link_speeds,
+                           part_distances)
 from ._grid import EPS, Grid, exact_tf, left_angles
-from ._kinematics import reach
+from ._kinematics import parts, reach
 from ._polygon import polygon_distances
 from ._scenario import ANGLE_TOLERANCE, Scenario
 
@@ -57,7 +58,7 @@ __all__ = ["COLUMNS", "JOINTS", "Trajectory", "csv_column_order", "load_trajecto
            "executed_trajectory", "trajectory_csv", "tube_lipschitz", "tolerance_rad",
            "TOLERANCE_STEP_RAD", "SPEED_TOLERANCE", "trajectory_distances", "validate",
            "between_samples_bound", "ReferenceSpeeds", "CHUNK_ROWS", "TrajectorySummary",
-           "certify_trajectory_file"]
+           "certify_trajectory_file", "log_end_bound"]
 
 #: The file columns, in the order of ``Trajectory.angles`` after t.
 COLUMNS = ("t", "left1", "left2", "right1", "right2")
@@ -161,10 +162,13 @@ def _csv_rows(lines: Iterator[str], source: str | None) -> Iterator[tuple[int, l
 
 
 def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str | None = None,
-                         allow_speed: bool = False) -> Trajectory:
+                         allow_speed: bool = False,
+                         name_row: Callable[[int], str] | None = None) -> Trajectory:
     """A CSV trajectory (its text, or its lines as ``files.bounded_lines`` streams them),
     validated (``validate``); errors name the file and line, echoing at most ECHO_CHARS of a
-    value. Rows are kept as doubles only (8 bytes a value), not as text."""
+    value. Rows are kept as doubles only (8 bytes a value), not as text. ``name_row``: how a
+    failed check names row k (1-based) instead of its line (a bag's "message k on TOPIC":
+    the lines are then the CSV's the bag stands for, no line of the bag's own)."""
     lines = iter(text.splitlines() if isinstance(text, str) else text)
     vals: array[float] = array("d")
     where: list[int] = []
@@ -175,7 +179,7 @@ def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str 
         raise _fail("trajectory", MISSING, "must have at least one row", source, 1)
     arr = np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
     traj = Trajectory(arr[:, 0].copy(), arr[:, 1:].copy(), source, tuple(where))
-    validate(traj, s, allow_speed=allow_speed)
+    validate(traj, s, allow_speed=allow_speed, name_row=name_row)
     return traj
 
 
@@ -271,10 +275,12 @@ def _parse_json_bytes(data: bytes, s: Scenario, source: str, allow_speed: bool) 
     return parse_trajectory_json(doc, s, source=source, allow_speed=allow_speed)
 
 
-def validate(traj: Trajectory, s: Scenario, *, allow_speed: bool = False) -> None:
+def validate(traj: Trajectory, s: Scenario, *, allow_speed: bool = False,
+             name_row: Callable[[int], str] | None = None) -> None:
     """Strictly increasing t; joint speeds within the scenario's omega (unless ``allow_speed``);
-    the subordinate's angles within its limits. Raises InputError naming the row."""
-    checks = _Checks(s, traj.source, allow_speed)
+    the subordinate's angles within its limits. Raises InputError naming the sample once: its
+    file line when it has one, else ``name_row(k)`` or "row k" (1-based)."""
+    checks = _Checks(s, traj.source, allow_speed, name_row)
     checks.add(traj.t, traj.angles, traj.lines, 0)
     checks.raise_first()
 
@@ -285,17 +291,30 @@ class _Checks:
     the failure of the first check in validate's order wins (times, then right1's and right2's
     limits, then speeds), as if the rows had been validated at once."""
 
-    def __init__(self, s: Scenario, source: str | None, allow_speed: bool) -> None:
+    def __init__(self, s: Scenario, source: str | None, allow_speed: bool,
+                 name_row: Callable[[int], str] | None = None) -> None:
         self.s, self.source, self.allow_speed = s, source, allow_speed
+        self.name_row = name_row
         self.failures: dict[int, InputError] = {}
         self.prev: tuple[float, FloatArray, int | None] | None = None
         self.omega = np.array([*s.left.omega, *s.right.omega])
+
+    def _fail(self, field: str, row: int, line: int | None, value: Any,
+              message: str) -> InputError:
+        """A failure of row ``row`` (1-based), naming the sample once: by its file line when it
+        has one (and no ``name_row``), else in the field ("right1 of message 3 on /topic",
+        "right1 (row 3)")."""
+        if self.name_row is not None:
+            return _fail(f"{field} of {self.name_row(row)}", value, message, self.source, None)
+        if line is not None:
+            return _fail(field, value, message, self.source, line)
+        return _fail(f"{field} (row {row})", value, message, self.source, None)
 
     def add(self, t: FloatArray, angles: FloatArray, lines: Iterable[int] | None,
             offset: int) -> None:
         """Rows ``offset`` .. ``offset + len(t) - 1`` (file lines ``lines``, or None)."""
         new_lines: list[int | None] = [None] * len(t) if lines is None else list(lines)
-        src, fail = self.source, self.failures
+        fail = self.failures
         if self.prev is None:
             tt, aa, ll, base = t, angles, new_lines, offset
         else:
@@ -306,18 +325,18 @@ class _Checks:
         bad = np.flatnonzero(dt <= 0)
         if 0 not in fail and len(bad):
             j = int(bad[0]) + 1
-            fail[0] = _fail(f"t (row {base + j + 1})", float(tt[j]), f"must be greater than the "
-                            f"previous time {float(tt[j - 1])!r} (times strictly increase)", src,
-                            ll[j])
+            fail[0] = self._fail("t", base + j + 1, ll[j], float(tt[j]), f"must be greater than "
+                                 f"the previous time {float(tt[j - 1])!r} (times strictly "
+                                 "increase)")
         for q in range(2):
             lo, hi = self.s.right.limits[q]
             col = angles[:, 2 + q]
             out = np.flatnonzero((col < lo - ANGLE_TOLERANCE) | (col > hi + ANGLE_TOLERANCE))
             if 1 + q not in fail and len(out):
                 k = int(out[0])
-                fail[1 + q] = _fail(f"{JOINTS[2 + q]} (row {offset + k + 1})", float(col[k]),
-                                    f"must lie within the subordinate's limits [{lo!r}, {hi!r}]",
-                                    src, new_lines[k])
+                fail[1 + q] = self._fail(JOINTS[2 + q], offset + k + 1, new_lines[k],
+                                         float(col[k]), "must lie within the subordinate's "
+                                         f"limits [{lo!r}, {hi!r}]")
         # After a time failure (which wins) a speed is no number: dt <= 0.
         if 0 not in fail and 3 not in fail and not self.allow_speed and len(tt) > 1:
             omega = self.omega
@@ -325,9 +344,11 @@ class _Checks:
             over = speed > omega[None, :] * (1.0 + SPEED_TOLERANCE)
             if np.any(over):
                 j, q = (int(x) for x in np.argwhere(over)[0])
-                fail[3] = _fail(f"{JOINTS[q]} speed (row {base + j + 2})", float(speed[j, q]),
-                                f"rad/s from the previous row exceeds omega = {float(omega[q])!r} "
-                                "rad/s (--allow-speed certifies it anyway)", src, ll[j + 1])
+                unit = "message" if self.name_row is not None else "row"
+                fail[3] = self._fail(
+                    f"{JOINTS[q]} speed", base + j + 2, ll[j + 1], MISSING,
+                    f"is {float(speed[j, q])!r} rad/s from the previous {unit}, above its omega "
+                    f"of {float(omega[q])!r} rad/s (--allow-speed certifies it anyway)")
         if len(t):
             self.prev = (float(t[-1]), angles[-1].copy(), new_lines[-1])
 
@@ -377,9 +398,9 @@ def trajectory_csv(traj: Trajectory) -> str:
 
 
 def tube_lipschitz(s: Scenario) -> float:
-    """L: the largest R_base + R_elbow over both arms' links (m/rad): a max-norm joint deviation
-    delta moves any point of any link by at most L delta."""
-    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in (0, 1))
+    """L: the largest R_base + R_elbow over both arms' parts (m/rad; links and tools): a max-norm
+    joint deviation delta moves any point of any part by at most L delta."""
+    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in parts(arm))
 
 
 def tolerance_rad(s: Scenario, cert: Certificate) -> float:
@@ -393,6 +414,15 @@ def tolerance_rad(s: Scenario, cert: Certificate) -> float:
     while k > 0 and two_l * (k / per) > cert.lower_bound_m - EPS:
         k -= 1
     return k / per
+
+
+def log_end_bound(d: Any, h: Any, w_robot: Any, w_ref: Any) -> Any:
+    """The largest deviation |x(t) - r(t)| of one joint at an instant t at most h from one
+    sample with deviation d, on the side where the log has no further sample (before its first
+    or after its last, docs/model.md §12): d + (w_robot + w_ref) h, by the triangle inequality
+    |x(t) - r(t)| <= |x(t) - x_k| + d + |r_k - r(t)| from that end alone (the first of the two
+    that ``between_samples_bound`` takes). Floats or numpy arrays (elementwise)."""
+    return d + (w_robot + w_ref) * h
 
 
 def between_samples_bound(d0: Any, d1: Any, h: Any, w_robot: Any, w_ref: Any) -> Any:
@@ -437,7 +467,8 @@ class ReferenceSpeeds:
 
 
 def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
-    """d[k, a, b]: distance between left link a and right link b at configurations (K, 4)
+    """d[k, a, b]: distance (3-D, with the heights) between left part a and right part b at
+    configurations (K, 4)
     (computed DISTANCE_BATCH configurations at a time: each is its own, so the batches change
     no value, only the temporaries' size)."""
     angles = np.asarray(angles, dtype=float).reshape(-1, 4)
@@ -446,7 +477,7 @@ def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
                                for k in range(0, len(angles), DISTANCE_BATCH)])
     left = link_rects(s.left, angles[:, :2])
     right = link_rects(s.right, angles[:, 2:])
-    return polygon_distances(left[:, :, None], right[:, None, :])
+    return part_distances(s, polygon_distances(left[:, :, None], right[:, None, :]))
 
 
 @dataclass(frozen=True)

@@ -34,9 +34,34 @@ def random_dr(draw: st.DrawFn, *, max_n: int, max_side: int, density: st.SearchS
 
 
 @st.composite
-def random_workcells(draw: st.DrawFn, *, dts: tuple[float, ...]) -> Scenario:
+def convex_tools(draw: st.DrawFn) -> list[list[float]]:
+    """A strictly convex polygon of 3 to 8 vertices in a forearm's frame (m): points of an
+    ellipse at sorted, well-separated angles, in either orientation."""
+    f = st.floats
+    n = draw(st.integers(3, 8))
+    cuts = sorted(draw(st.lists(f(0.0, 1.0), min_size=n, max_size=n)))
+    # Spread the angles so that no two vertices nearly coincide (the reader refuses those).
+    angles = [2 * math.pi * (k + 0.6 * c) / n for k, c in enumerate(cuts)]
+    cx, cy = draw(f(-0.05, 0.15)), draw(f(-0.05, 0.05))
+    ax, ay = draw(f(0.01, 0.12)), draw(f(0.01, 0.08))
+    pts = [[cx + ax * math.cos(a), cy + ay * math.sin(a)] for a in angles]
+    return pts[::-1] if draw(st.booleans()) else pts
+
+
+@st.composite
+def heights(draw: st.DrawFn) -> list[float] | None:
+    """A closed height interval (m) on a coarse scale, so that touching ends occur, or None."""
+    if draw(st.booleans()):
+        return None
+    lo = draw(st.integers(0, 4))
+    return [lo / 10, (lo + draw(st.integers(1, 3))) / 10]
+
+
+@st.composite
+def random_workcells(draw: st.DrawFn, *, dts: tuple[float, ...], tools: bool = False) -> Scenario:
     """Random workcells with coarse grids (a time step drawn from ``dts``): bases, links, widths,
-    speeds, start and goal all vary; the right base is near enough for the arms to meet."""
+    speeds, start and goal all vary; the right base is near enough for the arms to meet. With
+    ``tools``: each arm may carry a random convex tool, and its parts random heights."""
     dt = draw(st.sampled_from(dts))
     f = st.floats
 
@@ -59,5 +84,13 @@ def random_workcells(draw: st.DrawFn, *, dts: tuple[float, ...]) -> Scenario:
     size = [joint_points(limits[q][0], limits[q][1], right["omega"][q], dt) for q in range(2)]
     right["start_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
     right["goal_cell"] = [draw(st.integers(0, size[q] - 1)) for q in range(2)]
+    for a in (left, right) if tools else ():
+        z = [draw(heights()), draw(heights())]
+        if z[0] is not None and z[1] is not None:
+            a["z"] = z
+        if draw(st.booleans()):
+            a["tool"] = {"polygon": draw(convex_tools())}
+            if (tz := draw(heights())) is not None:
+                a["tool"]["z"] = tz
     return parse_scenario({"name": "random", "purpose": "hypothesis", "dt": dt, "left": left,
                            "right": right}, check_budget=False)

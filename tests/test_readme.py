@@ -21,10 +21,10 @@ MAX_WORDS = 1500
 #: Options that need not be in the synopsis, each with its reason ("*": every subcommand).
 NOT_IN_SYNOPSIS: dict[str, set[str]] = {
     "*": {"--help"},             # argparse's own; the README says `cfmpa COMMAND --help`
-    # A ROS 2 bag's options (issue 23.5): the README is at its 1,500 words, so they are in
+    # A ROS 2 bag's options: the README is at its 1,500 words, so they are in
     # `cfmpa COMMAND --help` and docs/model.md §12 only.
     "certify": {"--topic", "--joints", "--t0"},
-    "monitor": {"--topic", "--joints", "--t0"},
+    "monitor": {"--topic", "--joints", "--t0", "--allow-gaps"},
     "simulate": {"--topic", "--joints"},
 }
 

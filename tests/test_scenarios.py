@@ -3,11 +3,14 @@ and that the optimum never worsens from original to modified to tight."""
 
 from __future__ import annotations
 
+import dataclasses
+import re
 from functools import cache
 from pathlib import Path
 
 import pytest
 
+from cfmpa import cli
 from cfmpa.impl import build_dr, search_opt_path
 from cfmpa.spec import Variant, load_scenario, make_grid
 from cfmpa.spec._certificate import certify
@@ -89,3 +92,61 @@ def test_found_paths_are_valid_and_certified(name):
             assert is_path(r.path, dr, s.right.start_cell, s.right.goal_cell)
             assert (J1(r.path), J2(r.path)) == (r.J1, r.J2)
             assert certify(s, g, r.path).clear
+
+
+# --- tools and heights (docs/model.md §2, "Tools and heights") --------------------------------
+
+
+def _without(s, key):
+    """The workcell ``s`` with ``key`` ("tool" or "z") left out of both arms: what a user who
+    could not write it would have planned."""
+    return dataclasses.replace(s, left=dataclasses.replace(s.left, **{key: None}),
+                               right=dataclasses.replace(s.right, **{key: None}))
+
+
+@pytest.mark.parametrize("variant", ORDER, ids=str)
+def test_gripper_a_plan_made_without_the_tools_collides_through_them(variant):
+    s, g, _, best = planned("gripper", variant)
+    assert best.status is SearchStatus.FOUND and certify(s, g, best.path).clear
+    planar = _without(s, "tool")
+    blind = search_opt_path(build_dr(planar, variant, g), s.right.start_cell, s.right.goal_cell)
+    assert blind.status is SearchStatus.FOUND
+    assert certify(planar, g, blind.path).clear          # safe for arms that carry nothing
+    cert = certify(s, g, blind.path)                      # but the real arms carry tools
+    assert not cert.clear and cert.contact is not None
+    assert 3 in cert.contact[1]                           # part 3: a tool is in the contact
+
+
+def test_gripper_cfmpa_certify_with_the_tools_finds_the_contact_of_a_plan_without(tmp_path, capsys):
+    text = (ROOT / "gripper.toml").read_text()
+    blind = tmp_path / "blind.toml"
+    blind.write_text(re.sub(r"\n\[(left|right)\.tool\][^\n]*\npolygon = [^\n]*\n", "\n", text))
+    planar = load_scenario(blind)
+    assert planar.left.tool is None and planar.right.tool is None
+    assert cli.main(["plan", str(blind), "--out", str(tmp_path / "plan")]) == 0
+    capsys.readouterr()
+    code = cli.main(["certify", "gripper", "--traj", str(tmp_path / "plan" / "traj.csv"),
+                     "--json", str(tmp_path / "cert.json")])
+    got = capsys.readouterr()
+    out = got.out + got.err
+    assert code == 1
+    assert "NOT CLEAR: contact at" in out and "left tool and right tool" in out
+
+
+def test_levels_heights_shorten_the_plan():
+    for variant in ORDER:
+        s, g, dr, best = planned("levels", variant)
+        flat = _without(s, "z")
+        flat_best = search_opt_path(build_dr(flat, variant, g), s.right.start_cell,
+                                    s.right.goal_cell)
+        assert best.status is SearchStatus.FOUND and flat_best.status is SearchStatus.FOUND
+        # The subordinate no longer waits for the principal's forearm: J1 drops to the
+        # Manhattan distance, and fewer cells are blocked.
+        assert (best.J1, best.J2) < (flat_best.J1, flat_best.J2)
+        assert best.J1 == abs(s.right.goal_cell[0] - s.right.start_cell[0]) + abs(
+            s.right.goal_cell[1] - s.right.start_cell[1])
+        assert 0 < dr.sum() < build_dr(flat, variant, g).sum()
+        assert certify(s, g, best.path).clear
+        # Planned with the heights, the motion touches in the plane (the forearms cross above
+        # one another): without the heights it would not be clear.
+        assert not certify(flat, g, best.path).clear

@@ -91,3 +91,18 @@ def test_plan_and_prove_run_from_an_unrelated_folder(venv: Path, tmp_path: Path)
     assert "Scenario.default.containment" in ids
     # The prove run records the commit the wheel was built from, not None.
     assert results["run"]["git"]["commit"] == BUILT_FROM["commit"]
+
+
+def test_the_wheel_carries_docs_model_md_and_cfmpa_docs_prints_where(venv: Path, tmp_path: Path):
+    # The help cites docs/model.md: the wheel carries it (setup.py's build_py), and
+    # `cfmpa docs` prints where it is installed, from any folder.
+    import zipfile
+
+    (wheel,) = venv.parent.glob("cfmpa-*.whl")
+    with zipfile.ZipFile(wheel) as z:
+        assert z.read("cfmpa/docs/model.md") == (ROOT / "docs" / "model.md").read_bytes()
+    out = _run([str(venv / "bin" / "cfmpa"), "docs"], cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    path = Path(out.stdout.strip())
+    assert path.parts[-3:] == ("cfmpa", "docs", "model.md") and venv in path.parents
+    assert path.read_text(encoding="utf-8").startswith("# The cfmpa model")

@@ -38,7 +38,7 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert set(res) == {"meta", "builtdr", "builtdr_profile", "search", "shapely", "scaling",
                         "plan", "dr_cli", "check", "prove", "contracts", "one_degree", "monitor",
-                        "plan_scaling", "certify_stream", "targets", "informational"}
+                        "plan_scaling", "certify_stream", "tools", "targets", "informational"}
     assert [r["dt"] for r in res["plan_scaling"]["rows"]] == [0.16, 0.08]
     assert all("error" not in r and r["bytes_per_cell"] > 0 for r in res["plan_scaling"]["rows"])
     for v in Variant:
@@ -248,3 +248,17 @@ def test_the_slow_trajectory_is_valid_and_certified_clear(tmp_path):
     run.slow_trajectory_csv(path, 500, 0.01)
     info, cert, _ = certify_trajectory_file(path, load_scenario(BUNDLED_DIR / "default.toml"))
     assert info.rows == 500 and cert.clear and cert.intervals == 499
+
+
+def test_bench_only_tools_gives_each_workcells_ratio_to_the_default(tmp_path):
+    proc = subprocess.run([sys.executable, str(ROOT / "bench" / "run.py"), "--quick", "--only",
+                           "tools", "--out", str(tmp_path)], capture_output=True, text=True,
+                          cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    sec = json.loads((tmp_path / "results.json").read_text())["tools"]
+    assert list(sec["rows"]) == ["default", "gripper", "levels"]
+    for name, r in sec["rows"].items():
+        assert TIMING <= set(r), (name, r)
+        assert r["ratio_to_default"] == round(r["median_s"] / sec["rows"]["default"]["median_s"], 2)
+    assert sec["rows"]["default"]["ratio_to_default"] == 1.0
+    assert "BuiltDR fast with tools and heights" in proc.stdout

@@ -220,7 +220,7 @@ def test_another_scenarios_folder_says_what_it_expects(tmp_path: Path):
 def test_the_bundled_folder_says_what_it_expects():
     from cfmpa.proofs import BUNDLED_DIR
     note = scenarios_note(BUNDLED_DIR)
-    assert note.startswith("scenarios: the 5 bundled workcells, expecting "
+    assert note.startswith("scenarios: the 7 bundled workcells, expecting "
                            "Scenario.default.{time_grid,cspace_grid,margin_side,containment,"
                            "translation_original,translation_modified,translation_tight}, ")
     assert "\n" not in note and "Scenario.original-fails.{" in note

@@ -351,7 +351,7 @@ def test_section_one_gives_the_verdict_per_workcell_first(report, tiny_file):
             assert f'id="assumption-{a.replace(".", "-").replace("_", "-").lower()}"' in html
     first = html[:html.index('id="provenance"')]
     assert "1. Verdict per workcell" in first and "sampled minimum" in first
-    assert "proved clearance" in first and "mm at the tool tip" in first
+    assert "proved clearance" in first and "mm at the farthest point" in first
 
 
 def test_section_one_fails_a_plan_whose_proof_or_certificate_fails(report):

@@ -111,7 +111,7 @@ def test_each_found_plan_has_its_tube_in_json_and_html(report):
             2 * tube["lipschitz_m_per_rad"] * 1e-6 + 1e-9)
         assert f'<td class="n">{pl["tolerance_rad"]:.6f}</td>' in table
         assert f"{1000 * pl['margin_m']:.2f} mm" in table
-        assert f"{500 * pl['margin_m']:.2f} mm" in table           # L delta, at the tool tip
+        assert f"{500 * pl['margin_m']:.2f} mm" in table           # L delta, at the farthest point
     # The table says what the condition is and why c - 2 L delta is small.
     assert "The condition is c − 2 L δ &gt; 0, and δ is\nchosen as large as it allows" in text
     assert "c − 2 L δ (must be &gt; 0)" in table

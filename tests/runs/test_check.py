@@ -371,3 +371,42 @@ def test_a_plan_file_is_read_within_its_limit(tmp_path, monkeypatch):
     with pytest.raises(InputError) as e:
         read_plan(big)
     assert "limit of 1,000 bytes" in e.value.render()
+
+
+def test_a_dr_of_another_plan_says_which_failures_follow_from_the_first(outputs, tmp_path,
+                                                                           capsys):
+    # The original variant's D_R checked with the modified plan: D_R fails post.cells, and the
+    # three FAILs after it (pre.dr.spec, the path blocked in that D_R, optimality judged on it)
+    # say they follow from it; the lengths are in mm (docs/contributing.md, "Standards").
+    s = load_scenario(outputs / "small.toml")
+    write_plan(plan(s, "original", contracts="off"), tmp_path / "orig")
+    code = checked(outputs / "small.toml", tmp_path / "orig" / "dr.npy",
+                   outputs / "ref" / "plan.json")
+    out = capsys.readouterr().out
+    assert code == 1
+    fails = [x for x in out.splitlines() if x.startswith("FAIL")]
+    follows = [x for x in fails if "(follows from the failed " in x]
+    assert [x.split(":")[0] for x in follows] == [
+        "FAIL  Theorem 4 pre.dr.spec", "FAIL  Theorem 4 post.is_path",
+        "FAIL  Theorem 4 post.optimal"]
+    assert follows[0].endswith("(follows from the failed Theorem 3 post.cells above)")
+    assert follows[2].endswith("(follows from the failed Theorem 4 post.is_path above)")
+    assert any(x.startswith("FAIL  Theorem 3 post.cells") and "follows" not in x for x in fails)
+    assert out.rstrip().splitlines()[-1] == (
+        f"result: {len(fails)} of 13 checks failed, 3 of them following from an earlier failure")
+    cert = next(x for x in out.splitlines() if "continuous-time certificate: clear" in x)
+    assert " mm at every instant" in cert and " m at" not in cert.replace(" mm at", "")
+    # A value in metres is shown in mm, an angle in rad with its degrees.
+    assert any(x.strip().startswith("distance was ") and x.endswith(" mm")
+               for x in out.splitlines())
+    assert any(x.strip().startswith("angles was [") and "deg)" in x for x in out.splitlines())
+
+
+def test_a_jump_in_the_path_is_its_own_failure_not_one_that_follows():
+    from cfmpa.runs._check import CheckLine, _consequences
+
+    lines = [CheckLine("FAIL", "Theorem 3 post.cells: a cell is blocked"),
+             CheckLine("FAIL", "Theorem 4 post.is_path: step 3: a jump", (("clause", "jump"),)),
+             CheckLine("FAIL", "Theorem 4 post.costs: J1 is not the path's")]
+    got = _consequences(lines)
+    assert [x.follows for x in got] == [None, None, None]

@@ -15,8 +15,8 @@ from rosbags.typesys import Stores, get_typestore
 
 import factory
 from cfmpa.cli import main
-from cfmpa.runs import (BLOCK_ROWS, BagOptions, Excursion, bag_rows, log_csv, monitor_json,
-                        monitor_log, monitor_rows, simulate_log)
+from cfmpa.runs import (BLOCK_ROWS, MISSING_MESSAGES, BagOptions, Excursion, bag_rows, log_csv,
+                        monitor_json, monitor_log, monitor_rows, simulate_log)
 from cfmpa.spec import TRAJECTORY_COLUMNS, load_trajectory, tolerance_rad, trajectory_csv
 
 DOC = factory.doc(right__start_cell=[2, 8], right__goal_cell=[13, 5])
@@ -277,8 +277,7 @@ def test_simulate_out_mcap_round_trips(cell, tmp_path, capsys):
         JOINT_NAMES.split(","))), block_rows=1000)])
     assert got.shape == want.shape
     assert np.array_equal(got[:, 1:], want[:, 1:])                 # angles: the same doubles
-    assert np.max(np.abs(got[:, 0] - want[:, 0])) <= 1e-9           # t: to the ns
-    assert got[-1, 0] >= want[-1, 0]                               # the last one rounded up
+    assert np.max(np.abs(got[:, 0] - want[:, 0])) <= 1e-9           # t: to the nearest ns
     capsys.readouterr()
     c_csv, d_csv = monitor_doc(scen, traj_csv, csv, tmp_path / "c.json")
     c_bag, d_bag = monitor_doc(scen, traj_csv, bag, tmp_path / "b.json", "--joints", JOINT_NAMES)
@@ -286,4 +285,198 @@ def test_simulate_out_mcap_round_trips(cell, tmp_path, capsys):
     for key in ("status", "samples", "outside", "first_outside_line", "first_outside_joint",
                 "unobserved"):
         assert d_csv[key] == d_bag[key], key
-    assert "message " in capsys.readouterr().err                  # the user is told the message
+    assert "message " in capsys.readouterr().out                  # the user is told the message
+
+
+# --- the ends of a log, declared counts, names twice, --t0, simulate's outputs (§12) ----------
+
+
+def _shifted(traj, tmp_path):
+    """The trajectory with its times shifted by an offset c for which the nanosecond grid falls
+    short of its float end (round(t_end * 1e9) / 1e9 < t_end), as a bag's stamps do: (its CSV,
+    the shifted trajectory)."""
+    for c in np.arange(1, 200) * 0.1:                  # 0.1 steps as floats: 2.3000000000000003
+        end = float(traj.t[-1] + c)
+        if round(end * 1e9) / 1e9 < end:
+            break
+    else:
+        raise AssertionError("no offset puts the end between two nanoseconds")
+    moved = type(traj)(traj.t + c, traj.angles)
+    csv = tmp_path / "moved.csv"
+    csv.write_text(trajectory_csv(moved))
+    return csv, moved
+
+
+def test_a_bag_of_the_trajectorys_own_samples_with_nanosecond_stamps_is_inside_exit_0(
+        cell, tmp_path, capsys):
+    # docs/model.md §12: the ends are covered by the one-sided bound, so stamps rounded to the
+    # nanosecond (every ROS bag's), which end 1e-16 s before the trajectory's float end, leave
+    # nothing unobserved: the log of the trajectory's own samples is inside.
+    s, scen, _, traj, tol = cell
+    csv, moved = _shifted(traj, tmp_path)
+    t, a = simulate_log(moved)                                  # its own samples, 1 ms apart
+    ns = np.round(t * 1e9).astype(np.int64)
+    assert 0 < moved.t[-1] - ns[-1] / 1e9 < 1e-12              # the case: the end falls short
+    bag = write_bag(tmp_path / "own", ns, a, TRAJECTORY_COLUMNS[1:])
+    code, doc = monitor_doc(scen, csv, bag, tmp_path / "m.json", "--t0", "0")
+    assert code == 0 and doc["status"] == "inside" and doc["unobserved"] is None
+    assert doc["covered_fraction"] == 1.0 and doc["t_last_s"] < moved.t[-1]
+    assert "inside;" in capsys.readouterr().out
+
+
+def _flip_message_opcode(mcap: Path, k: int) -> None:
+    """Make message record k (0-based) of an uncompressed, chunked mcap file an unknown record,
+    which a reader skips: the summary still counts it (one corrupt byte)."""
+    data = bytearray(mcap.read_bytes())
+    at, seen = 8, 0
+    while at < len(data):
+        op, length = data[at], int.from_bytes(data[at + 1:at + 9], "little")
+        body = at + 9
+        if op == 0x06:                                          # a chunk: walk its records
+            size = int.from_bytes(data[body + 28:body + 32], "little")
+            assert data[body + 32:body + 32 + size] == b""     # no compression
+            rec = body + 32 + size + 8
+            end = rec + int.from_bytes(data[body + 32 + size:rec], "little")
+            while rec < end:
+                if data[rec] == 0x05:
+                    if seen == k:
+                        data[rec] = 0x7F
+                        mcap.write_bytes(bytes(data))
+                        return
+                    seen += 1
+                rec += 9 + int.from_bytes(data[rec + 1:rec + 9], "little")
+        at = body + length
+    raise AssertionError(f"no message record {k}")
+
+
+def test_a_message_the_bag_declares_but_cannot_give_is_exit_2_naming_both_counts(
+        cell, tmp_path, capsys):
+    s, scen, traj_csv, traj, tol = cell
+    ns, t, a = samples(traj, tol, samples=200)
+    folder = write_bag(tmp_path / "bag", ns, a, TRAJECTORY_COLUMNS[1:])
+    inner = next(folder.glob("*.mcap"))
+    lone = tmp_path / "lone.mcap"
+    lone.write_bytes(inner.read_bytes())
+    _flip_message_opcode(lone, 120)
+    out = tmp_path / "m.json"
+    argv = ["monitor", str(scen), "--traj", str(traj_csv), "--log", str(lone), "--json", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert ("--log has 199 messages on /joint_states that can be read, of the 200 the bag "
+            "declares (its mcap summary): 1 skipped or lost") in err
+    assert "--allow-gaps" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+    # --allow-gaps: monitored all the same, the time around the lost message unobserved.
+    assert main([*argv, "--allow-gaps"]) == 1
+    doc = json.loads(out.read_text())
+    assert doc["status"] == "unobserved" and doc["missing_messages"] == 1
+    (u,) = doc["unobserved"]["listed"]
+    assert u["why"] == MISSING_MESSAGES and u["line"] == 121       # message 120, then the lost
+    assert u["t_s"] == pytest.approx(t[119]) and u["length_s"] == pytest.approx(t[121] - t[119])
+    said = capsys.readouterr().out
+    assert "1 message(s) the bag declares on /joint_states were not read" in said
+    # A certify --traj bag has no --allow-gaps: a trajectory missing a waypoint is another one.
+    assert main(["certify", str(scen), "--traj", str(lone)]) == 2
+    assert "199 messages" in capsys.readouterr().err
+
+
+def test_a_folder_whose_metadata_declares_more_is_exit_2_or_wholly_unobserved(
+        cell, tmp_path, capsys):
+    s, scen, traj_csv, traj, tol = cell
+    ns, t, a = samples(traj, tol, samples=50)
+    folder = write_bag(tmp_path / "bag", ns, a, TRAJECTORY_COLUMNS[1:],
+                       storage=StoragePlugin.SQLITE3)
+    meta = folder / "metadata.yaml"
+    meta.write_text(meta.read_text().replace("message_count: 50", "message_count: 52"))
+    argv = ["monitor", str(scen), "--traj", str(traj_csv), "--log", str(folder)]
+    assert main(argv) == 2
+    assert "of the 52 the bag declares (its metadata.yaml): 2 skipped" in capsys.readouterr().err
+    # No message index says when they were lost (sqlite3): no time is vouched for.
+    assert main([*argv, "--allow-gaps", "--json", str(tmp_path / "m.json")]) == 1
+    doc = json.loads((tmp_path / "m.json").read_text())
+    assert doc["status"] == "unobserved" and doc["covered_fraction"] == 0.0
+    assert "2 message(s) the bag declares were not read" in doc["unobserved"]["first"]["why"]
+    # --allow-gaps is for a bag log only.
+    log = tmp_path / "log.csv"
+    log.write_bytes(log_csv(t, a))
+    assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log", str(log),
+                 "--allow-gaps"]) == 2
+    assert "--allow-gaps applies to a ROS 2 bag log only" in capsys.readouterr().err
+
+
+def test_a_joint_named_twice_in_a_message_is_exit_2(cell, tmp_path, capsys):
+    s, scen, traj_csv, traj, tol = cell
+    ns, t, a = samples(traj, tol, samples=20)
+    twice = np.column_stack([a, a[:, 2]])                       # right1's name again, last
+    bag = write_bag(tmp_path / "bag", ns, twice, [*TRAJECTORY_COLUMNS[1:], "right1"])
+    out = tmp_path / "m.json"
+    assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log", str(bag), "--json",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert ("error: joint 'right1' is named twice in message 1 on /joint_states (at positions 2 "
+            "and 4 of its 5 names)") in err
+    assert not out.exists() and "Traceback" not in err
+
+
+def test_every_sample_outside_well_past_the_start_suggests_t0(cell, tmp_path, capsys):
+    # A bag recorded from t = 0.3 s on the trajectory's clock: by default t counts from its
+    # first stamp, so every sample is compared 0.3 s early.
+    s, scen, traj_csv, traj, tol = cell
+    t, a = simulate_log(traj)
+    keep = t >= 0.3
+    ns = np.round(t[keep] * 1e9).astype(np.int64)
+    bag = write_bag(tmp_path / "late", ns, a[keep], TRAJECTORY_COLUMNS[1:])
+    assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log", str(bag)]) == 1
+    out = capsys.readouterr().out
+    n = int(keep.sum())
+    assert f"outside ({n} of {n} samples)" in out
+    hint = next(x for x in out.splitlines() if x.startswith("hint"))
+    assert "t counts from the bag's first stamp, 0.3 s" in hint and "--t0 0" in hint
+    # Given --t0 0, it is the trajectory's time: no sample outside (its first 0.3 s are
+    # unobserved: the log began late), and no hint.
+    assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log", str(bag),
+                 "--t0", "0"]) == 1
+    out = capsys.readouterr().out
+    assert ": unobserved (1 interval(s)" in out and "hint" not in out and "outside (" not in out
+
+
+def test_simulate_writes_a_bag_for_mcap_db3_or_a_folder_and_csv_otherwise(cell, tmp_path, capsys):
+    s, scen, traj_csv, traj, tol = cell
+    base = ["simulate", str(scen), "--traj", str(traj_csv), "--samples", "30", "--out"]
+    for name in ("run.mcap", "run.db3", "rundir/", "run.csv", "run"):
+        assert main([*base, f"{tmp_path}/{name}"]) == 0, name
+    assert (tmp_path / "run.db3").read_bytes().startswith(b"SQLite format 3\0")
+    assert (tmp_path / "run.mcap").read_bytes().startswith(b"\x89MCAP0\r\n")
+    assert sorted(p.name for p in (tmp_path / "rundir").iterdir()) == ["metadata.yaml",
+                                                                       "rundir.mcap"]
+    for name in ("run.csv", "run"):
+        assert (tmp_path / name).read_text().startswith("t,left1,left2,right1,right2\n")
+    said = capsys.readouterr().out
+    assert "wrote     " + str(tmp_path / "run.db3") + " (ROS 2 bag, sqlite3)" in said
+    csv = np.loadtxt(tmp_path / "run.csv", delimiter=",", skiprows=1)
+    for name in ("run.mcap", "run.db3", "rundir"):
+        got = np.concatenate([b for _, b in bag_rows(tmp_path / name, BagOptions(),
+                                                     block_rows=1000)])
+        assert np.array_equal(got[:, 1:], csv[:, 1:]), name
+    # A bag folder is replaced whole; a path ending in / that is a file or another folder is
+    # refused before anything is written.
+    assert main([*base, str(tmp_path / "rundir")]) == 0
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "keep.txt").write_text("mine")
+    for bad, words in ((f"{other}/", "is a folder that is not a ROS 2 bag"),
+                       (f"{tmp_path / 'run.csv'}/", "ends in / but is a file")):
+        assert main([*base, bad]) == 2
+        err = capsys.readouterr().err
+        assert words in err and len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in other.iterdir()) == ["keep.txt"]
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]   # no temporary left
+
+
+def test_a_corrupt_metadata_yaml_is_one_line(cell, tmp_path, capsys):
+    s, scen, traj_csv, traj, tol = cell
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    (bag / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  version: [\n  - a: :\n")
+    assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log", str(bag)]) == 2
+    err = capsys.readouterr().err
+    assert "is not a readable ROS 2 bag" in err and len(err.strip().splitlines()) == 1

@@ -36,7 +36,8 @@ def test_link_name_is_one_based_with_words():
     assert link_name("left", 2) == "left link 2 (forearm)"
     assert link_name("right", 1) == "right link 1 (upper arm)"
     assert LINK_WORDS == {1: "upper arm", 2: "forearm"}
-    for bad in (("left", 0), ("right", 3), ("middle", 1)):
+    assert link_name("right", 3) == "right tool"      # part 3: the tool (docs/model.md §2)
+    for bad in (("left", 0), ("right", 4), ("middle", 1)):
         with pytest.raises(ValueError):
             link_name(*bad)
     d = np.full((2, 2), 1.0)
@@ -82,4 +83,4 @@ def test_monitor_names_the_forearms_of_a_sample_in_contact(cell, tmp_path, capsy
     doc = json.loads((tmp_path / "m.json").read_text())
     c = doc["contact"]
     assert c["in_contact"] is True and c["links"] == [2, 2] and c["links_text"] == FOREARMS
-    assert f"IN CONTACT ({FOREARMS})" in capsys.readouterr().err
+    assert f"IN CONTACT ({FOREARMS})" in capsys.readouterr().out   # with the verdict

@@ -72,11 +72,25 @@ def test_trailing_blank_lines_are_no_rows(s):
 
 
 def test_a_joint_too_fast_is_refused_naming_row_joint_and_speed_unless_allowed(s):
+    # The sample named once (its line, no row besides), the speed and its limit in one sentence.
     text = HEADER + "0,0.3,0.8,0.5,1\n1,0.3,0.8,0.5,1\n1.5,0.3,0.8,1.5,1\n"
     e = _err(text, s)
-    assert e.line == 4 and "right1 speed (row 3)" in e.render() and "omega" in e.render()
-    assert e.value == pytest.approx(2.0)
+    assert e.line == 4 and e.render() == (
+        "traj.csv:4: error: right1 speed is 2.0 rad/s from the previous row, above its omega "
+        "of 1.0 rad/s (--allow-speed certifies it anyway)")
+    assert "row 3" not in e.render() and e.render().count("2.0") == 1
     assert parse_trajectory_csv(text, s, allow_speed=True).rows == 3
+    # Without lines (JSON) the row is named instead; a bag names its message (name_row).
+    doc = {"t": [0, 1, 1.5], "left1": [0.3] * 3, "left2": [0.8] * 3, "right1": [0.5, 0.5, 1.5],
+           "right2": [1, 1, 1]}
+    with pytest.raises(InputError) as info:
+        parse_trajectory_json(doc, s, source="t.json")
+    assert info.value.render().startswith("t.json: error: right1 speed (row 3) is 2.0 rad/s")
+    with pytest.raises(InputError) as info:
+        parse_trajectory_csv(text, s, source="run.mcap", name_row=lambda k: f"message {k} on /js")
+    assert info.value.line is None and info.value.render().startswith(
+        "run.mcap: error: right1 speed of message 3 on /js is 2.0 rad/s from the previous "
+        "message, above its omega of 1.0 rad/s")
 
 
 def test_json_columns(s, tmp_path):
