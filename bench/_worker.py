@@ -50,13 +50,17 @@ def load(spec: dict[str, Any]):
 
 
 def timed(fn: Callable[[], Any], runs: int, warmup: int, budget_s: float
-          ) -> tuple[list[float], Any]:
+          ) -> tuple[list[float], Any, float | None]:
+    """The timed runs' seconds, the last result, and the first warm-up call's seconds (the cold
+    call: the first in the process), None without a warm-up."""
     out = None
     first = None
+    cold = None
     for _ in range(warmup):
         t0 = time.perf_counter()
         out = fn()
         first = time.perf_counter() - t0
+        cold = first if cold is None else cold
     if first is not None and first * runs > budget_s:
         runs = max(1, math.floor(budget_s / first))
     times = []
@@ -64,11 +68,11 @@ def timed(fn: Callable[[], Any], runs: int, warmup: int, budget_s: float
         t0 = time.perf_counter()
         out = fn()
         times.append(time.perf_counter() - t0)
-    return times, out
+    return times, out, cold
 
 
 def item_builtdr(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any]]:
-    from cfmpa.impl import build_dr, build_dr_fast, right_regions
+    from cfmpa.impl import build_dr, build_dr_fast, load_fast_kernels, right_regions
     from cfmpa.spec import make_grid
 
     s = load(it["scenario"])
@@ -77,6 +81,10 @@ def item_builtdr(it: dict[str, Any]) -> tuple[Callable[[], Any], dict[str, Any]]
     info = {"cells": int(np.prod(g.shape)), "grid": [g.N + 1, g.m, g.n]}
     if impl == "reference":
         return (lambda: build_dr(s, it["variant"], g)), info
+    if impl != "reference":
+        # The kernels loaded first (from numba's cache), so the cold call (the warm-up) is the
+        # first call's own work, and the warm ones are the calls after it.
+        info["kernel_load_s"] = load_fast_kernels()
     if impl == "fast":
         return (lambda: build_dr_fast(s, it["variant"], g, progress=False)), info
     rr = right_regions(s, g)   # "fast_regions_given": the right arm's regions computed once
@@ -234,8 +242,8 @@ def main() -> None:
     for it in json.loads(sys.argv[1]):
         before = rss_mb()
         fn, info = ITEMS[it["kind"]](it)
-        times, _ = timed(fn, it["runs"], it["warmup"], it.get("budget_s", math.inf))
-        results.append({"times_s": times, "rss_before_mb": round(before, 1),
+        times, _, cold = timed(fn, it["runs"], it["warmup"], it.get("budget_s", math.inf))
+        results.append({"times_s": times, "cold_s": cold, "rss_before_mb": round(before, 1),
                         "peak_rss_mb": round(peak_mb(), 1), "info": info})
     print(json.dumps(results))
 

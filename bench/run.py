@@ -9,9 +9,11 @@ is that process's high-water mark so far; no warm-up). Never imported by the pac
 
 The table ends with the project's performance targets (``targets``: full checking's,
 the monitor's throughput, `make prove`'s time), each met or missed, and an informational
-section of former targets. ``builtdr_profile`` splits BuiltDR fast into
-its stages (the numbers behind the 0.15 s target's note). `make prove` itself (`cfmpa prove
---audit DIR`, one run, a minute or two) is measured only with --prove, which `make bench` passes.
+section of former targets. ``builtdr_profile`` splits BuiltDR fast into its stages (the numbers
+behind the 0.10 s target's note); the BuiltDR items report the cold call (the first in the
+process, kernels loaded: ``cold_s``) apart from the warm ones (the median). `make prove` itself
+(`cfmpa prove --audit DIR`, one run, a minute or two) is measured only with --prove, which `make
+bench` passes.
 
 The campaign item (`cfmpa compare`, a fixed campaign with 1 and 2 local workers, and the
 speed-up) runs in the full bench and alone with ``--only campaign`` (merged into an existing
@@ -22,7 +24,9 @@ memory and bytes a cell (docs/model.md §3's cell budget rests on it). And ``cer
 (``--only certify_stream``): `cfmpa certify` of a long slow trajectory of 10^6 rows (and of
 10^5, to show the peak does not grow with the rows), seconds and the child's peak memory. And
 ``tools`` (``--only tools``): BuiltDR fast of the bundled gripper and levels workcells, with
-their ratio to the default workcell's.
+their ratio to the default workcell's. And ``first_run`` (``--only first_run``; --quick too):
+`cfmpa plan default` with a fresh NUMBA_CACHE_DIR (the kernels compiled) against later runs
+with that cache, the first at most 2x a later one.
 """
 
 from __future__ import annotations
@@ -119,7 +123,8 @@ def in_workers(cfg: Config, items: list[dict[str, Any]]) -> list[dict[str, Any]]
             raise SystemExit(f"bench worker failed on {group}:\n{proc.stderr}")
         for r in json.loads(proc.stdout.strip().splitlines()[-1]):
             out.append(stats(r["times_s"], peak_rss_mb=r["peak_rss_mb"],
-                             rss_before_mb=r["rss_before_mb"], info=r["info"]))
+                             rss_before_mb=r["rss_before_mb"], cold_s=r.get("cold_s"),
+                             info=r["info"]))
     return out
 
 
@@ -138,13 +143,15 @@ def cli_has(command: str) -> bool:
 
 def cli_run(cfg: Config, argv: list[str], program: list[str] | None = None, *,
             runs: int | None = None, warmup: int | None = None,
-            env: dict[str, str] | None = None) -> dict[str, Any]:
+            env: dict[str, str] | None = None, stderr_of_first: bool = False) -> dict[str, Any]:
     """Time a `cfmpa` command (or ``program``) in its own process; peak memory from that
     process's rusage (ru_maxrss: the largest of it and the children it waited for).
-    ``runs`` and ``warmup`` override the configuration's; ``env`` is added to the environment."""
+    ``runs`` and ``warmup`` override the configuration's; ``env`` is added to the environment;
+    ``stderr_of_first``: the first run's stderr lines go into the result (``stderr_lines``)."""
     exe = program or [str(cfmpa_exe())]
     times: list[float] = []
     peak = 0.0
+    first_err: list[str] | None = None
     runs = cfg.runs if runs is None else runs
     warmup = cfg.warmup if warmup is None else warmup
     for n in range(warmup + runs):
@@ -156,7 +163,10 @@ def cli_run(cfg: Config, argv: list[str], program: list[str] | None = None, *,
             seconds = time.perf_counter() - t0
             proc.returncode = os.waitstatus_to_exitcode(status)
             err.seek(0)
-            message = err.read().decode(errors="replace").strip()[-500:]
+            text = err.read().decode(errors="replace")
+            message = text.strip()[-500:]
+            if first_err is None:
+                first_err = text.splitlines()[-20:]
         if proc.returncode != 0:
             return {"error": f"exit {proc.returncode}: {message}", "argv": argv,
                     "seconds": seconds, "peak_rss_mb": round(usage.ru_maxrss / 1024, 1)}
@@ -168,7 +178,8 @@ def cli_run(cfg: Config, argv: list[str], program: list[str] | None = None, *,
         times.append(seconds)
         if len(times) >= runs:
             break
-    return stats(times, peak_rss_mb=round(peak, 1), argv=argv)
+    extra = {"stderr_lines": first_err} if stderr_of_first else {}
+    return stats(times, peak_rss_mb=round(peak, 1), argv=argv, **extra)
 
 
 def scenario_file(spec: dict[str, Any], folder: Path) -> Path:
@@ -293,6 +304,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
     res["plan_scaling"] = plan_scaling_section(cfg, tmp) if have_cli else no_cli
     res["certify_stream"] = certify_stream_section(cfg, tmp) if have_cli else no_cli
     res["tools"] = tools_section(cfg, tmp)
+    res["first_run"] = first_run_section(cfg, tmp) if have_cli else no_cli
     res["targets"] = targets(res, cfg)
     res["informational"] = informational(res, cfg)
     res["meta"]["bench_wall_s"] = round(time.perf_counter() - t_start, 1)
@@ -341,6 +353,68 @@ def plan_scaling_section(cfg: Config, tmp: Path) -> dict[str, Any]:
                     "scaled to the grid), one run per dt in a fresh process; peak_mib is its "
                     "ru_maxrss, bytes_per_cell that over (N + 1) m n; time_exponent: the slope "
                     "of log seconds against log cells (least squares)"}
+
+
+def builtdr_only(cfg: Config, res: dict[str, Any]) -> None:
+    """``--only builtdr``: BuiltDR fast (right regions computed and given) and its profile, per
+    variant, into ``res`` (the reference's entries are kept from the last full run)."""
+    base = default_at(cfg.dt)
+    impls = ("fast", "fast_regions_given")
+    items = [{"kind": "builtdr", "scenario": base, "variant": v, "impl": impl}
+             for v in VARIANTS for impl in impls]
+    items += [{"kind": "builtdr_profile", "scenario": base, "variant": v} for v in VARIANTS]
+    out = iter(in_workers(cfg, items))
+    for v in VARIANTS:
+        for impl in impls:
+            res.setdefault("builtdr", {}).setdefault(v, {})[impl] = next(out)
+    res["builtdr_profile"] = builtdr_profile(res, {v: next(out) for v in VARIANTS})
+
+
+def builtdr_lines(res: dict[str, Any]) -> list[str]:
+    lines = ["", "BuiltDR fast in process, cold (first call, kernels loaded) and warm (median):"]
+    for v in VARIANTS:
+        d = res["builtdr"][v]["fast"]
+        if "median_s" in d:
+            lines.append(f"  {v:9s} cold {d.get('cold_s') or float('nan'):.3f} s, warm "
+                         f"{d['median_s']:.3f} s (min {d['min_s']:.3f}, max {d['max_s']:.3f}, "
+                         f"{d['runs']} runs)")
+    return lines + profile_lines(res.get("builtdr_profile"))
+
+
+#: The first run's target: a first `cfmpa plan default` at most this many times a later one.
+FIRST_RUN_LIMIT = 2.0
+
+
+def first_run_section(cfg: Config, tmp: Path) -> dict[str, Any]:
+    """`cfmpa plan default` as on a new machine: one run in a fresh process with a fresh
+    NUMBA_CACHE_DIR (the kernels compile, in parallel processes, docs/model.md §7.5), then
+    ``min(runs, 3)`` later runs with that cache (loaded, not compiled): seconds, the ratio of the
+    first to the later runs' median, and the first run's stderr lines (its compile line and
+    seconds; a later run prints none)."""
+    cache = tmp / "first-run-numba-cache"
+    env = {"NUMBA_CACHE_DIR": str(cache)}
+    argv = ["plan", "default", "--out", str(tmp / "first-run")]
+    first = cli_run(cfg, argv, runs=1, warmup=0, env=env, stderr_of_first=True)
+    later = cli_run(cfg, argv, runs=min(cfg.runs, 3), warmup=0, env=env, stderr_of_first=True)
+    out: dict[str, Any] = {"argv": argv, "first": first, "later": later,
+                           "limit_x": FIRST_RUN_LIMIT,
+                           "note": "first: one fresh process, fresh NUMBA_CACHE_DIR (compiles); "
+                                   "later: fresh processes with that cache, median; whole "
+                                   "processes, wall seconds"}
+    if "median_s" in first and "median_s" in later:
+        out["ratio_first_over_later"] = round(first["median_s"] / later["median_s"], 2)
+        out["compile_lines"] = [x for x in first.get("stderr_lines") or [] if "compil" in x]
+        out["later_prints_compile"] = any("compil" in x for x in later.get("stderr_lines") or [])
+    return out
+
+
+def first_run_lines(sec: dict[str, Any]) -> list[str]:
+    if "ratio_first_over_later" not in sec:
+        return ["", f"first run: {failed(sec.get('first')) or failed(sec.get('later')) or sec}"]
+    return ["", f"first `cfmpa plan default` (fresh numba cache) {sec['first']['median_s']:.1f} s, "
+                f"later {sec['later']['median_s']:.1f} s (median of {sec['later']['runs']}): "
+                f"{sec['ratio_first_over_later']:.2f}x (target <= {sec['limit_x']:g}x); "
+                + "; ".join(sec.get("compile_lines", []))]
 
 
 #: `cfmpa certify` of a long slow trajectory (issue 24.4): rows, and the targets.
@@ -698,14 +772,18 @@ def contracts_section(have_cli: bool, base: dict[str, Any],
     return out
 
 
+#: BuiltDR fast, slowest variant, warm, in process: the target (seconds).
+BUILTDR_LIMIT_S = 0.10
+
 #: build_dr_fast's stages as the profile names them (impl's STAGES, in order).
 PROFILE_STAGES = {
     "right_regions": "right regions (right_regions_fast: the subordinate's m + m n swept polygons)",
     "left_regions": "left regions (left_regions_fast: the principal's 2 polygons a layer)",
-    "pack_right": "right packing (centre lines, _pack_all of the m + m n polygons on the kernel "
-                  "threads, row boxes, margin)",
-    "pack_left": "left packing (_pack and centre lines of each layer's 2 polygons)",
-    "layer_kernel": "numba layer loop (_layer over the computed layers, on the kernel threads)",
+    "pack_right": "right packing (centre lines, link 1's polygons packed, every cell's box and "
+                  "each row's union box on the kernel threads; cells packed later, on first use)",
+    "pack_left": "left packing (_pack and centre lines of every layer's polygons, at once)",
+    "layer_kernel": "numba kernel (_layers: each row in every computed layer, the rows shared "
+                    "out among the kernel threads)",
     "settle_unsure": "settle of unsure cells (_settle_unsure: the reference's blocked_against)",
     "other": "rest layer copied",
 }
@@ -750,8 +828,8 @@ def profile_note(res: dict[str, Any], variant: str) -> str:
     parts = ", ".join(f"{name} {s[k]:.3f} s ({s[k] / total:.0%})" for k, name in short.items())
     floor = s["right_regions"] + s["left_regions"]
     return (f"profile of {variant} (builtdr_profile, in process): {parts}; staged total "
-            f"{s['total']:.3f} s. The two region builders alone take {floor:.3f} s, "
-            f"{floor / 0.15:.1f}x the 0.15 s budget")
+            f"{s['total']:.3f} s. The two region builders take {floor:.3f} s, "
+            f"{floor / BUILTDR_LIMIT_S:.0%} of the {BUILTDR_LIMIT_S:g} s budget")
 
 
 def row(name: str, measured: float | None, limit: float, at_most: bool = True,
@@ -813,11 +891,31 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
 
     # full checking: BuiltDR fast, slowest variant, in process
     fast = {v: res["builtdr"][v]["fast"].get("median_s") for v in VARIANTS}
+    cold = {v: res["builtdr"][v]["fast"].get("cold_s") for v in VARIANTS}
     slowest = max(fast, key=lambda v: fast[v] or -1.0)
-    rows.append(row("full checking: BuiltDR fast, slowest variant, in process (s)", fast[slowest],
-                    0.15, note=f"build_dr_fast in process, right regions included; slowest "
-                               f"{slowest} (" + ", ".join(f"{v} {fast[v]:.3f}" for v in VARIANTS)
-                               + "); " + profile_note(res, slowest)))
+    rows.append(row("full checking: BuiltDR fast, slowest variant, warm, in process (s)",
+                    fast[slowest], BUILTDR_LIMIT_S,
+                    note=f"build_dr_fast in process, right regions included, warm: the median of "
+                         f"{res['builtdr'][slowest]['fast'].get('runs')} calls after a cold one "
+                         f"(the first call in its process, kernels loaded); slowest {slowest} ("
+                         + ", ".join(f"{v} {fast[v]:.3f}" for v in VARIANTS) + "); cold: "
+                         + ", ".join(f"{v} {cold[v]:.3f}" for v in VARIANTS if cold[v])
+                         + "; " + profile_note(res, slowest)))
+
+    # the first run: a fresh numba cache against a later run
+    fr = res.get("first_run") or {}
+    ratio = fr.get("ratio_first_over_later")
+    rows.append(row("first run: cfmpa plan default, fresh numba cache / later run (x)", ratio,
+                    FIRST_RUN_LIMIT,
+                    note=(f"whole processes: first {fr['first']['median_s']:.1f} s (one run, "
+                          f"fresh NUMBA_CACHE_DIR), later {fr['later']['median_s']:.1f} s "
+                          f"(median of {fr['later']['runs']}); "
+                          + "; ".join(fr.get("compile_lines", []))
+                          + ("" if not fr.get("later_prints_compile")
+                             else "; a later run printed a compile line")
+                          if ratio is not None else
+                          "not measured: " + str(fr.get("skipped") or fr.get("error")
+                                                 or "no first_run section"))))
 
     # full checking: cfmpa dr whole process vs the shapely-vectorised peer
     dr = res.get("dr_cli", {})
@@ -912,7 +1010,7 @@ def informational(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
     rows = [
         row("BuiltDR fast, slowest variant (s)",
             max(res["builtdr"][v]["fast"]["median_s"] for v in VARIANTS), 0.5,
-            note="in process, right regions included; superseded by the 0.15 s target"),
+            note="in process, right regions included; superseded by the 0.10 s target"),
         row("BuiltDR fast vs per-cell shapely loop (x)", sh["loop_over_ours"], 1000, False,
             note="in process, both given the same regions; extrapolated from the sample"),
         row("BuiltDR fast vs vectorised shapely intersects (x)", sh["intersects_over_ours"], 10,
@@ -1020,6 +1118,8 @@ def table(res: dict[str, Any]) -> str:
         lines += certify_stream_lines(res["certify_stream"])
     if "rows" in (res.get("tools") or {}):
         lines += tools_lines(res["tools"])
+    if isinstance(res.get("first_run"), dict) and "skipped" not in res["first_run"]:
+        lines += first_run_lines(res["first_run"])
     lines += profile_lines(res.get("builtdr_profile"))
     lines.append("")
     lines.append("targets (measured, limit, verdict, what was measured):")
@@ -1079,30 +1179,58 @@ def campaign_lines(camp: dict[str, Any]) -> list[str]:
     return lines
 
 
+def merged(res: dict[str, Any], cfg: Config, section: str) -> None:
+    """After ``--only SECTION``: meta.merged records the section's run (date, commit, load), and
+    the targets are recomputed from the results as they now stand (if the file has a full run's
+    sections; else they are left as they were)."""
+    now = meta(cfg, {})
+    res.setdefault("meta", {}).setdefault("merged", []).append(
+        {"section": section, "date": now["date"], "commit": now["commit"],
+         "load_average": now["load_average"], "runs": cfg.runs})
+    try:
+        res["targets"] = targets(res, cfg)
+        res["informational"] = informational(res, cfg)
+    except (KeyError, TypeError) as e:
+        res["meta"]["merged"][-1]["targets_not_recomputed"] = f"{type(e).__name__}: {e}"
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke run on a coarse grid")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent),
                     help="folder for results.json (default: bench/)")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
-    ap.add_argument("--only", choices=["campaign", "plan_scaling", "certify_stream", "tools"],
+    ap.add_argument("--only", choices=["campaign", "plan_scaling", "certify_stream", "tools",
+                                        "first_run", "builtdr"],
                     default=None,
-                    help="run only this item and merge it into OUT/results.json")
+                    help="run only this item and merge it into OUT/results.json (the targets "
+                         "are recomputed; meta.merged says what came from which run)")
     ap.add_argument("--prove", action="store_true",
                     help="also time `make prove` (cfmpa prove --audit DIR), one run of a minute "
                          "or two; `make bench` passes it")
     args = ap.parse_args(argv)
     cfg = Config.of(args.quick, args.runs, prove=args.prove)
+    if args.only == "builtdr":
+        out = Path(args.out) / "results.json"
+        res = json.loads(out.read_text()) if out.exists() else {}
+        builtdr_only(cfg, res)
+        merged(res, cfg, "builtdr")
+        out.write_text(json.dumps(res, indent=1, default=str) + "\n")
+        print("\n".join(builtdr_lines(res)))
+        print(f"\nwrote {out} (builtdr merged)")
+        return 0
     if args.only is not None:
         section, lines = {"campaign": (campaign_section, campaign_lines),
                           "plan_scaling": (plan_scaling_section, plan_scaling_lines),
                           "certify_stream": (certify_stream_section,
                                              certify_stream_lines),
-                          "tools": (tools_section, tools_lines)}[args.only]
+                          "tools": (tools_section, tools_lines),
+                          "first_run": (first_run_section, first_run_lines)}[args.only]
         out = Path(args.out) / "results.json"
         res = json.loads(out.read_text()) if out.exists() else {}
         with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:
             res[args.only] = section(cfg, Path(tmp))
+        merged(res, cfg, args.only)
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text(json.dumps(res, indent=1, default=str) + "\n")
         print("\n".join(lines(res[args.only])))

@@ -21,7 +21,8 @@ from .errors import InputError
 __all__ = ["FILE", "FOLDER", "Budget", "budgets", "check_log_output", "check_output", "checked",
            "cpus",
            "bag_arguments", "engine_arguments", "json_argument", "kernel_argument", "number", "out_argument",
-           "output", "positive", "run_checks", "scenario_argument", "trajectory_arguments",
+           "output", "positive", "run_checks", "scenario_argument", "store_argument",
+           "trajectory_arguments",
            "variant_argument"]
 
 
@@ -61,6 +62,16 @@ def kernel_argument(p: argparse.ArgumentParser) -> None:
     p.add_argument("--kernel", choices=list(KERNELS), default=KERNELS[0],
                    help=f"{KERNELS[0]} (default; bit-identical to the reference) or "
                         f"{', '.join(KERNELS[1:])}")
+
+
+def store_argument(p: argparse.ArgumentParser) -> None:
+    """--store, how D_R is written (docs/model.md §9); default by the grid's cells."""
+    from .runs import DR_STORES, ZARR_ABOVE_CELLS
+
+    p.add_argument("--store", choices=list(DR_STORES), default=None,
+                   help=f"D_R as DIR/dr.npy or DIR/dr.zarr, a chunked, compressed Zarr v3 "
+                        f"store (default: zarr above {ZARR_ABOVE_CELLS:,} cells or "
+                        f"CFMPA_ZARR_CELLS, else npy)")
 
 
 #: What an output option names: a folder the command writes its files into, or one file.

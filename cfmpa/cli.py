@@ -60,11 +60,11 @@ def cmd_docs(args: argparse.Namespace) -> int:
 
 
 def cmd_dr(args: argparse.Namespace) -> int:
-    """Build D_R for one scenario and variant; write DIR/dr.npy."""
+    """Build D_R for one scenario and variant; write DIR/dr.npy or DIR/dr.zarr (--store)."""
     from .runs import run_dr
 
     return run_dr(resolve(args.scenario), args.variant, args.out, kernel=args.kernel,
-                  name=args.scenario)
+                  name=args.scenario, store=args.store)
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -75,7 +75,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
     return run_plan(resolve(args.scenario), args.variant, args.out, contracts=args.contracts,
                     seed=args.seed, sample=args.sample, kernel=args.kernel,
-                    witness=args.witness, name=args.scenario)
+                    witness=args.witness, name=args.scenario, store=args.store)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -276,8 +276,9 @@ def _parser() -> argparse.ArgumentParser:
                  "cfmpa dr default --variant tight --out build/dr", cmd_dr)
     opt.scenario_argument(d)
     opt.variant_argument(d)
-    opt.out_argument(d, "output folder (dr.npy is written there)")
+    opt.out_argument(d, "output folder (dr.npy or dr.zarr is written there)")
     opt.kernel_argument(d)
+    opt.store_argument(d)
 
     pl = _command(sub, "plan", "plan the subordinate's path; write dr.npy, plan.json and "
                                "traj.csv",
@@ -292,6 +293,7 @@ def _parser() -> argparse.ArgumentParser:
     opt.number(pl, "--sample", b["sample"], type=int, default=None,
                help="cells checked by sampled contracts (default: the mode's own)")
     opt.kernel_argument(pl)
+    opt.store_argument(pl)
     pl.add_argument("--witness", default=None, metavar="FILE",
                     help="also write the search's witness of its answer (npz, docs/model.md "
                          "§11); plan.json gets its witness_sha256")
@@ -303,13 +305,14 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("scenario", nargs="?", default=None,
                    help="scenario the outputs are for: a bundled name or a TOML file (with "
                         "--batch: optional, else each plan's bundled scenario by its name)")
-    c.add_argument("--dr", default=None, help="dr.npy (uint8, shape (N + 1, m, n))")
+    c.add_argument("--dr", default=None, help="dr.npy or dr.zarr (uint8, shape (N + 1, m, n))")
     c.add_argument("--plan", default=None, help="plan.json (docs/model.md §9)")
     c.add_argument("--witness", default=None, metavar="FILE",
                    help="a witness file (cfmpa plan --witness) to verify for optimality; "
                         "without it the fast search computes one")
     c.add_argument("--batch", default=None, metavar="DIR",
-                   help="check every folder under DIR holding plan.json and dr.npy, one task "
+                   help="check every folder under DIR holding plan.json and dr.npy (or "
+                        "dr.zarr), one task "
                         "per plan; summary in DIR/check-batch.json")
     opt.json_argument(c, "with --batch: write the summary here instead")
     opt.engine_arguments(c)

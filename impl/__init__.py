@@ -11,6 +11,7 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
     from ._builtdr_loops import build_dr_loops, builtdr_loop_nest
     from ._fast_builtdr import build_dr_fast
     from ._fast_search import search_opt_path_fast
+    from ._kernel_cache import ensure_compiled, load_fast_kernels
     from ._kernels import KERNELS, kernel_name, kernels
     from ._kinematics import link_reach, link_rectangles
     from ._progress import Progress, progress_default, progress_silenced
@@ -35,6 +36,8 @@ _EXPORTS: dict[str, str] = {
     "builtdr_loop_nest": "._builtdr_loops:builtdr_loop_nest",
     "build_dr_fast": "._fast_builtdr:build_dr_fast",
     "search_opt_path_fast": "._fast_search:search_opt_path_fast",
+    "ensure_compiled": "._kernel_cache:ensure_compiled",
+    "load_fast_kernels": "._kernel_cache:load_fast_kernels",
     "KERNELS": "._kernels:KERNELS",
     "kernel_name": "._kernels:kernel_name",
     "kernels": "._kernels:kernels",
@@ -57,8 +60,9 @@ _EXPORTS: dict[str, str] = {
 __all__ = [
     "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "Progress", "RightRegions", "build_dr",
     "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly",
-    "containment_slack", "convex_hull", "kernel_name", "kernel_threads", "kernels", "lattice_range",
-    "left_regions", "left_spacing", "link_reach", "link_rectangles", "naive_hull", "progress_default",
+    "containment_slack", "convex_hull", "ensure_compiled", "kernel_name", "kernel_threads",
+    "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
+    "load_fast_kernels", "naive_hull", "progress_default",
     "progress_silenced", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
     "set_kernel_threads", "swept_region",
 ]

@@ -137,11 +137,12 @@ def rotate_row(s: Scenario, g: Grid, link1: Polygon, link2: npt.NDArray[np.float
 
 def right_row(s: Scenario, g: Grid,
               hulls: Callable[[list[npt.NDArray[np.float64]]], Sequence[Polygon]], *,
-              margin_scale: float = 1.0
+              margin_scale: float = 1.0, row_points: Callable[..., Any] | None = None
               ) -> tuple[Polygon, npt.NDArray[np.float64], npt.NDArray[np.float64] | None]:
     """The subordinate's regions at t_i = 0, base at the origin: link 1 (V, 2), link 2 per j
     (n, V, 2), padded, and the tool's per j likewise (None without a tool); ``hulls`` takes the
-    convex hull of each point set (as convex_hull)."""
+    convex hull of each point set (as convex_hull), ``row_points`` (by default _row_points)
+    gives a part's point sets per j (the fast kernels' twin gives the same arrays)."""
     arm = s.right
     origin = type(arm)(**{**arm.__dict__, "base": (0.0, 0.0)})
     h1, h2 = g.h
@@ -150,7 +151,7 @@ def right_row(s: Scenario, g: Grid,
                            margin_scale=margin_scale)]
     per_cell = [p for p in parts(arm) if p > 0]
     for part in per_cell:
-        points += _row_points(origin, part, t_j, (h1, h2), margin_scale)
+        points += (row_points or _row_points)(origin, part, t_j, (h1, h2), margin_scale)
     polys = hulls(points)
     n = len(t_j)
     out = [pad_polygons(list(polys[1 + c * n:1 + (c + 1) * n])) for c in range(len(per_cell))]

@@ -31,6 +31,7 @@ from numba import njit
 
 from ..spec import (MOVES, REASON_UNREACHABLE,
                            Cell, SearchResult)
+from ._kernel_cache import ensure_compiled
 from ._progress import progress_bar
 from ._search import INF, J2_MASK, SHIFT, WAIT, BackPointers, _prepare, _unwind, hold_waits
 
@@ -47,6 +48,7 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
                          ) -> SearchResult:
     """The same result as ``search_opt_path`` (least (J1, J2), its path, or why none), and with
     ``with_witness`` the same witness."""
+    ensure_compiled()
     setup, early = _prepare(dr, start, goal, with_witness)
     if early is not None:
         return early
@@ -118,14 +120,45 @@ def _dag_step(free, keys, out, pred, si, sj, s, DI, DJ, NORM, GAP, shift, inf
 
 
 @njit(cache=True)
-def _grow(buf, count, value):  # pragma: no cover - compiled
-    """Append value to buf[:count], doubling buf when full; returns the (maybe new) buffer."""
-    if count == buf.shape[0]:
-        bigger = np.empty(2 * buf.shape[0], dtype=buf.dtype)
-        bigger[:count] = buf[:count]
-        buf = bigger
-    buf[count] = value
-    return buf
+def _grow(buf, count):  # pragma: no cover - compiled
+    """buf with room for one more after its first ``count`` entries (doubled when full; a plain
+    loop: slice assignment costs seconds of compile)."""
+    if count < buf.shape[0]:
+        return buf
+    bigger = np.empty(2 * buf.shape[0], dtype=np.int64)
+    for k in range(count):
+        bigger[k] = buf[k]
+    return bigger
+
+
+@njit(cache=True)
+def _by_j1(keys, shift, inf):  # pragma: no cover - compiled
+    """The states with a finite key, stably sorted by J1 (a counting sort: the order of a stable
+    argsort of J1 over them, taken in index order), and their J1s."""
+    count, lo, hi = 0, inf, -1
+    for u in range(keys.shape[0]):
+        if keys[u] < inf:
+            count += 1
+            b = keys[u] >> shift
+            lo = min(lo, b)
+            hi = max(hi, b)
+    initial = np.empty(count, dtype=np.int64)
+    j1 = np.empty(count, dtype=np.int64)
+    if count == 0:
+        return initial, j1
+    at = np.zeros(hi - lo + 2, dtype=np.int64)
+    for u in range(keys.shape[0]):
+        if keys[u] < inf:
+            at[(keys[u] >> shift) - lo + 1] += 1
+    for w in range(hi - lo):
+        at[w + 1] += at[w]
+    for u in range(keys.shape[0]):
+        if keys[u] < inf:
+            b = (keys[u] >> shift) - lo
+            initial[at[b]] = u
+            j1[at[b]] = b + lo
+            at[b] += 1
+    return initial, j1
 
 
 @njit(cache=True)
@@ -138,19 +171,18 @@ def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shi
     M = free.shape[0]
     m = M // n
     done = np.zeros(keys.shape[0], dtype=np.bool_)
-    initial = np.flatnonzero(keys < inf)
-    order = np.argsort(keys[initial] >> shift, kind="mergesort")
-    initial = initial[order]
-    init_j1 = (keys >> shift)[initial]                 # as sorted; a key may drop later
+    initial, init_j1 = _by_j1(keys, shift, inf)   # as sorted; a key may drop later
     nxt = 0                                            # next unread state of ``initial``
     # Moves cost J1 1 or 2, so the open buckets are b, b + 1, b + 2: a ring of three.
-    ring = [np.empty(1024, dtype=np.int64) for _ in range(3)]
+    ring0 = np.empty(1024, dtype=np.int64)
+    ring1 = np.empty(1024, dtype=np.int64)
+    ring2 = np.empty(1024, dtype=np.int64)
     size = np.zeros(3, dtype=np.int64)
     frontier = np.empty(1024, dtype=np.int64)
     b = 0 if initial.shape[0] == 0 else init_j1[0]
     found_key, found_last = inf, -1
-    while nxt < initial.shape[0] or size.sum() > 0:
-        if size.sum() == 0 and init_j1[nxt] > b:
+    while nxt < initial.shape[0] or size[0] + size[1] + size[2] > 0:
+        if size[0] + size[1] + size[2] == 0 and init_j1[nxt] > b:
             b = init_j1[nxt]                           # skip empty buckets
         slot = b % 3
         count = 0
@@ -159,13 +191,16 @@ def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shi
             nxt += 1
             if not done[u] and keys[u] >> shift == b:
                 done[u] = True
-                frontier = _grow(frontier, count, u)
+                frontier = _grow(frontier, count)
+                frontier[count] = u
                 count += 1
+        ring = ring0 if slot == 0 else (ring1 if slot == 1 else ring2)
         for r in range(size[slot]):
-            u = ring[slot][r]
+            u = ring[r]
             if not done[u] and keys[u] >> shift == b:
                 done[u] = True
-                frontier = _grow(frontier, count, u)
+                frontier = _grow(frontier, count)
+                frontier[count] = u
                 count += 1
         size[slot] = 0
         if found_last < 0:
@@ -197,7 +232,15 @@ def _static_phase(free, n, keys, pred, from_static, goal, DI, DJ, NORM, GAP, shi
                     pred[v] = p
                     from_static[v] = True
                     target = (b + NORM[d]) % 3
-                    ring[target] = _grow(ring[target], size[target], v)
+                    if target == 0:
+                        ring0 = _grow(ring0, size[0])
+                        ring0[size[0]] = v
+                    elif target == 1:
+                        ring1 = _grow(ring1, size[1])
+                        ring1[size[1]] = v
+                    else:
+                        ring2 = _grow(ring2, size[2])
+                        ring2[size[2]] = v
                     size[target] += 1
                 elif cand == keys[v] and from_static[v] and p < pred[v]:
                     pred[v] = p                         # equal keys: the least previous move

@@ -30,9 +30,9 @@ _WIDTH = 30
 
 class Progress:
     """cfmpa's one progress bar: ``label done/total [####   ] rate/s, elapsed, ETA`` redrawn
-    in place on a stream (None: silent); BuiltDR's layers, the search's, a campaign's or batch's
-    tasks. The rate is of the units done in this run (``start`` counts those done before it, e.g.
-    reused from a store), so the time left does not count reused work."""
+    in place on a stream (None: silent); BuiltDR's rows, the search's layers, a campaign's or
+    batch's tasks. The rate is of the units done in this run (``start`` counts those done before
+    it, e.g. reused from a store), so the time left does not count reused work."""
 
     def __init__(self, label: str, total: int, start: int = 0, stream: TextIO | None = None
                  ) -> None:

@@ -8,15 +8,18 @@ expanded as vectorised frontiers.
 
 from __future__ import annotations
 
+import os
+import tempfile
 from dataclasses import replace
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ..errors import InputError
 from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                   Cell, LayerSpill, SearchResult, Witness, check_search_inputs, spill_wanted)
+                   SPILL_BYTES, Cell, LayerSpill, SearchResult, Witness, check_search_inputs,
+                   spill_wanted)
 
 __all__ = ["BackPointers", "WitnessLabels", "hold_waits", "search_opt_path"]
 
@@ -115,16 +118,52 @@ class FreeLayers:
         return np.ascontiguousarray(np.asarray(self.dr[key]) == 0)
 
 
+#: Back-pointers held in memory past this many bytes go to a temporary file (BackPointers).
+BACK_POINTER_BYTES = SPILL_BYTES
+
+
 class BackPointers:
     """The DAG steps' back-pointers, compact: for step s = 1..N, the previous move (index into
     MOVES, int8) of each state's optimal predecessor, kept only on the box of cells within s
     moves of the start, rows r0:r1 and columns c0:c1 of ``box(s)``. A state at step s outside
     that box has no label (a move changes each coordinate by at most 1), so nothing is lost: the
-    pointers take 9 (2 s + 1)^2 bytes at step s at most, instead of 9 m n."""
+    pointers take 9 (2 s + 1)^2 bytes at step s at most, instead of 9 m n.
 
-    def __init__(self, start: Cell, m: int, n: int) -> None:
+    Once the finished steps' pointers held pass ``spill_bytes`` (default
+    ``BACK_POINTER_BYTES``, 64 MiB), they are moved to an unnamed temporary file (``TMPDIR``),
+    as every later step's is when the next one is made; ``at`` then reads its one byte there.
+    So the search's memory does not grow with N beyond that (the walk back reads N bytes)."""
+
+    def __init__(self, start: Cell, m: int, n: int, spill_bytes: int | None = None) -> None:
         self.start, self.m, self.n = start, m, n
-        self.layers: list[npt.NDArray[np.int8]] = []
+        #: Step s's pointers at index s - 1; None once moved to the file.
+        self.layers: list[npt.NDArray[np.int8] | None] = []
+        self.spill_bytes = BACK_POINTER_BYTES if spill_bytes is None else spill_bytes
+        self._held = 0
+        self._file: IO[bytes] | None = None
+        self._offsets: dict[int, int] = {}             # step index -> its offset in the file
+        self._end = 0
+
+    @property
+    def spilled(self) -> int:
+        """The steps whose pointers are in the temporary file."""
+        return len(self._offsets)
+
+    def _settle(self) -> None:
+        """Every step made so far is finished: past ``spill_bytes`` held, to the file."""
+        if self._held <= self.spill_bytes:
+            return
+        if self._file is None:
+            self._file = tempfile.TemporaryFile(prefix="cfmpa-backpointers-")
+        for k, a in enumerate(self.layers):
+            if a is None:
+                continue
+            self._file.write(np.ascontiguousarray(a).data)
+            self._offsets[k] = self._end
+            self._end += a.nbytes
+            self._held -= a.nbytes
+            self.layers[k] = None
+        self._file.flush()
 
     @property
     def N(self) -> int:
@@ -140,9 +179,12 @@ class BackPointers:
         made in order 1, 2, ..."""
         if s != self.N + 1:
             raise AssertionError(f"BackPointers.new({s}) after step {self.N}")
+        self._settle()
         r0, r1, c0, c1 = self.box(s)
-        self.layers.append(np.full((9, r1 - r0, c1 - c0), -1, dtype=np.int8))
-        return self.layers[-1]
+        a = np.full((9, r1 - r0, c1 - c0), -1, dtype=np.int8)
+        self.layers.append(a)
+        self._held += a.nbytes
+        return a
 
     def at(self, s: int, d: int, i: int, j: int) -> int:
         """The previous move of state (s, (i, j), d)'s optimal predecessor."""
@@ -150,7 +192,12 @@ class BackPointers:
         if not (r0 <= i < r1 and c0 <= j < c1):
             raise AssertionError(f"BackPointers.at: cell {(i, j)} is not within {s} moves of "
                                  f"the start {self.start}")
-        return int(self.layers[s - 1][d, i - r0, j - c0])
+        a = self.layers[s - 1]
+        if a is not None:
+            return int(a[d, i - r0, j - c0])
+        assert self._file is not None
+        at = self._offsets[s - 1] + (d * (r1 - r0) + i - r0) * (c1 - c0) + j - c0
+        return int.from_bytes(os.pread(self._file.fileno(), 1, at), "little", signed=True)
 
 
 class WitnessLabels:

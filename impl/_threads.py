@@ -1,9 +1,11 @@
 """How many threads impl's compiled kernels use, and the one way to run them on that many.
 
-A fork-safe threading layer (workqueue here; numba's OpenMP on Linux is GNU's, which aborts a
-forked child that runs a parallel kernel once the parent has): the prove run, the audit and the
-campaigns fork processes that build D_R. Workqueue is not thread-safe, so ``parallel`` holds a
-lock: threads that run kernels at once (a multi-threaded Dask worker) take turns.
+``shared`` runs a kernel compiled with ``nogil=True`` once per thread, each call doing its own
+share: plain Python threads, started and joined within the call. No kernel is ``parallel=True``,
+so numba's threading layer is never started: its compile machinery cost seconds of the first
+run (docs/model.md §7.5), and its OpenMP layer aborts a forked child that runs a parallel kernel
+once the parent has (the prove run, the audit and the campaigns fork processes that build D_R).
+Calls from several threads at once (a multi-threaded Dask worker) each run their own threads.
 """
 
 from __future__ import annotations
@@ -15,12 +17,7 @@ from typing import Any
 
 import numba
 
-__all__ = ["kernel_threads", "parallel", "set_kernel_threads"]
-
-# numba.config's settings are set from the environment at import time: no static attributes.
-if numba.config.THREADING_LAYER == "default":  # type: ignore[attr-defined]
-    numba.config.THREADING_LAYER = "forksafe"  # type: ignore[attr-defined]
-_LOCK = threading.Lock()
+__all__ = ["kernel_threads", "set_kernel_threads", "shared"]
 
 #: Two where the machine has two cores or more; one in processes that run side by side (the
 #: prove run's workers, the audit's second process, a local campaign's workers), which call
@@ -40,13 +37,28 @@ def set_kernel_threads(k: int) -> None:
     _THREADS[0] = k
 
 
-def parallel(kernel: Callable[..., Any], *args: Any) -> Any:
-    """``kernel(*args)`` on kernel_threads() threads (numba's setting is per calling thread)."""
-    with _LOCK:
-        before = numba.get_num_threads()
-        numba.set_num_threads(min(_THREADS[0],
-                                  numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]
+def shared(kernel: Callable[..., Any], *args: Any) -> None:
+    """``kernel(t, k, *args)`` for t = 0 .. k - 1 at once, k = kernel_threads() (at most
+    NUMBA_NUM_THREADS): ``kernel`` is compiled with nogil=True, does share t of k and writes
+    nothing another share writes. Share 0 runs on the calling thread; an exception in any share
+    is raised here once all have ended."""
+    k = min(_THREADS[0], numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
+    if k <= 1:
+        kernel(0, 1, *args)
+        return
+    errors: list[BaseException] = []
+
+    def run(t: int) -> None:
         try:
-            return kernel(*args)
-        finally:
-            numba.set_num_threads(before)
+            kernel(t, k, *args)
+        except BaseException as exc:  # noqa: BLE001 - re-raised below, on the calling thread
+            errors.append(exc)
+
+    threads = [threading.Thread(target=run, args=(t,), daemon=True) for t in range(1, k)]
+    for th in threads:
+        th.start()
+    run(0)
+    for th in threads:
+        th.join()
+    if errors:
+        raise errors[0]

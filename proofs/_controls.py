@@ -14,9 +14,18 @@ wrong input built from a correct one on the built-in workcell ``small`` (cfmpa.s
 - dr.unsound_free_cell: D_R with one blocked cell, on the border of free space, set free;
 - path.through_blocked: the optimal path with one cell replaced by a blocked neighbour;
 - certificate.contact: the subordinate held, from the start, at a cell where the arms touch at
-  a layer's instant.
-Each construction asserts that the wrong input is what it says (else the control is FAILED, a
-bug in the control, never a pass).
+  a layer's instant;
+and the wiring's controls of ``_controls_wiring`` (a moving near-contact, a gap over three
+pieces, a raised start label). Each construction asserts that the wrong input is what it says,
+and each names the condition its fault must be rejected at: a control that cannot build its
+input, or whose input is rejected at another condition (so it is not the fault the control
+plants), ends ``error``, which no control expects, never ``rejected``.
+
+Positive controls (``Control.accept.*``) give each checker a right input it must accept (the
+optimal path with its genuine witness, the D_R as built, the optimal path, its certificate, a
+gap the monitor covers): a checker that rejects everything fails them. ``Control.harness``
+checks the harness itself: a control that cannot build its input, or is rejected at another
+condition, must end ``error``.
 
 Premise controls: for each ``Safety.<variant>.composition`` and each of its hypotheses that is
 not an instance of a proved lemma, the composition without it. Expected: not proved, i.e. Z3
@@ -44,8 +53,9 @@ from ..spec import (J1, J2, MOVES, SearchResult, SearchStatus, Witness, certify,
                     check_witness, dr_cell_failures, is_path, left_angles, make_grid,
                     parse_scenario, path_violations, pose_distance)
 
-__all__ = ["Control", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS", "checker_controls",
-           "collect_controls", "premise_controls", "run_control"]
+__all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS",
+           "checker_controls", "collect_controls", "harness_controls", "positive_controls",
+           "premise_controls", "run_control"]
 
 #: Z3's budget per premise control: with the composition's pins, then without them.
 PREMISE_PINNED_MS = 1_000
@@ -96,7 +106,8 @@ def _require(ok: bool, what: str) -> None:
 
 
 def run_control(c: Control) -> ControlResult:
-    """Run one control; an exception (a control that could not be built) is FAILED, saying why."""
+    """Run one control; an exception (a control that could not be built) ends ``error``, which no
+    control expects, saying why."""
     t0 = time.perf_counter()
     try:
         outcome, detail = c.run()
@@ -138,11 +149,18 @@ def _case() -> _Case:
     return _CASE[0]
 
 
-def _rejected(failures: list[Any]) -> tuple[str, str]:
+def _rejected(failures: list[Any], want: Sequence[str] = ()) -> tuple[str, str]:
+    """``rejected`` when the checker's first failure is at a condition of ``want`` (any, for a
+    positive control's empty ``want``), ``accepted`` when it raised nothing, and ``error`` when
+    it failed elsewhere: the input is then not the fault the control plants."""
     if failures:
         f = failures[0]
         what = getattr(f, "condition", None) or getattr(f, "clause", None) or type(f).__name__
-        return "rejected", f"{what}: {getattr(f, 'message', f)}"
+        text = f"{what}: {getattr(f, 'message', f)}"
+        if want and what not in want:
+            return "error", (f"rejected at {what}, not at {' or '.join(want)} where the control "
+                             f"plants its fault (its input is not what it says); {text}")
+        return "rejected", text
     return "accepted", "the checker raised nothing"
 
 
@@ -156,7 +174,9 @@ def _forged_witness() -> tuple[str, str]:
     j1[N, settled, gi, gj] -= 1
     forged = Witness.of_labels(j1, j2)
     _require(not np.array_equal(forged.j1, c.best.witness.j1), "the forgery changed nothing")
-    return _rejected(check_witness(c.dr, c.start, c.goal, c.best, forged))
+    # A lowered goal label breaks the edge into that goal state (or, reached otherwise, the goal).
+    return _rejected(check_witness(c.dr, c.start, c.goal, c.best, forged),
+                     ("witness.edge", "witness.goal"))
 
 
 def _worse_path() -> tuple[str, str]:
@@ -171,7 +191,8 @@ def _worse_path() -> tuple[str, str]:
     else:
         raise ControlNotMade("no single wait gives a valid path worse than the optimum")
     worse = replace(c.best, path=tuple(longer), J1=J1(longer), J2=J2(longer))
-    out, detail = _rejected(check_witness(c.dr, c.start, c.goal, worse, c.best.witness))
+    out, detail = _rejected(check_witness(c.dr, c.start, c.goal, worse, c.best.witness),
+                            ("witness.goal",))
     return out, f"a wait at step {at}, (J1, J2) = ({J1(longer)}, {J2(longer)}); {detail}"
 
 
@@ -187,7 +208,7 @@ def _unsound_free_cell() -> tuple[str, str]:
     bad = c.dr.copy()
     bad[k, i, j] = 0
     _, failures = dr_cell_failures(c.scenario, "modified", c.grid, bad)
-    out, detail = _rejected(failures)
+    out, detail = _rejected(failures, ("post.cells",))
     return out, f"layer {k}, cell ({i}, {j}) set free; {detail}"
 
 
@@ -202,7 +223,8 @@ def _through_blocked() -> tuple[str, str]:
                 bad = path[:k] + [(i, j)] + path[k + 1:]
                 if all(abs(a[0] - b[0]) <= 1 and abs(a[1] - b[1]) <= 1
                        for a, b in zip(bad, bad[1:])):
-                    out, detail = _rejected(path_violations(bad, c.dr, c.start, c.goal))
+                    out, detail = _rejected(path_violations(bad, c.dr, c.start, c.goal),
+                                            ("blocked",))
                     return out, f"step {k} moved to the blocked cell ({i}, {j}); {detail}"
     raise ControlNotMade("no blocked neighbour keeps the moves adjacent")
 
@@ -220,13 +242,91 @@ def _contact() -> tuple[str, str]:
                     cert = certify(s, g, path)
                     if cert.clear:
                         return "accepted", f"held at ({i}, {j}) through layer {k}: certified clear"
-                    what = "a contact" if cert.contact is not None else "undecided intervals"
-                    return "rejected", f"held at ({i}, {j}) through layer {k}: not clear ({what})"
+                    if cert.contact is None:    # not the contact the control plants
+                        return "error", (f"held at ({i}, {j}) through layer {k}: not clear, but "
+                                         "undecided rather than a contact")
+                    return "rejected", f"held at ({i}, {j}) through layer {k}: not clear (a contact)"
     raise ControlNotMade("no cell of the grid touches the principal at a layer's instant")
 
 
+# --- right inputs each checker must accept ------------------------------------------------------
+
+
+def _accept_witness() -> tuple[str, str]:
+    c = _case()
+    return _rejected(check_witness(c.dr, c.start, c.goal, c.best, c.best.witness))
+
+
+def _accept_dr() -> tuple[str, str]:
+    c = _case()
+    _, failures = dr_cell_failures(c.scenario, "modified", c.grid, c.dr)
+    return _rejected(failures)
+
+
+def _accept_path() -> tuple[str, str]:
+    c = _case()
+    return _rejected(path_violations(list(c.best.path), c.dr, c.start, c.goal))
+
+
+def _accept_certificate() -> tuple[str, str]:
+    c = _case()
+    cert = certify(c.scenario, c.grid, list(c.best.path))
+    if cert.clear:
+        return "accepted", f"the optimal path certified clear by {cert.lower_bound_m:.4f} m"
+    return "rejected", "the optimal path not certified clear (" + (
+        "a contact" if cert.contact is not None else "undecided intervals") + ")"
+
+
+def positive_controls() -> list[Control]:
+    """One right input per checker: each must accept it."""
+    from ._controls_wiring import wiring_positive_controls
+
+    A = ("accepted",)
+    return [
+        Control("Control.accept.witness", "witness (spec.check_witness)",
+                "the optimal path with its genuine witness", A, _accept_witness),
+        Control("Control.accept.dr", "D_R postcondition (spec.dr_cell_failures)",
+                "the D_R BuiltDR builds", A, _accept_dr),
+        Control("Control.accept.path", "path (spec.path_violations, fixed is_path)",
+                "the optimal path", A, _accept_path),
+        Control("Control.accept.certificate", "certificate (spec.certify)",
+                "the optimal path's motion", A, _accept_certificate),
+    ] + wiring_positive_controls()
+
+
+# --- the harness itself -----------------------------------------------------------------------
+
+
+def _harness() -> tuple[str, str]:
+    """Two controls that must end ``error``: one whose input cannot be built, one rejected at a
+    condition other than its own. ``rejected`` when both do, ``accepted`` (a harness that
+    counts them as passes) otherwise."""
+    def unbuildable() -> tuple[str, str]:
+        raise ControlNotMade("a wrong input that cannot be built")
+
+    elsewhere = [type("Planted", (), {"condition": "witness.form", "message": "planted"})()]
+    inner = [run_control(Control("Control.harness.inner.unbuildable", "none",
+                                 "an input that cannot be built", ("rejected",), unbuildable)),
+             run_control(Control("Control.harness.inner.elsewhere", "none",
+                                 "rejected at another condition", ("rejected",),
+                                 lambda: _rejected(elsewhere, ("witness.goal",))))]
+    bad = [r for r in inner if r.outcome != "error" or r.ok]
+    if bad:
+        return "accepted", "; ".join(f"{r.id} ended {r.outcome}: {r.detail}" for r in bad)
+    return "rejected", "both ended error: " + "; ".join(r.detail for r in inner)
+
+
+def harness_controls() -> list[Control]:
+    return [Control("Control.harness.error_is_not_a_pass", "the controls' harness (run_control)",
+                    "a control that cannot build its input, and one rejected at another "
+                    "condition: both must end error", ("rejected",), _harness)]
+
+
 def checker_controls() -> list[Control]:
-    """One wrong input per checker the safety argument reads at run time."""
+    """One wrong input per checker the safety argument reads at run time, and the wiring's (a
+    moving near-contact, a gap over three pieces, a raised start label)."""
+    from ._controls_wiring import wiring_controls
+
     R = ("rejected",)
     return [
         Control("Control.witness.forged", "witness (spec.check_witness)",
@@ -243,7 +343,7 @@ def checker_controls() -> list[Control]:
                 _through_blocked),
         Control("Control.certificate.contact", "certificate (spec.certify)",
                 "the subordinate held where the arms touch at a layer's instant", R, _contact),
-    ]
+    ] + wiring_controls()
 
 
 # --- the compositions without a premise --------------------------------------------------------
@@ -290,9 +390,10 @@ def premise_controls() -> list[Control]:
 
 
 def collect_controls(only: Sequence[str] | None = None) -> list[Control]:
-    """The controls of ``cfmpa prove``, checkers' first: all, or (``only``, as ``--only``) those
-    whose id or whose composition is selected."""
+    """The controls of ``cfmpa prove``, checkers' wrong inputs first, then their right inputs,
+    the harness's, the compositions': all, or (``only``, as ``--only``) those whose id or whose
+    composition is selected."""
     from ._runner import selected
 
-    return [c for c in checker_controls() + premise_controls()
-            if selected(c.id, only) or selected(c.checker, only)]
+    return [c for c in checker_controls() + positive_controls() + harness_controls()
+            + premise_controls() if selected(c.id, only) or selected(c.checker, only)]

@@ -34,7 +34,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "Every (layer, cell) a found path occupies is re-decided in arb ball arithmetic "
         "(plan.json's exact_gaps), and the containment of the variants' regions is decided "
         "exactly on the computed doubles, so neither rests on rounding.",
-        "Sep.distance_monotone, Scenario.*.containment, Safety.* (A11)"),
+        "Sep.distance_monotone, Scenario.*.containment, Safety.* (A11), Certificate.wiring, "
+        "Monitor.reference_speeds"),
     Assumption(
         "A3.trigonometry",
         "sin and cos enter Z3 as real unknowns (in Safety.*, the uninterpreted functions Cos, "
@@ -109,10 +110,12 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "A8.named_instances",
         "Where Z3 needs a universally quantified hypothesis used at a particular set, point or "
         "path (Definition 3's superset, Definition 2's points, Definition 5's rival path, a "
-        "proved step lemma), the obligation names the instance.",
+        "proved step lemma, a slice's maximum at the piece named, increasing times at the rows "
+        "named), the obligation names the instance.",
         "Instantiating a universal is sound: the statement says so where it happens, and Z3 "
         "checks everything else.",
-        "Def3.convex_hull, Lemma1, Lemma2, Sep.*, Lemma.sweep_margin, Prop8.optimal_cost"),
+        "Def3.convex_hull, Lemma1, Lemma2, Sep.*, Lemma.sweep_margin, Prop8.optimal_cost, "
+        "Certificate.wiring, Monitor.reference_speeds"),
     Assumption(
         "A9.regions_opaque",
         "In Theorems 1-4 the regions are opaque values and the intersection test uninterpreted; "
@@ -175,4 +178,26 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "proves what it buys: with eps = spec.EPS above it, a freed pair is at a positive exact "
         "distance; an eps below it is refuted.",
         "Safety.separation, Safety.*.composition"),
+    Assumption(
+        "A13.tools_and_heights",
+        "For a workcell with a tool or height intervals (docs/model.md §2), the end-to-end "
+        "theorem's compositions (Safety.<variant>.composition) are stated for the two link "
+        "rectangles per arm: what covers the tool and the heights is Safety.tool_region (the "
+        "tool inside its region at every configuration of the box), Safety.height_rule (parts "
+        "at disjoint heights share no point), Certificate.height_gap and the tool terms of "
+        "Certificate.lipschitz and Tolerance.tube_factor, each proved on its own, and the "
+        "run-time checks (D_R's postcondition, the certificate, the exact re-decision). Within "
+        "Safety.tool_region three steps are stated, not proved: the polygon grown by the "
+        "square is the hull of the vertices moved by the square's corners ('hull of sums "
+        "stated'); a tool of fewer than 16 vertices is the 16-vertex one with a vertex "
+        "repeated; and the numpy stand-in that runs impl's functions on terms "
+        "(proofs/_obl_tools.py, _Numpy) computes what numpy computes.",
+        "The lemmas are proved for the code as it runs; what joins them into one theorem for a "
+        "workcell with a tool is the compositions' pair list, not yet extended. Until it is, "
+        "such a workcell carries the scope label (spec.theorem_scope) in plan, prove and the "
+        "report, and its verdict reads 'certified', not 'safe'. The stated steps are tested: "
+        "the numpy stand-in against impl's floats on sample tools, the padding by the loader's "
+        "MAX_TOOL_VERTICES, the grown polygon against impl.part_polygons.",
+        "Safety.tool_region, Safety.height_rule, Certificate.height_gap, the verdict rows of "
+        "workcells with a tool or heights"),
 )

@@ -321,9 +321,12 @@ def _interval_vc() -> VC:
 
 
 def certificate_vcs() -> tuple[VC, ...]:
-    """Certificate.lipschitz's VCs, from the spec's functions as they are now."""
+    """Certificate.lipschitz's VCs, from the spec's functions as they are now; then the tool's
+    (its reach and speed, proofs/_obl_tools.py)."""
+    from ._obl_tools import tool_certificate_vcs
     return (_reach_vc(0, "base"), _reach_vc(1, "elbow"), _reach_vc(1, "base"), _velocity_vc(),
-            _speed_vc(0), _speed_vc(1), _distance_rate_vc(), _interval_vc())
+            _speed_vc(0), _speed_vc(1), _distance_rate_vc(), _interval_vc(),
+            *tool_certificate_vcs())
 
 
 # --- Tolerance.tube_factor ----------------------------------------------------------------------
@@ -528,8 +531,10 @@ def _deviation_vc() -> VC:
 
 
 def tube_factor_vcs() -> tuple[VC, ...]:
-    """Tolerance.tube_factor's VCs, from the spec's functions as they are now."""
-    return (_factor_vc(), _lipschitz_vc(), _deviation_vc())
+    """Tolerance.tube_factor's VCs, from the spec's functions as they are now; lipschitz_tool
+    with a tool on each arm (proofs/_obl_tools.py)."""
+    from ._obl_tools import tube_tool_vc
+    return (_factor_vc(), _lipschitz_vc(), _deviation_vc(), tube_tool_vc())
 
 
 # --- Exact.gap_formula --------------------------------------------------------------------------
@@ -603,10 +608,18 @@ def constants_obligations() -> list[Obligation]:
             "is at most spec.link_speeds; two links' distance changes by at most "
             "spec.pair_lipschitz(v_a, v_b) h over a time h (either way: reversed time has the same "
             "bounds); and on [t0, t1] it is at least "
-            "spec.interval_bound(d0, d1, L, t1 - t0). Named, not checked: the triangle "
+            "spec.interval_bound(d0, d1, L, t1 - t0). A tool (a convex polygon of 16 symbolic "
+            "vertices fixed to link 2; fewer: a vertex repeated): every point, a chain of two-point "
+            "convex combinations of its vertices, is within R_elbow of the elbow and R_base of the "
+            "base, (R_base, R_elbow) = spec.reach(arm, TOOL) run on terms (its max as an If, its "
+            "farthest vertex: tool_far_vertex, tool_reach_frame, reach_point, reach_tool, with "
+            "hull_step from comb_id), and moves at most spec.link_speeds(arm, w)[0, TOOL] "
+            "(speed_term, speed_tool; rot_norm, kin, square_monotone and triangle as proved in "
+            "Safety.region_soundness). Named, not checked: the triangle "
             "inequality at the instances used (proved in Tolerance.tube); that a speed bound v "
-            "gives a move of at most v h (integration); that nearest points exist; that the "
-            "piece's joint speeds are |goal - start| / Tf and |step| / dt.",
+            "gives a move of at most v h (integration); that nearest points exist. That the "
+            "joint speeds handed to link_speeds for a piece bound the motion's on it: "
+            "Certificate.wiring.",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(certificate_vcs()),
             label="speed integrated in prose"),
         Obligation(
@@ -617,7 +630,10 @@ def constants_obligations() -> list[Obligation]:
             "(body k -= 1) summed up as k <= k0 and k >= 0 when k0 >= 0, L > 0 any; and a "
             "max-norm joint deviation delta moves "
             "any point of any link of either arm by at most L delta, L = spec.tube_lipschitz "
-            "(its bytecode on terms, Python's max as an If) over spec.reach of each link. Named, "
+            "(its bytecode on terms, Python's max as an If) over spec.reach of each link; "
+            "lipschitz_tool: with a tool of 16 symbolic vertices on each arm, L (spec.tube_"
+            "lipschitz and spec.reach run on terms) is at least R_base + R_elbow of every part, "
+            "the tools' included. Named, "
             "not checked: a point moves by at most |dtheta1| R_base + |dtheta2| R_elbow (the "
             "speed bound of Certificate.lipschitz integrated along the joint-space segment).",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(tube_factor_vcs()),

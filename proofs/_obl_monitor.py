@@ -15,9 +15,10 @@ argument Z3 finds is the triangle inequality at either end, |x(t) - r(t)| <= |x(
 t - t_k, t_k+1 - t is at most h / 2. Linear in the products w (t - t_k) that Z3 treats as
 atoms, with no If but the bound's max, so Z3 decides it at once (with the absolute values as
 If terms it answered unknown after 20 s). Prose, not checked: that a speed bound |x'| <= w_x gives
-|x(t) - x_k| <= w_x (t - t_k) (the mean value theorem), and that the trajectory's largest speed
-over the pieces the gap meets (``spec.ReferenceSpeeds.over``) bounds r' on the gap; the four
-joints are independent, so the max norm is within the tube when every joint is.
+|x(t) - x_k| <= w_x (t - t_k) (the mean value theorem); the four joints are independent, so the
+max norm is within the tube when every joint is. That the trajectory's largest speed over the
+pieces the gap meets (``spec.ReferenceSpeeds.over``) bounds r' on the gap is
+``Monitor.reference_speeds`` (proofs/_obl_wiring.py).
 
 Registered by the proofs' registry (``monitor_obligations``), not by this module.
 """
@@ -87,8 +88,8 @@ def monitor_obligations() -> list[Obligation]:
                    "instant of it by at most max(d_k, d_k+1) + (w_x + w_r) h / 2, d the "
                    "deviations sampled at the ends (spec.between_samples_bound on the terms). "
                    "Prose, not checked: a speed bound gives the distance bound from either end "
-                   "(mean value theorem); the trajectory's largest speed over the pieces the gap "
-                   "meets bounds its speed there.",
+                   "(mean value theorem). That w_r, the trajectory's largest speed over the "
+                   "pieces the gap meets, bounds its speed there: Monitor.reference_speeds.",
                    Method.Z3, Verdict.PROVED, _query,
                    label="per joint; the speed bounds' integration is prose"),
     ]

@@ -15,10 +15,11 @@ T = max(LENGTH L - 1, N); its state at step k is ``(min(k, N), c(k), p(k))``.
 - ``Witness.reachable_sound``: the invariant "the state at step k is in the set" holds at 0,
   is kept by closure, and at T contradicts the exclusion: no list is a valid path.
 
-The checker's edge and goal conditions are not restated here: ``spec``'s own functions
-(``step_cost``, ``label_key``, ``edge_bound``, ``edge_holds``, ``label_in_range``,
-``goal_holds``), which ``check_witness`` calls on numpy arrays, are called on Z3 terms, so a
-loosened condition fails ``labels.step`` or ``labels.optimal``; the reachable set's conditions are
+The checker's start, edge and goal conditions are not restated here: ``spec``'s own functions
+(``start_label_breaks``, ``step_cost``, ``label_key``, ``edge_bound``, ``edge_holds``,
+``label_in_range``, ``goal_holds``), which ``check_witness`` calls on numpy arrays, are called
+on Z3 terms, so a loosened condition fails ``labels.base``, ``labels.step`` or
+``labels.optimal``; the reachable set's conditions are
 ``start_breaks``, ``closure_breaks`` and ``exclusion_breaks``, likewise run on Z3 terms (a
 loosened one fails ``reachable.base``, ``reachable.step`` or ``reachable.conclusion``). The goal
 condition in ``labels.conclusion`` is the checker's comparison of keys (``label_key`` plus
@@ -48,7 +49,8 @@ from dataclasses import dataclass
 import z3
 
 from ..spec import (KEY_BASE, closure_breaks, edge_bound, edge_holds, exclusion_breaks,
-                    goal_holds, label_in_range, label_key, start_breaks, step_cost, stop_key)
+                    goal_holds, label_in_range, label_key, start_breaks, start_label_breaks,
+                    step_cost, stop_key)
 from ..spec.z3defs import (Z3Dims, Z3PathVar, abs_int, in_grid, is_path_fixed, lex_le, position,
                             z3_path)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
@@ -194,8 +196,14 @@ def _labels_vcs() -> tuple[VC, ...]:
             A1[kk + 1] == A1[kk] + abs_int(d_k[0]) + abs_int(d_k[1]),
             A2[kk + 1] == A2[kk] + abs_int(d_k[0] - p_k[0]) + abs_int(d_k[1] - p_k[1]))))))
     origin = (0, w.start[0], w.start[1], 0, 0)
-    start = ("witness.start: the start state labelled (0, 0) or less",
-             z3.And(has[origin], lex_le(label(origin), (0, 0))))
+    # spec.check_witness's own start test (start_label_breaks), run on Z3 terms; the checker
+    # reads "no label" as the type's largest value in both arrays (witness.form), > 0.
+    start = ("witness.start: the start state's label is (0, 0) (start_label_breaks false)",
+             z3.Not(start_label_breaks(lab1[origin], lab2[origin])))
+    none = z3.Int("none")
+    unlabelled = ("witness.form at the start state: without a label it holds the no-label value "
+                  "(the type's largest, > 0)",
+                  z3.And(none > 0, z3.Implies(z3.Not(has[origin]), lab1[origin] == none)))
     edge = ("witness.edge at L's edge k: label[s'] <= label[s] + cost if it is a free edge from "
             "a labelled state", _edge_condition(w, has, edge_ok, w.state(k), w.prev(k + 1)))
     form = ("witness.form at L's states k, k + 1: labels unsigned, in range",
@@ -221,7 +229,8 @@ def _labels_vcs() -> tuple[VC, ...]:
     cost_L = (A1[w.T], A2[w.T] + abs_int(last[0]) + abs_int(last[1]))
     dims = w.base()[0]
     return (
-        VC("labels.base", w.base() + (prefix, start), inv(z3.IntVal(0)), key_premise=start[0]),
+        VC("labels.base", w.base() + (prefix, start, unlabelled), inv(z3.IntVal(0)),
+           key_premise=start[0]),
         _walk_vc(w, "labels.walk"),
         VC("labels.step", (dims, prefix, ("L's edge k is a free edge to its state at k + 1 "
                                            "(VC labels.walk)", _walk(w, k)),

@@ -16,7 +16,14 @@ changed.
   scenario's check must match the one pin.
 
 The lock is JSON, keys sorted, one obligation per entry; ``repin`` rewrites it and says which
-ids were added, removed or changed, with the old and new hashes. An entry also records what cvc5
+ids were added, removed or changed, with the old and new hashes.
+
+An entry also pins the obligation's kind (``kind``: ``theorem`` or ``definitional``, with
+``kind_why``, the reason of proofs/_runner.py's DEFINITIONAL). ``repin`` writes the kind of an
+obligation pinned for the first time and never changes a pinned one (it refreshes only the
+reason of an unchanged kind): a theorem moved into the definitional list, or the reverse,
+fails every run (``check_kinds``) until the lock is edited by hand, as an expected verdict
+(pinned in the code) cannot be re-pinned either. An entry also records what cvc5
 answered on each VC when it was pinned (``cvc5``; not part of the comparison): a run replays
 in cvc5 only the statements cvc5 decided then (``cvc5_skips``), since the same text gets the
 same answer, and ``--repin`` replays every one again.
@@ -26,15 +33,15 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
 from ..files import JsonStyle, write_json
 from ._obligation import Proof
 
-__all__ = ["LOCK", "Mismatch", "check_pins", "cvc5_skips", "load_lock", "pin_entry", "pin_key",
-           "repin"]
+__all__ = ["LOCK", "KindOf", "Mismatch", "check_kinds", "check_pins", "cvc5_skips", "load_lock",
+           "pin_entry", "pin_key", "repin"]
 
 #: The lock file shipped with the package (package data), next to this module.
 LOCK = Path(__file__).with_name("obligations.lock")
@@ -42,6 +49,10 @@ LOCK = Path(__file__).with_name("obligations.lock")
 _FORMAT = "cfmpa obligations lock 1"
 
 Mismatch = tuple[str, str]     # (obligation id, what differs)
+#: An obligation id -> (its kind, why): proofs/_runner.py's kind_of and DEFINITIONAL.
+KindOf = Callable[[str], tuple[str, str]]
+#: What an entry holds besides its statement (not part of the statement's comparison).
+_NOT_STATEMENT = ("cvc5", "kind", "kind_why")
 
 
 def pin_key(ident: str) -> str:
@@ -77,8 +88,9 @@ def _reason_class(reason: str | None) -> str:
 
 
 def _statement(entry: dict[str, Any]) -> dict[str, Any]:
-    """The part of an entry a run must match (cvc5's recorded answers are not)."""
-    return {k: v for k, v in entry.items() if k != "cvc5"}
+    """The part of an entry a run must match as its statement (cvc5's recorded answers are not;
+    the kind is matched by ``check_kinds``, which --repin cannot silence)."""
+    return {k: v for k, v in entry.items() if k not in _NOT_STATEMENT}
 
 
 def cvc5_skips(lock: dict[str, dict[str, Any]]) -> dict[str, str]:
@@ -135,12 +147,32 @@ def check_pins(proofs: Iterable[Proof], lock: dict[str, dict[str, Any]]) -> list
     return out
 
 
+def check_kinds(proofs: Iterable[Proof], lock: dict[str, dict[str, Any]],
+                kind_of: KindOf) -> list[Mismatch]:
+    """Every proof whose kind in the code (``kind_of``) is not the kind the lock pins, or whose
+    entry pins none (a lock from before kinds were pinned: ``--repin`` adds them)."""
+    out: list[Mismatch] = []
+    for p in proofs:
+        old = lock.get(pin_key(p.id))
+        if old is None:
+            continue                    # not pinned at all: check_pins says so
+        kind, _ = kind_of(p.id)
+        if "kind" not in old:
+            out.append((p.id, f"its kind ({kind}) is not pinned (cfmpa prove --repin pins it)"))
+        elif old["kind"] != kind:
+            out.append((p.id, f"kind {kind} in the code, {old['kind']} pinned: --repin never "
+                              "changes a kind (edit proofs/obligations.lock by hand, with the "
+                              "reason, if the change is meant)"))
+    return out
+
+
 def repin(proofs: Iterable[Proof], path: str | Path | None = None, *,
-          complete: bool = True) -> list[str]:
+          complete: bool = True, kind_of: KindOf | None = None) -> list[str]:
     """Rewrite the lock with the proofs' statements; return the changes, one line each.
 
     ``complete``: the proofs are a whole run, so a pinned id not among them is removed (with
-    ``--only`` the others are kept as they are)."""
+    ``--only`` the others are kept as they are). ``kind_of``: the kind of an id not pinned yet
+    (or pinned without one) is written; a pinned kind is kept whatever the code says."""
     f = Path(path) if path is not None else LOCK
     old = load_lock(f)
     new: dict[str, dict[str, Any]] = {} if complete else dict(old)
@@ -148,6 +180,14 @@ def repin(proofs: Iterable[Proof], path: str | Path | None = None, *,
     conflicts = []
     for p in proofs:
         key, entry = pin_key(p.id), pin_entry(p)
+        before = old.get(key, {})
+        if "kind" in before:
+            entry["kind"] = before["kind"]
+            entry["kind_why"] = before.get("kind_why", "")
+            if kind_of is not None and kind_of(p.id)[0] == before["kind"]:
+                entry["kind_why"] = kind_of(p.id)[1]
+        elif kind_of is not None:
+            entry["kind"], entry["kind_why"] = kind_of(p.id)
         if key in produced and _statement(produced[key]) != _statement(entry):
             conflicts.append(f"conflict: {p.id} is not {key} as pinned by another scenario")
         produced.setdefault(key, entry)

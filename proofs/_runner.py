@@ -39,10 +39,12 @@ from ._obl_constants import constants_obligations
 from ._obl_monitor import monitor_obligations
 from ._obl_tolerance import tolerance_obligations
 from ._obl_safety import safety_obligations
+from ._obl_tools import tools_obligations
+from ._obl_wiring import wiring_obligations
 from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
 from ._controls import Control, ControlResult, run_control
 from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
-from ._pins import LOCK, Mismatch, check_pins, cvc5_skips, load_lock
+from ._pins import LOCK, Mismatch, check_kinds, check_pins, cvc5_skips, load_lock
 from ._pins import repin as repin_lock
 
 __all__ = [
@@ -56,6 +58,7 @@ __all__ = [
     "default_workers",
     "expected_ids",
     "is_bundled",
+    "kind_and_why",
     "kind_of",
     "pinned_verdict",
     "render_report",
@@ -89,11 +92,13 @@ EXPECTED_VERDICTS: dict[str, Verdict] = {
     "Prop8.prestrength_thm4": _P,
     "Tolerance.tube": _P, "Monitor.between_samples": _P,
     "Certificate.lipschitz": _P, "Tolerance.tube_factor": _P, "Exact.gap_formula": _P,
+    "Certificate.wiring": _P, "Certificate.pieces": _P, "Monitor.reference_speeds": _P,
     "Safety.original.principal_in_layer_box": _P, "Safety.modified.principal_in_layer_box": _P,
     "Safety.tight.principal_in_layer_box": _P, "Safety.subordinate_in_cell_box": _P,
     "Safety.region_soundness": _P, "Safety.region_statement": _P,
     "Safety.separation": _P, "Safety.original.composition": _P,
     "Safety.modified.composition": _P, "Safety.tight.composition": _P,
+    "Safety.height_rule": _P, "Safety.tool_region": _P, "Certificate.height_gap": _P,
 }
 
 #: Obligations whose proof is definitional: true by a definition's own clauses, a termination
@@ -116,6 +121,11 @@ DEFINITIONAL: dict[str, str] = {
 def kind_of(ident: str) -> str:
     """``definitional`` for the ids of DEFINITIONAL, else ``theorem``."""
     return "definitional" if ident in DEFINITIONAL else "theorem"
+
+
+def kind_and_why(ident: str) -> tuple[str, str]:
+    """(kind, why) of an id, as proofs/obligations.lock pins it (``_pins.check_kinds``)."""
+    return kind_of(ident), DEFINITIONAL.get(ident, "")
 
 
 #: The obligations every run must produce, besides the per-scenario ones.
@@ -157,7 +167,7 @@ def collect_obligations(scenarios_dir: str | Path = BUNDLED_DIR,
            + path_obligations() + theorem_obligations() + witness_obligations()
            + prop8_obligations()
            + tolerance_obligations() + monitor_obligations() + constants_obligations()
-           + safety_obligations()
+           + safety_obligations() + tools_obligations() + wiring_obligations()
            + scenario_obligations(scenarios_dir))
     return tuple(o for o in obs if selected(o.id, only))
 
@@ -217,13 +227,14 @@ class ProveRun:
     pin_mismatch: tuple[Mismatch, ...] = ()  # statement not the one obligations.lock pins
     repinned: tuple[str, ...] | None = None  # --repin: what it changed in the lock
     controls: tuple[ControlResult, ...] = ()  # the negative controls (proofs/_controls.py)
+    kind_mismatch: tuple[Mismatch, ...] = ()  # kind not the one obligations.lock pins
 
     @property
     def ok(self) -> bool:
         return (all(p.as_expected for p in self.proofs) and not self.missing_ids
                 and not self.unexpected_ids and not self.verdict_mismatch
                 and not self.duplicate_ids and not self.pin_mismatch
-                and all(c.ok for c in self.controls))
+                and not self.kind_mismatch and all(c.ok for c in self.controls))
 
 
 def compare_ids(ids: Sequence[str], expected: Sequence[str]
@@ -285,8 +296,10 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
     if repin:
         ran = {p.id for p in proofs}
         complete = set(FIXED_IDS) <= set(expected) <= ran
-        repinned = tuple(repin_lock(proofs, lock_path, complete=complete))
+        repinned = tuple(repin_lock(proofs, lock_path, complete=complete, kind_of=kind_and_why))
     pins = tuple(check_pins(proofs, load_lock(lock_path)))
+    # A kind is pinned like an expected verdict: --repin above kept every pinned one.
+    kinds = tuple(check_kinds(proofs, load_lock(lock_path), kind_and_why))
     changes = {}
     for p in proofs:
         old = previous.get(p.id)
@@ -309,7 +322,7 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                    seconds=seconds, verdict_mismatch=tuple(mismatch),
                    duplicate_ids=tuple(sorted(repeated)),
                    scenarios_note=note, record=dict(record or {}), pin_mismatch=pins,
-                   repinned=repinned, controls=checked)
+                   repinned=repinned, controls=checked, kind_mismatch=kinds)
     _write_atomic(out / "results.json", _results_json(run, previous))
     return run
 
@@ -485,6 +498,7 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
         "removed_since_last_run": list(run.removed),
         "depth": depth_table(run.proofs), "second_solver": solver_table(run.proofs),
         "pins": {"mismatch": [{"id": i, "what": w} for i, w in run.pin_mismatch],
+                 "kind_mismatch": [{"id": i, "what": w} for i, w in run.kind_mismatch],
                  "repinned": None if run.repinned is None else list(run.repinned)},
         "obligations": entries + carried,
         "controls": [c.as_json() for c in run.controls],
@@ -629,10 +643,13 @@ def render_report(run: ProveRun) -> str:
         lines += [f"    {ln}" for ln in run.repinned]
     for ident, what in run.pin_mismatch:
         lines.append(f"STATEMENT NOT PINNED: {ident}: {what} (review, then cfmpa prove --repin)")
+    for ident, what in run.kind_mismatch:
+        lines.append(f"KIND NOT AS PINNED: {ident}: {what}")
     if run.controls:
         cs = control_summary(run.controls)
-        lines += ["", "Negative controls (wrong inputs each checker must reject; each safety "
-                  "composition without one of its premises, which must not be proved)", "",
+        lines += ["", "Controls (wrong inputs each checker must reject, right inputs it must "
+                  "accept, the harness's own; each safety composition without one of its "
+                  "premises, which must not be proved)", "",
                   f"{cs['as_expected']} of {cs['total']} as expected: "
                   + ", ".join(f"{v} {k}" for k, v in cs.items()
                               if k not in ("total", "as_expected"))]
@@ -652,6 +669,6 @@ def render_report(run: ProveRun) -> str:
     verdict = "OK: every verdict as expected" if run.ok else "NOT OK"
     lines += ["", f"{verdict}; {len(run.proofs)} obligations ({kinds['theorem']} theorems, "
               f"{kinds['definitional']} definitional) in {run.seconds:.1f} s"
-              + (f"; {sum(c.ok for c in run.controls)} of {len(run.controls)} negative "
+              + (f"; {sum(c.ok for c in run.controls)} of {len(run.controls)} "
                  "controls as expected" if run.controls else "")]
     return "\n".join(lines) + "\n"

@@ -162,6 +162,15 @@ SUMMARIES: dict[str, str] = {
     "Tolerance.tube": "A robot that tracks a plan proved clear by c to within delta in every "
                       "joint cannot collide while c > 2 L delta, L the largest reach of a link "
                       "about its two joints (metres per radian).",
+    "Monitor.reference_speeds": "For a gap between two measured samples, the plan's speed the "
+                                "monitor uses is at least its speed on every part of the plan "
+                                "the gap overlaps, however many parts that is.",
+    "Certificate.wiring": "For each time piece of a motion the certificate checks, the speed it "
+                          "charges each arm is the speed that arm really has on that piece, and "
+                          "the angles it samples are the motion's own.",
+    "Certificate.pieces": "The certificate cuts the motion into pieces that each lie within one "
+                          "path step, stop where the principal arm stops, and together cover "
+                          "the whole motion without gaps.",
     "Monitor.between_samples": "Between two measured samples, a robot and a plan that each "
                                "move at most their speed limit stay within the larger sampled "
                                "deviation plus their speeds times half the gap.",
@@ -187,6 +196,17 @@ SUMMARIES: dict[str, str] = {
     "Safety.original.composition": _COMPOSED.format(variant="original"),
     "Safety.modified.composition": _COMPOSED.format(variant="modified"),
     "Safety.tight.composition": _COMPOSED.format(variant="tight"),
+    "Safety.height_rule": ("Two parts whose height ranges the planner calls apart share no point "
+                           "in space, whatever their outlines, so their planar test may be "
+                           "skipped; ranges that only touch count as overlapping."),
+    "Safety.tool_region": "Every point of a tool on the wrist, at any joint angles inside a box, "
+                          "lies inside the swept region the planner builds for the tool: its "
+                          "margin, taken from the farthest vertex, covers the motion between the "
+                          "sample angles.",
+    "Certificate.height_gap": "Between two parts at disjoint heights the motion check's distance, "
+                              "made of the planar distance and the height gap, never exceeds "
+                              "their true distance in space, and changes no faster than the "
+                              "planar one.",
     # Per workcell
     "Scenario.*.time_grid": "{workcell}: the time steps cover the whole of the principal arm's "
                             "motion, for the numbers as written in the file and as the computer "

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import io
 import math
 import time
@@ -48,7 +49,7 @@ from ._findings import (Finding, early_arrival_finding, inconsistency_finding, n
                         prop8_finding, sample_clearance)
 from ._obligations import (ProofData, card_groups, control_summary, load_proofs, load_selftest,
                            read_results, summary_table)
-from ._provenance import provenance
+from ._provenance import VERSION_GROUPS, provenance
 from ._sections import Section, compute_order, numbers, verdict_of
 
 __all__ = ["AuditResult", "FORMAT", "SECTIONS", "DEFAULT_COMPARE_N", "build_audit", "contract_rows",
@@ -127,11 +128,13 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
     on ``stdout`` (default sys.stdout), and a line per stage with its time on ``progress``.
 
     ``scenarios``: scenario files (None: every scenarios/*.toml). ``proofs_json``: a results.json
-    of ``make prove`` to report (None: run the obligations afresh). Exit code 0 when everything
-    the report checks holds (see the report's first table), 1 otherwise (the report is written
-    either way), 2 for bad input. ``expected_ids``: the obligation ids the report must find
-    (None: every obligation of the prove machinery). ``campaign``: a folder written by
-    ``cfmpa compare --out``, whose recorded campaign the report shows instead of running one.
+    of ``make prove`` to report (None: run the obligations afresh). Exit code 0 when no check of
+    the report failed (see "What this run checked"; an incomplete report, with a check not
+    available, is 0 too and says "incomplete" in its last line and its status), 1 otherwise
+    (the report is written either way), 2 for bad input. ``expected_ids``: the obligation ids
+    the report must find (None: every obligation of the prove machinery). ``campaign``: a
+    folder written by ``cfmpa compare --out``, whose recorded campaign the report shows instead
+    of running one.
     ``progress``: where to write a line per stage with its time (``cfmpa audit``: stderr).
     """
     stages = _Progress(progress)
@@ -149,6 +152,9 @@ def run_audit(scenarios: list[str] | None, out_dir: str, *, argv: list[str] | No
     for item in v["items"]:
         state = {True: "ok", False: "FAILED", None: "not available"}[item["ok"]]
         print(f"{item['check']:<38} {state}: {item['detail']}", file=so)
+    print(f"{'overall':<38} {v['status']}"
+          + (f" (not available: {', '.join(v['not_available'])})" if v["not_available"] else ""),
+          file=so)
     print(f"wrote     {html_path} ({html_path.stat().st_size} bytes), {json_path}", file=so)
     return 0 if v["ok"] else 1
 
@@ -257,6 +263,9 @@ def template_env() -> jinja2.Environment:
                              lstrip_blocks=True, keep_trailing_newline=True,
                              loader=jinja2.FunctionLoader(lambda n: _template_source(n)))
     env.filters.update(num=_num, pct=_pct, mm=_mm, secs=_secs, s3=_s3, anchor=_anchor)
+    env.tests["control_id"] = lambda i: str(i).startswith("Control.")   # a negative control's id
+    env.globals["version_groups"] = VERSION_GROUPS
+    env.globals["version_grouped"] = [k for _, keys in VERSION_GROUPS for k in keys]
     return env
 
 
@@ -349,7 +358,7 @@ def _controls_item(doc: Mapping[str, Any]) -> dict[str, Any]:
 def _relate(doc: dict[str, Any]) -> None:
     """Give each finding the obligations that state it (by id prefix), with their verdicts."""
     for f in doc["findings"]:
-        f["related_obligations"] = [{"id": r["id"], "verdict": r["verdict"]}
+        f["related_obligations"] = [{"id": r["id"], "verdict": r["verdict"], "badge": r["badge"]}
                                     for r in doc["obligations"]["items"]
                                     if any(r["id"].startswith(pre) for pre in f["related"])]
 
@@ -364,6 +373,99 @@ def _relate(doc: dict[str, Any]) -> None:
 #: witness was checked (the contracts' post.optimal, or the translation check).
 _SAFETY_ASSUMPTIONS = ("A1", "A2", "A3", "A4", "A11")
 _NO_PATH_ASSUMPTIONS = ("A1", "A2")
+#: The scenario-independent obligations a found plan's "safe" rests on, by id prefix: the safety
+#: theorem's parts (§10: ``Safety.<variant>.*`` of the row's variant only, and every ``Safety.*``
+#: of no variant), the certificate's bound (§7.2: "certified clear") and the tolerance tube the
+#: row shows (§12). Taken from the prove machinery's ids (``cfmpa.proofs.FIXED_IDS``), so a part
+#: added there is required here too.
+ROW_OBLIGATION_PREFIXES = ("Safety.", "Certificate.", "Tolerance.")
+_VARIANTS = tuple(v.value for v in Variant)
+
+
+def row_requirements(stem: str, variant: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(obligation ids, control ids) a found plan's row of workcell ``stem`` (its file's stem)
+    and ``variant`` rests on: ROW_OBLIGATION_PREFIXES' ids of the prove machinery, of this
+    variant or none; the workcell's ``Scenario.<stem>.*`` checks (the translation check of this
+    variant only, §7.4); and the negative controls (§10) of every checker the argument reads
+    and of each of those obligations (``Control.Safety.<variant>.composition.without[k]``)."""
+    from ..proofs import FIXED_IDS, SCENARIO_CHECKS, scenario_check_id
+
+    def of_row(i: str) -> bool:
+        parts = i.split(".")
+        return i.startswith(ROW_OBLIGATION_PREFIXES) and (
+            len(parts) < 3 or parts[1] not in _VARIANTS or parts[1] == variant)
+
+    obligations = tuple(i for i in FIXED_IDS if of_row(i)) + tuple(
+        scenario_check_id(stem, c) for c in SCENARIO_CHECKS
+        if not c.startswith("translation_") or c == f"translation_{variant}")
+    controls = tuple(cid for cid, checker in _control_checkers()
+                     if not checker.startswith(ROW_OBLIGATION_PREFIXES) or checker in obligations)
+    return obligations, controls
+
+
+@functools.lru_cache(maxsize=1)
+def _control_checkers() -> tuple[tuple[str, str], ...]:
+    """(id, checker) of every negative control of the prove machinery (built once: a fraction
+    of a second each time)."""
+    from ..proofs import collect_controls
+
+    return tuple((c.id, c.checker) for c in collect_controls())
+
+
+@dataclass(frozen=True)
+class _Standing:
+    """How a row's required obligations and controls stand in this run's data: ``missing``
+    (not run: absent, carried over from an earlier run, or the data not available) and
+    ``wrong`` (run, not as expected), each a list of ids; ``held``: how many ran as expected;
+    ``stale``: why the proof data are not of this tree (None: they are, or cannot tell)."""
+
+    missing_obligations: tuple[str, ...]
+    missing_controls: tuple[str, ...]
+    wrong: tuple[str, ...]
+    held: int
+    total: int
+    stale: str | None
+
+    @property
+    def missing(self) -> tuple[str, ...]:
+        return self.missing_obligations + self.missing_controls
+
+    def text(self) -> str:
+        """What the row says of its obligations and controls (for ``why``)."""
+        out = [f"{self.held} of {self.total} of its obligations and negative controls ran as "
+               "expected" + (f" (not: {', '.join(self.wrong)})" if self.wrong else "")]
+        if self.missing_obligations:
+            out.append("not in this run: " + ", ".join(self.missing_obligations))
+        if self.missing_controls:
+            n = len(self.missing_controls)
+            out.append(f"{n} negative control{'s' if n != 1 else ''} not in this run ("
+                       + (", ".join(self.missing_controls) if n <= 3 else
+                          f"{self.missing_controls[0]}, ...; all in report.json's "
+                          "summary[].missing") + ")")
+        if self.stale:
+            out.append(f"proof results not of this tree ({self.stale})")
+        return "; ".join(out)
+
+
+def _standing(doc: Mapping[str, Any], stem: str, variant: str) -> _Standing:
+    """The row's ``_Standing`` in report.json's obligations, controls and provenance."""
+    obligations, controls = row_requirements(stem, variant)
+    ob = doc["obligations"]
+    ran = {i["id"]: i for i in ob["items"] if i.get("change") != "not run"} if ob[
+        "available"] else {}
+    ctl = doc.get("controls") or {"available": False, "items": []}
+    checked = {c["id"]: c for c in ctl["items"]} if ctl["available"] else {}
+    wrong = tuple(i for i in obligations if i in ran and not ran[i]["as_expected"]) + tuple(
+        c for c in controls if c in checked and not checked[c]["ok"])
+    missing_ob = tuple(i for i in obligations if i not in ran)
+    missing_ctl = tuple(c for c in controls if c not in checked)
+    stale = None
+    if ob["available"] and "provenance" in doc:
+        tree = _proofs_of_this_tree(ob, doc["provenance"])
+        stale = tree["detail"] if tree["ok"] is False else None
+    total = len(obligations) + len(controls)
+    return _Standing(missing_ob, missing_ctl, wrong,
+                     total - len(wrong) - len(missing_ob) - len(missing_ctl), total, stale)
 
 
 def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list[dict[str, Any]]:
@@ -371,16 +473,21 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
     certificate's lower bound, mm; None unless clear), the least sampled clearance (mm, an upper
     bound on the true minimum), the tolerance in rad, degrees and mm at the farthest point of
     either arm (delta times L, the largest R_base + R_elbow over both arms' parts, the tool tip
-    where there is a tool: the most a deviation of delta in every joint moves any point), the
-    ledger ids it rests on, its verdict and why, and ``scope``: ``spec.theorem_scope``, what the
-    safety theorem does not yet cover of the workcell (a tool, heights), or None.
+    where there is a tool: the most a deviation of delta in every joint moves any point;
+    ``tolerance_farthest_point_mm``, also under its former name ``tolerance_tip_mm`` for format
+    version 1), the ledger ids it rests on, its verdict and why, ``missing``: the obligations
+    and controls it rests on that are not in this run, and ``scope``: ``spec.theorem_scope``,
+    what the safety theorem does not yet cover of the workcell (a tool, heights), or None.
 
-    ``ok`` is True for a found plan certified clear with no contract violation and none of its
-    obligations (the Safety.* of its variant, Tolerance.tube, its workcell's checks) other than
-    expected; False for a plan not certified clear, a violation or such an obligation; None for
-    "no path" (nothing moves, so nothing is claimed safe). A row that would be "safe" but whose
-    workcell the safety theorem does not yet cover (``scope``) is "certified" instead: certified
-    clear and checked, not proved (docs/model.md §8, §10)."""
+    A found plan's verdict rests on what ran (``row_requirements``): ``ok`` is True ("safe")
+    for a plan certified clear with no contract violation whose every required obligation and
+    negative control ran in this run's data as expected, the proof data being of this tree;
+    False ("FAILED") for a plan not certified clear, a violation, or a required obligation or
+    control not as expected; None with verdict "incomplete" when it would be safe but any of
+    them is missing (named in ``missing`` and ``why``) or the proof data are of another tree.
+    None with "no plan" for "no path" (nothing moves, so nothing is claimed safe). A row that
+    would be "safe" but whose workcell the safety theorem does not yet cover (``scope``) is
+    "certified" instead: certified clear and checked, not proved (docs/model.md §8, §10)."""
     from ..proofs import ASSUMPTIONS
 
     ledger = {a.id.split(".")[0]: a.id for a in ASSUMPTIONS}
@@ -393,30 +500,32 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
         scope = theorem_scope(s)
         for v in entry["variants"]:
             name = v["variant"]
-            related = [i for k, i in verdicts.items()
-                       if k.startswith((f"Safety.{name}.", f"Scenario.{stem}."))
-                       or k in ("Safety.subordinate_in_cell_box", "Safety.region_soundness",
-                                "Safety.region_statement",
-                                "Safety.separation", "Tolerance.tube")]
-            related = [i for i in related if not i["id"].startswith(f"Scenario.{stem}.translation_")
-                       or i["id"].endswith(f"_{name}")]
-            wrong = [i["id"] for i in related if not i["as_expected"]]
+            standing = _standing(doc, stem, name)
             translated = verdicts.get(f"Scenario.{stem}.translation_{name}", {}).get(
                 "verdict") == "proved"
             cl = v["clearance"]
             violations = (v["contracts"] or {}).get("violations") or []
             tol = v.get("tolerance_rad")
             needs: tuple[str, ...] = ()
+            missing: tuple[str, ...] = ()
             if v["status"] == "found" and cl and cl["clear"] and not violations:
-                ok, needs = (not wrong), _SAFETY_ASSUMPTIONS + (() if translated else ("A5",))
+                needs = _SAFETY_ASSUMPTIONS + (() if translated else ("A5",))
                 why = ["certified clear in continuous time",
                        f"contracts held ({(v['contracts'] or {}).get('mode', 'not recorded')})"]
+                missing = standing.missing
+                if standing.wrong:
+                    ok, verdict = False, "FAILED"
+                elif missing or standing.stale:
+                    ok, verdict = None, "incomplete"
+                else:
+                    ok, verdict = True, "safe" if scope is None else "certified"
             elif v["status"] == "found":
-                ok = False
+                ok, verdict = False, "FAILED"
                 why = ["not certified clear" if not (cl and cl["clear"]) else
                        "certified clear", f"{len(violations)} contract violation(s)"]
             elif v["status"] == "no_path":
                 ok = None if not violations else False
+                verdict = "no plan" if ok is None else "FAILED"
                 witnessed = translated or _held(v["contracts"], "post.optimal")
                 needs = _NO_PATH_ASSUMPTIONS + (() if translated else ("A5",)) + (
                     () if witnessed else ("A6",))
@@ -424,30 +533,54 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
                        "its absence checked by a witness" if witnessed else
                        "its absence taken from the search's contract"]
             else:
-                ok, why = False, [f"the plan stopped: {v['reason']}"]
-            if ob["available"] and related:
-                why.append(f"{len(related) - len(wrong)} of {len(related)} of its obligations "
-                           "as expected" + (f" (not: {', '.join(wrong)})" if wrong else ""))
-            else:
-                why.append("its obligations not in this run's proof data")
+                ok, verdict, why = False, "FAILED", [f"the plan stopped: {v['reason']}"]
+            why.append(standing.text() if ob["available"] else
+                       f"its obligations not in this run's proof data ({ob.get('source', 'none')})")
+            if verdict == "incomplete":
+                why.insert(0, "incomplete: it would be "
+                           + ("safe" if scope is None else "certified")
+                           + ", but not all it rests on ran in this run")
             if scope is not None:
                 why.insert(0, scope)
             found = v["status"] == "found" and tol is not None
-            verdict = {True: "safe" if scope is None else "certified", False: "FAILED",
-                       None: "no plan"}[ok]
+            tip = 1000 * reach * tol if found else None
             rows.append({
                 "scenario": entry["name"], "variant": name, "status": v["status"],
                 "lower_bound_mm": 1000 * cl["lower_bound_m"] if cl and cl["clear"] else None,
                 "min_mm": 1000 * cl["min_m"] if cl else None,
                 "tolerance_rad": tol if found else None,
                 "tolerance_deg": math.degrees(tol) if found else None,
-                "tolerance_tip_mm": 1000 * reach * tol if found else None,
+                "tolerance_farthest_point_mm": tip,
+                "tolerance_tip_mm": tip,
                 "reach_m_per_rad": reach,
                 "assumptions": [ledger[a] for a in needs if a in ledger],
                 "ok": ok, "verdict": verdict, "scope": scope,
+                "missing": list(missing),
                 "why": "; ".join(why),
             })
     return rows
+
+
+def _rows_item(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """The verdict's row for section 1: every found plan's verdict rests on what ran. False when
+    a row FAILED, None (incomplete) when a row is incomplete, True otherwise."""
+    check = "verdict rows rest on what ran"
+    rows = doc["summary"]
+    failed = [f"{r['scenario']}/{r['variant']}" for r in rows if r["ok"] is False]
+    short = [f"{r['scenario']}/{r['variant']}" for r in rows if r["verdict"] == "incomplete"]
+    counts = {}
+    for r in rows:
+        counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
+    detail = ", ".join(f"{n} {k}" for k, n in counts.items())
+    if failed:
+        return _item(check, False, detail + f"; FAILED: {', '.join(failed)}")
+    if short:
+        n = max(len(r["missing"]) for r in rows)
+        return _item(check, None, detail + f"; incomplete: {', '.join(short)} ("
+                     + (f"up to {n} of the obligations and negative controls they rest on not "
+                        "in this run, named in summary[].missing" if n else
+                        "the proof results are not of this tree") + ")")
+    return _item(check, True, detail)
 
 
 def _held(contracts: Mapping[str, Any] | None, condition: str) -> bool:
@@ -1198,7 +1331,7 @@ def _this_tree_item(doc: Mapping[str, Any]) -> dict[str, Any]:
 #: pictures and campaign, which do not need them (`cfmpa prove --audit` overlaps the two).
 SECTIONS: tuple[Section, ...] = (
     Section("summary", "Verdict per workcell", _compute_summary, "section_summary.html",
-            needs=("scenarios", "obligations"),
+            needs=("scenarios", "obligations", "controls", "provenance"), checks=(_rows_item,),
             contents=('<a href="#workcells">Verdict per workcell</a>',)),
     Section("provenance", "Provenance and what this run checked", _compute_provenance,
             "section_provenance.html"),

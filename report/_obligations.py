@@ -34,6 +34,8 @@ __all__ = [
     "VCRow",
     "SUMMARY_COLUMNS",
     "CARD_GROUPS",
+    "BADGES",
+    "badge_of",
     "audited_ids",
     "card_groups",
     "control_summary",
@@ -58,6 +60,26 @@ SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
 
 _VERDICTS = ("proved", "refuted as expected", "unknown", "failed")
 _KINDS = ("theorem", "definitional")
+
+#: What a card's badge says was done, by the obligation's method, for a *proved* verdict: only a
+#: solver's proof is "proved" (Z3's unsat, sympy's exact computation); a check on the run's
+#: concrete data (the per-workcell Scenario.* checks) is "checked on data"; a method that only
+#: tests, "tested only". Other verdicts are shown as they are (refuted as expected, unknown,
+#: failed). The ledger's entries are "assumed" (docs/model.md §6.3, §8).
+PROVED_BADGES: dict[str, str] = {"z3": "proved", "sympy": "proved", "data": "checked on data",
+                                 "test": "tested only"}
+#: Every badge a card or a ledger entry can carry.
+BADGES = ("proved", "checked on data", "tested only", "refuted as expected", "unknown", "failed",
+          "assumed")
+
+
+def badge_of(method: str, verdict: str) -> str:
+    """The badge of an obligation's card: what was done (PROVED_BADGES), never "proved" for a
+    check on data; a proved verdict under a method this report does not know is "unknown"
+    (nothing is called proved that is not known to be a proof)."""
+    if verdict == "proved":
+        return PROVED_BADGES.get(method, "unknown")
+    return verdict
 
 
 @dataclass(frozen=True)
@@ -103,9 +125,15 @@ class ObligationRow:
     def as_expected(self) -> bool:
         return self.verdict == self.expected
 
+    @property
+    def badge(self) -> str:
+        """What its card's badge says was done (``badge_of``)."""
+        return badge_of(self.method, self.verdict)
+
     def as_json(self) -> dict[str, Any]:
         return {"id": self.id, "group": self.group, "paper_ref": self.paper_ref,
                 "statement": self.statement, "method": self.method, "verdict": self.verdict,
+                "badge": self.badge,
                 "expected": self.expected, "as_expected": self.as_expected,
                 "seconds": self.seconds, "counterexample": self.counterexample,
                 "reason": self.reason, "sha256": self.sha256, "change": self.change,
@@ -461,15 +489,21 @@ def _z3_only(vcs: Any) -> tuple[str, ...]:
 def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
     import tempfile
 
-    from ..proofs import (ASSUMPTIONS, DEFINITIONAL, default_workers, kind_of, obligation_summary,
-                          run_obligations)
+    from ..proofs import (ASSUMPTIONS, DEFINITIONAL, FIXED_IDS, collect_controls,
+                          default_workers, kind_of, obligation_summary, run_obligations)
 
     # The prove runner itself: its worker processes side by side, each with its cvc5 replay in
     # the background, and the lock's record of what cvc5 did not decide (one obligation at a
     # time with a fresh cvc5 each, as before, took 157 s of a 173 s audit on two cores).
     workers = default_workers()
+    # A run of every scenario-independent obligation runs the negative controls too, as
+    # `cfmpa prove` does: the verdict rows rest on them (docs/model.md §8); a narrower run
+    # (a test's stand-in) has none to run and says so.
+    whole = set(FIXED_IDS) <= {o.id for o in obligations}
+    controls = collect_controls() if whole else ()
     with tempfile.TemporaryDirectory(prefix="cfmpa-audit-proofs-") as tmp:
-        run = run_obligations(obligations, tmp, [o.id for o in obligations], workers=workers)
+        run = run_obligations(obligations, tmp, [o.id for o in obligations], workers=workers,
+                              controls=controls)
     by_id = {p.id: p for p in run.proofs}
     rows = []
     for ob in obligations:
@@ -486,23 +520,36 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
             vcs=tuple(VCRow(v.name, v.depth, tuple(v.solvers), bool(v.nonlinear))
                       for v in p.vcs)))
     missing, unexpected = check_ids([r.id for r in rows], expected)
+    checked = tuple(ControlRow(id=c.id, checker=c.checker, what=c.what, expected=c.expected,
+                               outcome=c.outcome, detail=c.detail, seconds=float(c.seconds),
+                               recorded_ok=None) for c in run.controls)
+    missing_controls: tuple[str, ...] = ()
+    if set(FIXED_IDS) <= set(expected):
+        have = {c.id for c in checked}
+        missing_controls = tuple(c.id for c in collect_controls() if c.id not in have)
     return ProofData(available=True, source="a fresh run of the prove machinery for this report",
                      note=f"{len(rows)} obligations discharged by {workers} process(es) side "
                      "by side, "
-                     f"{sum(r.seconds or 0.0 for r in rows):.1f} s in all; nothing written under "
-                     "build/proofs",
+                     f"{sum(r.seconds or 0.0 for r in rows):.1f} s in all"
+                     + (f", then {len(checked)} negative controls" if checked else "")
+                     + "; nothing written under build/proofs",
                      rows=tuple(rows), ledger=_ledger_entries(ASSUMPTIONS), ledger_available=True,
                      missing_ids=missing, unexpected_ids=unexpected,
-                     controls_note="not run for this report: cfmpa prove runs the negative "
-                     "controls; give its results.json (cfmpa audit --proofs) to show them")
+                     controls=checked or None, missing_controls=missing_controls,
+                     controls_note="run for this report, as cfmpa prove runs them" if checked
+                     else "not run for this report: this run did not discharge every "
+                     "scenario-independent obligation, with which cfmpa prove runs the negative "
+                     "controls")
 
 
 def _ledger_entries(entries: Iterable[Any]) -> tuple[dict[str, str], ...]:
-    """Ledger entries {id, what, why, used_by} from Assumption values or their JSON."""
+    """Ledger entries {id, what, why, used_by, badge} from Assumption values or their JSON; the
+    badge of each is "assumed" (taken on trust, not proved here)."""
     out = []
     for e in entries:
         get = e.get if isinstance(e, dict) else (lambda k, _e=e: getattr(_e, k, None))
-        out.append({k: str(get(k) or "") for k in ("id", "what", "why", "used_by")})
+        out.append({**{k: str(get(k) or "") for k in ("id", "what", "why", "used_by")},
+                    "badge": "assumed"})
     return tuple(out)
 
 

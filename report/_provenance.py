@@ -12,13 +12,26 @@ from typing import Any
 
 from ..gitstate import git_state, package_state
 
-__all__ = ["REPORTED_DISTRIBUTIONS", "git_state", "library_versions", "provenance"]
+__all__ = ["REPORTED_DISTRIBUTIONS", "VERSION_GROUPS", "git_state", "library_versions",
+           "provenance"]
 
-#: Distributions besides those of ``cfmpa.runs.versions`` whose version the report gives:
-#: the prover's second engine (sympy), the fast kernels' compiler (numba on llvmlite), and what
-#: draws and writes the report (matplotlib with Pillow, Jinja2).
-REPORTED_DISTRIBUTIONS = {"sympy": "sympy", "numba": "numba", "llvmlite": "llvmlite",
-                          "matplotlib": "matplotlib", "pillow": "pillow", "jinja2": "jinja2"}
+#: Distributions besides those of ``cfmpa.runs.versions`` (Python, numpy, shapely, Z3) whose
+#: version the report gives (key -> distribution name): the second SMT solver, which replays
+#: every VC (cvc5), the exact symbolic engine (sympy), the ball arithmetic of the exact
+#: re-decision (python-flint), the fast kernels' compiler (numba on llvmlite), and what draws
+#: and writes the report (matplotlib with Pillow, Jinja2).
+REPORTED_DISTRIBUTIONS = {"cvc5": "cvc5", "sympy": "sympy", "python-flint": "python-flint",
+                          "numba": "numba", "llvmlite": "llvmlite", "matplotlib": "matplotlib",
+                          "pillow": "pillow", "jinja2": "jinja2"}
+
+#: How the provenance table groups the versions (docs/model.md §8): every key of
+#: ``provenance.versions`` is in exactly one group (tested).
+VERSION_GROUPS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("tool", ("cfmpa", "python")),
+    ("solvers", ("z3", "cvc5", "sympy")),
+    ("numerics", ("numpy", "shapely", "python-flint", "numba", "llvmlite")),
+    ("report", ("matplotlib", "pillow", "jinja2")),
+)
 
 
 def library_versions() -> dict[str, str]:

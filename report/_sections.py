@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Check", "Section", "compute_order", "numbers", "verdict_of"]
+__all__ = ["Check", "STATUSES", "Section", "compute_order", "numbers", "verdict_of"]
 
 #: A check of the report's verdict: report.json (every part computed) -> one verdict item,
 #: ``{"check": name, "ok": True | False | None (not available), "detail": text}``.
@@ -93,11 +93,22 @@ def compute_order(sections: Sequence[Section]) -> tuple[Section, ...]:
     return tuple(order)
 
 
+#: The report's overall status (the pill of section 1 and of "What this run checked"), worst
+#: first: a check failed; none failed but one is not available (not run here, or a verdict row
+#: whose proofs did not all run), so the verdict rests on less than it needs; every check holds.
+STATUSES = ("FAILED", "incomplete", "no failure")
+
+
 def verdict_of(doc: Mapping[str, Any], sections: Sequence[Section]) -> dict[str, Any]:
-    """The report's verdict: every section's checks in the sections' order, and ``ok``, which is
-    False when any item is False (None, not available, counts neither way)."""
+    """The report's verdict: every section's checks in the sections' order; ``ok``, which is
+    False when any item is False (None, not available, counts neither way: the exit code);
+    ``status`` (STATUSES): "FAILED" when ``ok`` is False, else "incomplete" when any item is
+    None, else "no failure"; ``not_available``: the checks that are None."""
     items = [check(doc) for s in sections for check in s.checks]
-    return {"ok": all(i["ok"] is not False for i in items), "items": items}
+    ok = all(i["ok"] is not False for i in items)
+    short = [i["check"] for i in items if i["ok"] is None]
+    return {"ok": ok, "status": STATUSES[0] if not ok else STATUSES[1] if short else STATUSES[2],
+            "not_available": short, "items": items}
 
 
 def numbers(sections: Sequence[Section]) -> dict[str, int]:

@@ -36,10 +36,12 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
                             STORE_NAME, Campaign,
                             CaseError, CaseResult, VariantOutcome, load_campaign, plan_workcell,
                             random_workcell, run_campaign, workcell_task)
-    from ._limits import MAX_DT, MAX_WORKCELLS
+    from ._limits import MAX_DT, MAX_LOG_SAMPLES, MAX_WORKCELLS, MIN_PERIOD_S
     from ._store import Store, open_store, read_store
     from ._batch import BATCH_JSON, batch_table, check_plan_folder, find_plan_folders, run_batch
     from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
+    from ._drstore import (DR_FILES, DR_STORES, ZARR_ABOVE_CELLS, default_store, dr_sha256_of,
+                           find_dr, load_dr, open_dr_layers, write_dr)
     from ._engine import (CONNECT_TIMEOUT_S, RETRIES, WORKER_TIMEOUT_S, Engine, ProgressBar,
                           TaskLost, check_scheduler_address, error_message)
     from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json,
@@ -47,8 +49,8 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
     from ._plan import (CERTIFICATE, PlanResult, clearance_line, plan, plan_json, run_dr, run_plan,
                         versions, write_plan)
     from ._bundled import run_scenarios
-    from ._trajectory_runs import (AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, BLOCK_ROWS, MAX_LOG_SAMPLES,
-                                   MIN_PERIOD_S, LISTED_UNOBSERVED, MISSING_MESSAGES, Excursion,
+    from ._trajectory_runs import (AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, BLOCK_ROWS,
+                                   LISTED_UNOBSERVED, MISSING_MESSAGES, Excursion,
                                    MonitorResult,
                                    Unobserved, certify_json, log_csv, monitor_json, monitor_log,
                                    monitor_rows, parse_excursion, parse_max_speed, run_certify, run_monitor,
@@ -94,6 +96,15 @@ _EXPORTS: dict[str, str] = {
     "read_dr": "._check:read_dr",
     "read_plan": "._check:read_plan",
     "run_check": "._check:run_check",
+    "DR_FILES": "._drstore:DR_FILES",
+    "DR_STORES": "._drstore:DR_STORES",
+    "ZARR_ABOVE_CELLS": "._drstore:ZARR_ABOVE_CELLS",
+    "default_store": "._drstore:default_store",
+    "dr_sha256_of": "._drstore:dr_sha256_of",
+    "find_dr": "._drstore:find_dr",
+    "load_dr": "._drstore:load_dr",
+    "open_dr_layers": "._drstore:open_dr_layers",
+    "write_dr": "._drstore:write_dr",
     "CONNECT_TIMEOUT_S": "._engine:CONNECT_TIMEOUT_S",
     "RETRIES": "._engine:RETRIES",
     "WORKER_TIMEOUT_S": "._engine:WORKER_TIMEOUT_S",
@@ -123,8 +134,8 @@ _EXPORTS: dict[str, str] = {
     "BEFORE_LOG": "._trajectory_runs:BEFORE_LOG",
     "BETWEEN_SAMPLES": "._trajectory_runs:BETWEEN_SAMPLES",
     "BLOCK_ROWS": "._trajectory_runs:BLOCK_ROWS",
-    "MAX_LOG_SAMPLES": "._trajectory_runs:MAX_LOG_SAMPLES",
-    "MIN_PERIOD_S": "._trajectory_runs:MIN_PERIOD_S",
+    "MAX_LOG_SAMPLES": "._limits:MAX_LOG_SAMPLES",
+    "MIN_PERIOD_S": "._limits:MIN_PERIOD_S",
     "LISTED_UNOBSERVED": "._trajectory_runs:LISTED_UNOBSERVED",
     "MISSING_MESSAGES": "._trajectory_runs:MISSING_MESSAGES",
     "Excursion": "._trajectory_runs:Excursion",
@@ -183,6 +194,9 @@ __all__ = [
     "clearance_line", "run_dr", "run_plan", "run_scenarios",
     # another planner's files
     "CheckReport", "check_outputs", "read_dr", "read_plan", "run_check",
+    # D_R on disk: dr.npy or the chunked dr.zarr (docs/model.md §9)
+    "DR_FILES", "DR_STORES", "ZARR_ABOVE_CELLS", "default_store", "dr_sha256_of", "find_dr",
+    "load_dr", "open_dr_layers", "write_dr",
     "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
     "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost", "WORKER_TIMEOUT_S",
     "check_scheduler_address", "error_message",

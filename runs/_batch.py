@@ -1,7 +1,8 @@
 """`cfmpa check --batch DIR [SCENARIO]`: every plan folder under DIR checked, one task per plan.
 
-A plan folder is any folder under DIR (DIR itself included) holding a plan.json; its dr.npy is
-expected beside it. Each plan is checked as `cfmpa check` does (``check_outputs``: D_R in full,
+A plan folder is any folder under DIR (DIR itself included) holding a plan.json; its D_R is
+expected beside it: the store plan.json's ``dr_store`` names, else dr.npy, else dr.zarr
+(docs/model.md §9). Each plan is checked as `cfmpa check` does (``check_outputs``: D_R in full,
 the path, its costs, optimality, the certificate) against SCENARIO when given, else against the
 bundled scenario named by the plan's ``scenario`` key (``cfmpa.scenarios``). The checks
 run as tasks on ``Engine`` (in this process, a local Dask cluster, or a scheduler's); the
@@ -26,8 +27,9 @@ from typing import Any, TextIO
 from ..errors import InputError, WorkersLost
 from ..files import dumps_json, write_bytes_atomic
 from ..scenarios import BUNDLED_DIR, bundled_names
-from ..spec import load_scenario
-from ._check import _file_sha256, check_outputs, read_dr, read_plan
+from ..spec import load_scenario, make_grid
+from ._check import check_outputs, read_plan
+from ._drstore import find_dr, load_dr
 from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
                       error_message)
 
@@ -50,13 +52,13 @@ def check_plan_folder(folder: str, scenario: str | None, rel: str) -> dict[str, 
     row: dict[str, Any] = {"folder": rel, "scenario": None, "variant": None, "status": "error",
                            "checks": 0, "failed": [], "message": None}
     try:
-        plan_path, dr_path = Path(folder) / "plan.json", Path(folder) / "dr.npy"
+        plan_path = Path(folder) / "plan.json"
         doc = read_plan(plan_path)
         scenario_path = Path(scenario) if scenario is not None else _bundled(plan_path)
         s = load_scenario(scenario_path)
         row.update(scenario=s.name, variant=doc.variant.value)
-        dr = read_dr(dr_path)
-        report = check_outputs(s, dr, doc, dr_sha256=_file_sha256(dr_path))
+        dr, dr_sha = load_dr(find_dr(folder, doc.dr_store), make_grid(s).shape)
+        report = check_outputs(s, dr, doc, dr_sha256=dr_sha)
         row.update(status="ok" if report.ok else "FAIL",
                    checks=sum(line.status != "skip" for line in report.lines),
                    failed=[line.what for line in report.failed])

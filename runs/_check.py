@@ -1,15 +1,16 @@
 """`cfmpa check SCENARIO --dr FILE --plan FILE`: another planner's outputs against the spec.
 
-The outputs are docs/model.md §9's dr.npy and plan.json. Checked, all in full: D_R's shape and dtype
-and Theorem 1/3's postcondition for the plan's variant at every cell (the spec's own regions);
+The outputs are docs/model.md §9's dr.npy (or dr.zarr) and plan.json. Checked, all in full: D_R's
+shape and dtype and Theorem 1/3's postcondition for the plan's variant at every cell (the spec's own regions);
 the path by is_path; J1 and J2 as reported; optimality (or that no path exists) through a
 witness verified by ``spec.check_witness`` (docs/model.md §11): the ``--witness`` file, else one
 computed by the fast search, so that what is trusted is the spec's checker; the continuous-time
 certificate. Also, when plan.json states them: the scenario's hash, the grid, the angles of the
-path's cells, dr_sha256 against the dr file's bytes (a mismatch means the two files are not from
-the same run) and witness_sha256 against the witness file's.
+path's cells, dr_sha256 against the dr file's bytes (a dr.zarr's: its array's .npy bytes; a
+mismatch means the two files are not from the same run) and witness_sha256 against the witness file's.
 Exit 0 when everything holds, 1 with a listing of what failed, 2 when an input cannot be read
-(missing file, not .npy, bad JSON, missing or mistyped keys), as ``file: error: ...``.
+(missing file, not .npy, a corrupt dr.zarr or one not of the grid's shape, bad JSON, missing or
+mistyped keys), as ``file: error: ...``.
 """
 
 from __future__ import annotations
@@ -22,7 +23,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
-import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, ContractViolation, InputError
@@ -33,6 +33,7 @@ from ..spec import certify, require_clear
 from ..spec import SearchResult, SearchStatus
 from ..spec import Witness, cost_failures, load_witness, search_triple
 from ._contracts import Mode, Settings, TripleRun, builtdr_post, search_post, search_pre
+from ._drstore import load_dr
 from ._plan import CERTIFICATE
 
 __all__ = ["CheckLine", "CheckReport", "PlanDoc", "check_outputs", "read_dr", "read_plan",
@@ -53,6 +54,8 @@ class PlanDoc:
     angles: tuple[tuple[float, float], ...] | None
     dr_sha256: str | None = None
     witness_sha256: str | None = None
+    #: The D_R store beside plan.json (``npy`` | ``zarr``), when plan.json names it.
+    dr_store: str | None = None
 
 
 @dataclass(frozen=True)
@@ -104,8 +107,8 @@ def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | P
     file (`cfmpa plan --witness`) to verify instead of computing one."""
     so = sys.stdout if stdout is None else stdout
     s = load_scenario(scenario_path)
-    dr = read_dr(dr_path)
-    dr_sha = _file_sha256(dr_path)
+    # A dr.npy or a dr.zarr (checked against the grid before a chunk is read), and dr_sha256.
+    dr, dr_sha = load_dr(dr_path, make_grid(s).shape)
     doc = read_plan(plan_path)
     witness = witness_sha = None
     if witness_path is not None:
@@ -128,20 +131,11 @@ def _file_sha256(path: str | Path, field: str = "dr") -> str:
                          source=str(path)) from None
 
 
-def read_dr(path: str | Path) -> npt.NDArray[Any]:
-    """dr.npy as an array (of any dtype: the check judges it); InputError if unreadable."""
-    source = str(path)
-    try:
-        arr = np.load(path, allow_pickle=False)
-    except OSError as exc:
-        raise InputError("dr", MISSING, f"cannot be read ({exc.strerror or exc})",
-                         source=source) from None
-    except ValueError as exc:
-        raise InputError("dr", MISSING, f"is not a .npy array file ({exc})",
-                         source=source) from None
-    if not isinstance(arr, np.ndarray):
-        raise InputError("dr", MISSING, "is not a single .npy array", source=source)
-    return arr
+def read_dr(path: str | Path, expect: tuple[int, int, int] | None = None) -> npt.NDArray[Any]:
+    """dr.npy (of any dtype: the check judges it) or dr.zarr (of the grid's shape ``expect``
+    when given) as an array; InputError if unreadable, corrupt or over the cell budget
+    (``runs/_drstore.py``'s ``load_dr``, which also gives dr_sha256)."""
+    return load_dr(path, expect)[0]
 
 
 def read_plan(path: str | Path) -> PlanDoc:
@@ -196,6 +190,9 @@ def read_plan(path: str | Path) -> PlanDoc:
     witness_sha = doc.get("witness_sha256")
     if witness_sha is not None and not isinstance(witness_sha, str):
         raise bad("witness_sha256", witness_sha, "must be a string")
+    dr_store = doc.get("dr_store")
+    if dr_store is not None and dr_store not in ("npy", "zarr"):
+        raise bad("dr_store", _short(dr_store), "must be \"npy\" or \"zarr\"")
     grid = doc.get("grid")
     if grid is not None and not isinstance(grid, dict):
         raise bad("grid", grid, "must be an object")
@@ -206,7 +203,7 @@ def read_plan(path: str | Path) -> PlanDoc:
                 for a in angles):
             raise bad("angles", _short(angles), "must be a list of [t1, t2] number pairs")
         angles = tuple((float(a[0]), float(a[1])) for a in angles)
-    return PlanDoc(variant, result, sha, grid, angles, dr_sha, witness_sha)
+    return PlanDoc(variant, result, sha, grid, angles, dr_sha, witness_sha, dr_store)
 
 
 def check_outputs(s: Scenario, dr: npt.NDArray[Any], doc: PlanDoc, *,

@@ -42,8 +42,8 @@ class CodeMutant:
 CODE_MUTANTS: tuple[CodeMutant, ...] = (
     CodeMutant("rest_layer_free", "the fast BuiltDR leaves the rest layer free",
                "impl/_fast_builtdr.py",
-               (("            clock.lap(\"settle_unsure\")\n    return P\n",
-                 "            clock.lap(\"settle_unsure\")\n    P[-1] = 0  # mutant\n    return P\n"),)),
+               (("    clock.lap(\"other\")\n    return P\n",
+                 "    clock.lap(\"other\")\n    P[-1] = 0  # mutant\n    return P\n"),)),
     CodeMutant("margin_halved", "the regions grown by half the margin the lemma needs",
                "impl/_regions.py",
                (("    return t1, t2, margin_scale * sweep_margin(arm, link, g, moving)",
@@ -137,6 +137,80 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
        "    hi_a = functools.reduce(min_of, (_upper(nx * x + ny * y) for x, y in a))\n"),)),
     CodeMutant("eps_zero", "BuiltDR frees a cell at any positive float distance (EPS = 0)",
                "spec/_grid.py", (("\nEPS = 1e-9\n", "\nEPS = 0.0\n"),)),
+    # --- the wiring: which segment, pieces, label or kind a verdict reads (docs/model.md §6.4,
+    # §7.3, §10-§12; proofs/_obl_wiring.py, proofs/_controls_wiring.py) ---
+    CodeMutant("certificate_previous_segment_speed", "the certificate takes the previous path "
+               "segment's speed for a time piece (Certificate.wiring's right_rate refuted; "
+               "Control.certificate.moving_contact certified clear)", "spec/_certificate.py",
+               (("        wr = np.where(seg[:, None] >= 0, steps[np.maximum(seg, 0)], 0.0)\n",
+                 "        wr = np.where(seg[:, None] >= 0, steps[np.maximum(seg - 1, 0)], 0.0)\n"),)),
+    CodeMutant("trajectory_previous_row_speed", "a trajectory's certificate takes the previous "
+               "row's speeds for a piece (Certificate.wiring's trajectory VC refuted)",
+               "spec/_trajectory.py",
+               (("                np.maximum(seg - self.offset, 0)]\n",
+                 "                np.maximum(seg - self.offset - 1, 0)]\n"),)),
+    CodeMutant("monitor_gap_slice_short", "the monitor's speed over a gap leaves out the gap's "
+               "last trajectory piece (Monitor.reference_speeds refuted; "
+               "Control.monitor.gap_last_piece covered)", "spec/_trajectory.py",
+               (("            out[g] = self.per_piece[lo[g]:hi[g] + 1].max(axis=0)\n",
+                 "            out[g] = self.per_piece[lo[g]:hi[g]].max(axis=0)\n"),)),
+    CodeMutant("witness_start_or_and", "the witness checker's start test with its or made and "
+               "(Witness.labels_sound's labels.base refuted; Control.witness.raised_start "
+               "accepted)", "spec/_witness.py",
+               (("    return (j1 != 0) | (j2 != 0)\n", "    return (j1 != 0) & (j2 != 0)\n"),)),
+    CodeMutant("control_error_counted_rejected", "a control that cannot build its input counted "
+               "as rejected (Control.harness.error_is_not_a_pass)", "proofs/_controls.py",
+               (("        outcome, detail = \"error\", f\"{type(exc).__name__}: {exc}\"\n",
+                 "        outcome, detail = \"rejected\", f\"{type(exc).__name__}: {exc}\"\n"),)),
+    CodeMutant("theorem_made_definitional", "a theorem moved into the definitional list (its "
+               "kind, pinned in obligations.lock, is not what --repin may change)",
+               "proofs/_runner.py",
+               (("    \"Def1.segment\": \"the definition's weights named\",\n}\n",
+                 "    \"Def1.segment\": \"the definition's weights named\",\n"
+                 "    \"Safety.separation\": \"a definition restated\",\n}\n"),)),
+    CodeMutant("loader_spacing_bound_raised", "the loader's exact spacing bound raised above the "
+               "157/50 the safety proofs assume (Control.loader.spacing_above_bound loaded)",
+               "spec/_scenario.py",
+               (("\n_G_MAX = MAX_SPACING\n", "\n_G_MAX = MAX_SPACING + Fraction(1, 100)\n"),)),
+    # --- tools and heights under proof (docs/model.md §7.3, §10; proofs/_obl_tools.py: each
+    # caught by its obligation under --repin) ---
+    CodeMutant("heights_compared_strictly", "the height test compares with < where <= is meant "
+               "(touching intervals called disjoint: Safety.height_rule refuted)",
+               "spec/_kinematics.py",
+               (("    return a[0] <= b[1] and b[0] <= a[1]\n",
+                 "    return a[0] < b[1] and b[0] < a[1]\n"),)),
+    CodeMutant("height_gap_far_ends", "the height gap measured between the intervals' far ends "
+               "(a gap larger than the true one: Certificate.height_gap's gap_vertical refuted)",
+               "spec/_kinematics.py",
+               (("    return max(0.0, a[0] - b[1], b[0] - a[1])\n",
+                 "    return max(0.0, a[1] - b[0], b[1] - a[0])\n"),)),
+    CodeMutant("tool_vertex_left_out", "the tool's last vertex left out of its region's points "
+               "(Safety.tool_region's tool_points refuted)", "impl/_kinematics.py",
+               (("    local = np.asarray(arm.tool.polygon, dtype=float)  ",
+                 "    local = np.asarray(arm.tool.polygon[:-1], dtype=float)  "),)),
+    CodeMutant("tool_margin_nearest_vertex", "the tool's reach, and so its margin, from its "
+               "nearest vertex instead of its farthest (Safety.tool_region's far_vertex refuted)",
+               "impl/_kinematics.py",
+               (("        far_tool = max(float(np.hypot(l2 + x, y)) for x, y in arm.tool.polygon)\n",
+                 "        far_tool = min(float(np.hypot(l2 + x, y)) for x, y in arm.tool.polygon)\n"),)),
+    CodeMutant("tool_in_link1_frame", "the tool's polygon laid along link 1 (its axes turned by "
+               "theta1 only) at the wrist (Safety.tool_region's tool_points refuted)",
+               "impl/_kinematics.py",
+               (("    wrist = elbow + arm.links[1] * along\n",
+                 "    wrist = elbow + arm.links[1] * along\n"
+                 "    along = np.stack([np.cos(t1), np.sin(t1)], axis=-1)  # mutant\n"
+                 "    normal = np.stack([-along[..., 1], along[..., 0]], axis=-1)\n"),)),
+    CodeMutant("tube_lipschitz_without_tool", "the tube's L over the links only, the tools' reach "
+               "left out (Tolerance.tube_factor's lipschitz_tool refuted)", "spec/_trajectory.py",
+               (("    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in "
+                 "parts(arm))\n",
+                 "    return max(sum(reach(arm, link)) for arm in (s.left, s.right) for link in "
+                 "(0, 1))\n"),)),
+    CodeMutant("tool_speed_from_forearm", "the certificate's speed bound for a tool from the "
+               "forearm's reach (Certificate.lipschitz's speed_tool refuted)",
+               "spec/_certificate.py",
+               (("    per_link = [reach(arm, link) for link in parts(arm)]\n",
+                 "    per_link = [reach(arm, min(link, 1)) for link in parts(arm)]\n"),)),
 )
 
 #: The checks a mutant is run through, in this order.
@@ -264,6 +338,7 @@ def _check_prove(copy: Path, work: Path, only: Sequence[str] = ()) -> tuple[bool
         doc = json.loads((out / "results.json").read_text())
         failed = [o["id"] for o in doc["obligations"] if not o.get("as_expected", True)]
         failed += [c["id"] for c in doc.get("controls", []) if not c.get("ok", True)]
+        failed += [f"kind of {k['id']}" for k in doc.get("pins", {}).get("kind_mismatch", [])]
     except (OSError, ValueError, KeyError):
         pass
     if code == 0:

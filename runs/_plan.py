@@ -17,22 +17,26 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, TextIO, TypeVar
+from typing import TYPE_CHECKING, Any, TextIO, TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from ..files import dumps_json, npy_bytes, write_atomic_with, write_bytes_atomic
+from ..files import dumps_json, write_atomic_with, write_bytes_atomic
 from ..errors import ContractViolation
-from ..impl import build_dr_fast, kernel_name, search_opt_path, search_opt_path_fast
-from ..spec import Grid, Scenario, Variant, make_grid, parse_scenario
+from ..impl import (build_dr_fast, kernel_name, load_fast_kernels, search_opt_path,
+                    search_opt_path_fast)
+from ..spec import Grid, Scenario, Variant, make_grid
 from ..spec import Certificate, certificate_json, certify, contact_links_text, require_clear
 from ..spec import SearchResult, SearchStatus
 from ..spec import executed_trajectory, tolerance_rad, trajectory_csv
-from ..spec import ExactGaps, exact_path_gaps, save_npz, theorem_scope
+from ..spec import save_npz, theorem_scope
 from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
                          checked_search, contracts_json, violation_json)
+
+if TYPE_CHECKING:     # the exact re-decision loads python-flint: only plan() needs it
+    from ..spec import ExactGaps
 
 R = TypeVar("R")
 
@@ -160,6 +164,7 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
         if stop:
             require_clear(cert, name=CERTIFICATE)
         t0 = time.perf_counter()
+        from ..spec import exact_path_gaps   # python-flint, for plan only (not `cfmpa dr`)
         exact = exact_path_gaps(s, v, g, result.path)
         t["exact_gaps"] = time.perf_counter() - t0
         if stop and not exact.ok:
@@ -176,29 +181,10 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
                       settings=settings, exact=exact)
 
 
-#: A workcell with a 4 x 14 x 14 grid: calling the fast kernels on it loads (or compiles) every
-#: numba specialisation a real run uses (same dtypes and layouts), in milliseconds of work.
-_WARM_UP = {
-    "name": "kernel-warm-up", "purpose": "load the fast kernels", "dt": 0.5,
-    "left": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.0, 0.0],
-             "start": [0.3, 0.8], "goal": [1.6, 2.2]},
-    "right": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.6, 0.0],
-              "limits": [[0.0, 6.283185307179586], [0.0, 6.283185307179586]],
-              "start_cell": [0, 4], "goal_cell": [7, 4]},
-}
-_loaded: list[float] = []
-
-
 def _load_fast_kernels() -> float:
-    """Seconds spent loading the fast kernels in this process by this call (0.0 if done before)."""
-    if _loaded:
-        return 0.0
-    t0 = time.perf_counter()
-    s = parse_scenario(_WARM_UP, check_budget=False)
-    dr = build_dr_fast(s, Variant.MODIFIED, make_grid(s), progress=False)
-    search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False)
-    _loaded.append(time.perf_counter() - t0)
-    return _loaded[0]
+    """Seconds spent loading the fast kernels in this process by this call (0.0 if done before):
+    compiling them first where numba's cache is cold (one line on stderr says so)."""
+    return load_fast_kernels()
 
 
 #: The certificate's name in violations (it is not one of the paper's triples).
@@ -238,7 +224,8 @@ def _timed(fn: Callable[..., R], t: dict[str, float], key: str) -> Callable[...,
 
 def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
               witness_bytes: bytes | None = None, *, dr_sha256: str | None = None,
-              witness_sha256: str | None = None) -> dict[str, Any]:
+              witness_sha256: str | None = None, dr_store: str | None = None
+              ) -> dict[str, Any]:
     """The plan.json document of docs/model.md §9 (keys are stable: add, never rename).
 
     ``witness_sha256`` (only when ``witness_bytes``, the witness file's, or the hash itself is
@@ -247,12 +234,17 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
 
     ``dr_sha256`` is the sha256 of dr.npy's bytes (``dr_bytes``, by default ``npy_bytes(p.dr)``,
     what write_plan writes; or the hash itself, as write_plan gives it), so that a dr.npy from
-    another run is detectable. In ``clearance``,
+    another run is detectable; a dr.zarr has the same one (runs/_drstore.py). ``dr_store``
+    (``npy`` | ``zarr``, only when given: write_plan gives it) names the D_R file beside
+    plan.json. In ``clearance``,
     ``min_m`` / ``t_s`` are the least SAMPLED distance and its instant (an upper bound on the
     true minimum); ``lower_bound_m`` is the PROVED lower bound over every instant.
     """
     if dr_sha256 is None:
-        dr_sha256 = hashlib.sha256(npy_bytes(p.dr) if dr_bytes is None else dr_bytes).hexdigest()
+        from ._drstore import dr_sha256_of     # npy_bytes(p.dr)'s hash, a layer at a time
+
+        dr_sha256 = (dr_sha256_of(p.dr) if dr_bytes is None
+                     else hashlib.sha256(dr_bytes).hexdigest())
     if witness_sha256 is None and witness_bytes is not None:
         witness_sha256 = hashlib.sha256(witness_bytes).hexdigest()
     r = p.search
@@ -284,17 +276,21 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
         "contracts": p.contracts,
         "timings_s": {k: round(v, 6) for k, v in sorted(p.timings_s.items())},
         "versions": versions(),
-    } | ({} if witness_sha256 is None else {"witness_sha256": witness_sha256})
+    } | ({} if witness_sha256 is None else {"witness_sha256": witness_sha256}) | (
+        {} if dr_store is None else {"dr_store": dr_store})
 
 
 #: The executed motion of a found path, beside plan.json (docs/model.md §9, §12).
 TRAJ_CSV = "traj.csv"
 
 
-def write_plan(p: PlanResult, out: str | Path, *,
-               witness: str | Path | None = None) -> tuple[Path, Path]:
-    """Write DIR/dr.npy and DIR/plan.json, each atomically (temporary name, then rename);
-    plan.json's dr_sha256 is the hash of the very bytes written to dr.npy. For a found path
+def write_plan(p: PlanResult, out: str | Path, *, witness: str | Path | None = None,
+               store: str | None = None) -> tuple[Path, Path]:
+    """Write DIR/dr.npy (or with ``store="zarr"`` DIR/dr.zarr; by default the one
+    ``default_store`` picks for the grid's cells, docs/model.md §9) and DIR/plan.json, each
+    atomically (temporary name, then rename); plan.json's dr_sha256 is the hash of the very
+    bytes written (for dr.zarr, of the same array's .npy bytes) and its dr_store the store. A
+    D_R of the other store left by an earlier run is removed. For a found path
     also DIR/traj.csv, its executed motion (one row per step, `cfmpa certify` reads it); with
     no path a traj.csv left by an earlier run is deleted. ``witness``: also write the search's
     witness there (npz, ``spec.Witness``; plan() with witness=True makes it), its hash in
@@ -309,14 +305,16 @@ def write_plan(p: PlanResult, out: str | Path, *,
             raise ValueError("write_plan(witness=...) needs a plan made with witness=True")
         members = p.search.witness.npz_members()
         _, witness_sha = _write_streamed(witness, lambda fh: save_npz(fh, members))
-    dr_path, dr_sha = _write_streamed(out / "dr.npy",
-                                      lambda fh: np.save(fh, p.dr, allow_pickle=False))
+    from ._drstore import default_store, write_dr
+
+    store = default_store(int(p.dr.size)) if store is None else store
+    dr_path, dr_sha = write_dr(out, p.dr, store)
     if p.search.status is SearchStatus.FOUND:
         traj = executed_trajectory(p.scenario, p.grid, p.search.path)
         write_bytes_atomic(out / TRAJ_CSV, trajectory_csv(traj).encode())
     else:
         (out / TRAJ_CSV).unlink(missing_ok=True)
-    doc = plan_json(p, dr_sha256=dr_sha, witness_sha256=witness_sha)
+    doc = plan_json(p, dr_sha256=dr_sha, witness_sha256=witness_sha, dr_store=store)
     plan_path = write_bytes_atomic(out / "plan.json", dumps_json(doc).encode())
     return dr_path, plan_path
 
@@ -325,23 +323,26 @@ def write_plan(p: PlanResult, out: str | Path, *,
 
 
 def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *,
-           kernel: str = "fast", name: str | None = None, stdout: TextIO | None = None) -> int:
+           kernel: str = "fast", name: str | None = None, stdout: TextIO | None = None,
+           store: str | None = None) -> int:
     """`cfmpa dr`: build D_R of the scenario file for ``variant`` with the ``kernel`` pair
-    (``impl.KERNELS``), write ``out``/dr.npy atomically and print the grid and the free
-    fraction; 0 (bad input raises InputError). ``name``: the scenario as the user gave it."""
-    from ..files import save_npy_atomic
+    (``impl.KERNELS``), write ``out``/dr.npy or dr.zarr (``store``, by default by the grid's
+    cells: ``default_store``) atomically and print the grid and the free fraction; 0 (bad input
+    raises InputError). ``name``: the scenario as the user gave it."""
     from ..impl import kernels
+    from ._drstore import default_store, write_dr
     from ..spec import load_scenario
 
     so = sys.stdout if stdout is None else stdout
     v = Variant(variant)
     s = load_scenario(scenario_path)
     g = make_grid(s)
+    store = default_store((g.N + 1) * g.m * g.n) if store is None else store
     build, _ = kernels(kernel)
     t0 = time.perf_counter()
     dr = build(s, v.value, g)
     seconds = time.perf_counter() - t0
-    path = save_npy_atomic(Path(out) / "dr.npy", dr)
+    path, _ = write_dr(out, dr, store)
     free = 1.0 - float(dr.mean())
     print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)
     print(f"variant   {v.value} ({kernel} kernel)", file=so)
@@ -356,9 +357,11 @@ def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *
 def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path, *,
              contracts: Mode | str = "full", seed: int = 0, sample: int | None = None,
              kernel: str = "fast", witness: str | Path | None = None, name: str | None = None,
-             stdout: TextIO | None = None, stderr: TextIO | None = None) -> int:
+             stdout: TextIO | None = None, stderr: TextIO | None = None,
+             store: str | None = None) -> int:
     """`cfmpa plan`: ``plan`` with the ``kernel`` pair, not stopping at a violation, then
-    ``write_plan`` into ``out`` (and the witness file); print the summary.
+    ``write_plan`` into ``out`` (D_R as ``store``, by default by the grid's cells; and the
+    witness file); print the summary.
 
     0 when nothing was violated; 1 when a contract failed or the certificate is not clear (a
     contact or an undecided interval is a violation in every contracts mode, off included); the
@@ -370,11 +373,14 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
 
     so = sys.stdout if stdout is None else stdout
     se = sys.stderr if stderr is None else stderr
+    from ._drstore import zarr_threshold
+
     s = load_scenario(scenario_path)
+    zarr_threshold()                  # a bad CFMPA_ZARR_CELLS is exit 2 before any work
     build, search = kernels(kernel)
     p = plan(s, variant, contracts=contracts, seed=seed, sample=sample, stop=False, build=build,
              search=search, kernel=kernel, witness=witness is not None)
-    dr_path, plan_path = write_plan(p, out, witness=witness)
+    dr_path, plan_path = write_plan(p, out, witness=witness, store=store)
     violations = p.violations
     g, r, t = p.grid, p.search, p.timings_s
     print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)

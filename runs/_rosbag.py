@@ -25,7 +25,6 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
-import sqlite3
 import struct
 import tempfile
 from collections.abc import Iterator, Sequence
@@ -142,6 +141,8 @@ def _joint_indices(names: Sequence[str], joints: Sequence[str], where: str,
 
 def _reader(path: Path, option: str, source: str) -> Any:
     """An open rosbags Reader of the bag, or InputError naming the option and the path."""
+    import sqlite3      # here, not at the top: a CSV run loads no bag machinery
+
     from rosbags.rosbag2 import Reader, ReaderError
 
     try:

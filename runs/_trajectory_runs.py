@@ -26,6 +26,7 @@ import numpy.typing as npt
 
 from ..errors import MISSING, InputError
 from ..files import angle_text, bounded_lines, dumps_json, echo, write_bytes_atomic
+from ._limits import MAX_LOG_SAMPLES
 from ._rosbag import (BagOptions, BagReading, bag_rows, bag_sha256, is_bag, load_bag_trajectory,
                       log_output_kind, write_bag)
 from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
@@ -36,16 +37,11 @@ from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, 
                     trajectory_distances, tube_lipschitz)
 
 __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
-           "LISTED_UNOBSERVED", "MAX_LOG_SAMPLES", "MIN_PERIOD_S", "MISSING_MESSAGES",
+           "LISTED_UNOBSERVED", "MISSING_MESSAGES",
            "MonitorResult", "Unobserved",
            "certify_json", "log_csv", "monitor_json", "monitor_log", "monitor_rows",
            "parse_excursion", "parse_max_speed", "run_certify", "run_monitor", "run_simulate", "simulate_log"]
 
-#: The most samples `cfmpa simulate` writes: the log is built in memory (about 0.5 KB a sample
-#: at its peak, a 100 MB CSV), so a count beyond is refused before anything is allocated.
-MAX_LOG_SAMPLES = 1_000_000
-#: The shortest --period (s): a 1 MHz log; finer is no measured robot's.
-MIN_PERIOD_S = 1e-6
 
 #: Log rows parsed per numpy block by the monitor ...
 BLOCK_ROWS = 16_384
@@ -164,7 +160,8 @@ def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
         where = "" if c["line"] is None else f" (line {c['line']})"
         print(f"clearance NOT CLEAR: contact at t={c['t_s']:.9g} s, {c['links_text']}, "
               f"{c['segment']}{where}; left angles "
-              f"{c['left_angles_rad']}, right angles {c['right_angles_rad']}", file=sys.stderr)
+              f"{', '.join(angle_text(a) for a in c['left_angles_rad'])}; right angles "
+              f"{', '.join(angle_text(a) for a in c['right_angles_rad'])}", file=sys.stderr)
     else:
         print(f"clearance NOT CLEAR: {len(cert.undecided)} interval(s) neither proved clear nor "
               f"in contact, first {cert.undecided[0]} s; {sampled}", file=sys.stderr)

@@ -46,8 +46,8 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
                           spill_wanted)
     from ._witness import (KEY_BASE, LABEL_LIMITS, WITNESS_FORMAT, Witness, check_witness,
                            closure_breaks, edge_bound, edge_holds, exclusion_breaks, goal_holds,
-                           label_in_range, label_key, load_witness, start_breaks, step_cost,
-                           stop_key)
+                           label_in_range, label_key, load_witness, start_breaks,
+                           start_label_breaks, step_cost, stop_key)
 
 #: Each public name -> "module:name", imported on first use (PEP 562, cfmpa.lazy): a
 #: command loads only the modules it needs (docs/model.md §1.1).
@@ -203,6 +203,7 @@ _EXPORTS: dict[str, str] = {
     "label_key": "._witness:label_key",
     "load_witness": "._witness:load_witness",
     "start_breaks": "._witness:start_breaks",
+    "start_label_breaks": "._witness:start_label_breaks",
     "step_cost": "._witness:step_cost",
     "stop_key": "._witness:stop_key",
 }
@@ -241,7 +242,7 @@ __all__ = [
     "LABEL_LIMITS", "WITNESS_FORMAT", "Witness", "check_witness", "load_witness",
     # its conditions, on numpy arrays and on Z3 terms (proofs/_obl_witness.py)
     "KEY_BASE", "closure_breaks", "edge_bound", "edge_holds", "exclusion_breaks", "goal_holds",
-    "label_in_range", "label_key", "start_breaks", "step_cost", "stop_key",
+    "label_in_range", "label_key", "start_breaks", "start_label_breaks", "step_cost", "stop_key",
     # arrays read one layer at a time (the witness on large grids)
     "SPILL_BYTES", "LayerSpill", "Layers", "npz_layers", "npz_member", "save_npz",
     "spill_wanted",

@@ -76,8 +76,8 @@ from ._triples import Failure
 
 __all__ = ["KEY_BASE", "LABEL_LIMITS", "WITNESS_FORMAT", "Witness", "check_witness",
            "closure_breaks", "edge_bound", "edge_holds", "exclusion_breaks", "goal_holds",
-           "label_in_range", "label_key", "load_witness", "start_breaks", "step_cost",
-           "stop_key"]
+           "label_in_range", "label_key", "load_witness", "start_breaks", "start_label_breaks",
+           "step_cost", "stop_key"]
 
 #: The tag a witness file carries (npz member ``format``).
 WITNESS_FORMAT = "cfmpa-witness-1"
@@ -127,6 +127,12 @@ def stop_key(key: Any, p: tuple[Any, Any]) -> Any:
 def goal_holds(cost: tuple[Any, Any], least: tuple[Any, Any]) -> Any:
     """witness.goal: the path's (J1, J2) equals the least goal label plus its stop term."""
     return (cost[0] == least[0]) & (cost[1] == least[1])
+
+
+def start_label_breaks(j1: Any, j2: Any) -> Any:
+    """witness.start (found path) fails: the start state's label is not (0, 0) (no label, the
+    type's largest value, is not (0, 0) either)."""
+    return (j1 != 0) | (j2 != 0)
 
 
 def start_breaks(start_free: Any, in_set: Any) -> Any:
@@ -283,7 +289,7 @@ def _check_labels(free: Layers, start: tuple[int, int], goal: tuple[int, int],
                           ("state", _state(s, (i, j), p)),
                           ("label", [int(j1[s, p, i, j]), int(j2[s, p, i, j])]))]
     at = (0, _WAIT, *start)
-    if j1[at] != 0 or j2[at] != 0:
+    if start_label_breaks(j1[at], j2[at]):
         return [_fail("start", "the start state's label is not (0, 0)",
                       ("state", _state(0, start, _WAIT)), ("label", _label(j1, j2, at)))]
     edge = _check_edges(free, j1, j2)

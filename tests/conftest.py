@@ -9,3 +9,12 @@ from hypothesis import settings
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CFMPA_HYPOTHESIS") == "ci":
     settings.load_profile("ci")
+
+
+def pytest_sessionstart(session):
+    """Compile the fast kernels first where numba's cache is cold (in parallel, docs/model.md
+    §7.5), so their one line on stderr goes to the terminal, not into the first test that calls
+    a kernel and reads its stderr. With a warm cache this prints nothing."""
+    from cfmpa.impl import ensure_compiled
+
+    ensure_compiled()

@@ -131,6 +131,10 @@ def test_gripper_cfmpa_certify_with_the_tools_finds_the_contact_of_a_plan_withou
     out = got.out + got.err
     assert code == 1
     assert "NOT CLEAR: contact at" in out and "left tool and right tool" in out
+    # The contact's angles as a person reads them: rad with degrees (docs/contributing.md).
+    line = next(x for x in out.splitlines() if "NOT CLEAR" in x)
+    assert re.search(r"left angles -?[\d.]+ rad \(-?[\d.]+ deg\), -?[\d.]+ rad \(-?[\d.]+ deg\); "
+                     r"right angles -?[\d.]+ rad \(", line), line
 
 
 def test_levels_heights_shorten_the_plan():
@@ -150,3 +154,16 @@ def test_levels_heights_shorten_the_plan():
         # Planned with the heights, the motion touches in the plane (the forearms cross above
         # one another): without the heights it would not be clear.
         assert not certify(flat, g, best.path).clear
+
+
+@pytest.mark.parametrize("name", ["gripper", "levels"])
+def test_tool_and_height_workcells_plan_in_every_variant_with_full_contracts(name):
+    from cfmpa.runs._plan import plan
+
+    s = load_scenario(ROOT / f"{name}.toml")
+    for v in ORDER:
+        r = plan(s, v, contracts="full")       # raises on any violation
+        assert r.search.status is SearchStatus.FOUND
+        assert r.certificate is not None and r.certificate.clear
+        assert r.exact is not None and r.exact.ok
+        assert r.contracts["violations"] == [] and r.checked > 6_000_000

@@ -99,3 +99,82 @@ def test_lazy_packages_keep_their_public_names(folder):
     assert set(pkg.__all__) <= set(dir(pkg))
     with pytest.raises(AttributeError):
         pkg.no_such_name  # noqa: B018
+
+
+# --- each command, run whole, imports only what it uses ----------------------------------------
+
+#: Modules no command below needs unless it says so: the solvers, the report, the cluster, the
+#: bag reader, the store, the exact re-decision.
+NOT_NEEDED = ("z3", "cvc5", "matplotlib", "jinja2", "dask", "distributed", "rosbags", "sqlite3",
+              "zarr", "numcodecs", "flint", "sympy", "crosshair")
+#: What each command may load of NOT_NEEDED (and what the trajectory commands must not load of
+#: the planner), with the argv it runs; {tmp} is a folder of the test's, holding t.csv and a plan.
+COMMANDS: dict[str, tuple[list[str], set[str], tuple[str, ...]]] = {
+    "scenarios": (["scenarios"], set(), ("numba", "shapely")),
+    # (numpy comes with every command: the shared parser reads spec's variant table.)
+    "docs": (["docs"], set(), ("numba", "shapely")),
+    "dr": (["dr", "{small}", "--out", "{tmp}/dr"], set(), ()),
+    "plan": (["plan", "{small}", "--out", "{tmp}/plan"], {"flint"}, ()),
+    "check": (["check", "{small}", "--dr", "{tmp}/plan/dr.npy", "--plan",
+               "{tmp}/plan/plan.json"], {"flint"}, ()),
+    "certify": (["certify", "default", "--traj", "{tmp}/t.csv"], set(), PLANNER),
+    "simulate": (["simulate", "default", "--traj", "{tmp}/t.csv", "--out", "{tmp}/log.csv"],
+                 set(), PLANNER),
+    "monitor": (["monitor", "default", "--traj", "{tmp}/t.csv", "--log", "{tmp}/log.csv"],
+                set(), PLANNER),
+}
+
+
+def _command_modules(argv: list[str], prelude: str = "") -> tuple[int, set[str]]:
+    """(exit code, top-level modules of NOT_NEEDED + PLANNER + numpy loaded) of `cfmpa argv`
+    run whole in a fresh interpreter, after ``prelude``."""
+    watch = list(NOT_NEEDED + PLANNER + ("numpy",))
+    probe = (f"{prelude}\nimport contextlib, io, json, sys\nfrom cfmpa.cli import main\n"
+             "with contextlib.redirect_stdout(io.StringIO()), "
+             "contextlib.redirect_stderr(io.StringIO()):\n"
+             f"    code = main({argv!r})\n"
+             f"print(json.dumps([code, sorted(m for m in {watch!r} if m in sys.modules)]))")
+    proc = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    code, mods = json.loads(proc.stdout.strip().splitlines()[-1])
+    return code, set(mods)
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory) -> Path:
+    import factory
+
+    tmp = tmp_path_factory.mktemp("startup")
+    (tmp / "t.csv").write_text(TRAJ)
+    (tmp / "small.toml").write_text(factory.toml(factory.doc()))
+    return tmp
+
+
+def _argv(command: str, workdir: Path) -> list[str]:
+    return [a.format(tmp=workdir, small=workdir / "small.toml") for a in COMMANDS[command][0]]
+
+
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_each_command_imports_only_what_it_uses(command, workdir):
+    _, allowed, never = COMMANDS[command]
+    # check reads plan's folder, monitor simulate's log: made first (by the same commands).
+    for needs, made in (("check", "plan/plan.json"), ("monitor", "log.csv")):
+        if command == needs and not (workdir / made).exists():
+            assert _command_modules(_argv("plan" if needs == "check" else "simulate",
+                                          workdir))[0] == 0
+    code, loaded = _command_modules(_argv(command, workdir))
+    assert code == 0, (command, code)
+    assert not (loaded & set(NOT_NEEDED)) - allowed, (command, sorted(loaded))
+    assert not loaded & set(never), (command, sorted(loaded))
+
+
+def test_seeded_faults_an_eager_bag_reader_or_exact_import_is_caught(workdir):
+    # The bag reader importing sqlite3 at its top, as it did (with the parser's budgets read
+    # from the trajectory runs, it came with every command); plan.py importing the exact
+    # re-decision at its top, as it did: python-flint comes with `cfmpa dr`.
+    for planted, module in (("import cfmpa.runs._trajectory_runs, sqlite3", "sqlite3"),
+                            ("import cfmpa.spec._exact", "flint")):
+        code, loaded = _command_modules(_argv("dr", workdir), planted)
+        assert code == 0 and module in loaded
+        assert module in set(NOT_NEEDED) - COMMANDS["dr"][1]

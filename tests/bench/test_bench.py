@@ -38,7 +38,8 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert set(res) == {"meta", "builtdr", "builtdr_profile", "search", "shapely", "scaling",
                         "plan", "dr_cli", "check", "prove", "contracts", "one_degree", "monitor",
-                        "plan_scaling", "certify_stream", "tools", "targets", "informational"}
+                        "plan_scaling", "certify_stream", "tools", "first_run", "targets",
+                        "informational"}
     assert [r["dt"] for r in res["plan_scaling"]["rows"]] == [0.16, 0.08]
     assert all("error" not in r and r["bytes_per_cell"] > 0 for r in res["plan_scaling"]["rows"])
     for v in Variant:
@@ -92,9 +93,9 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
 
 
 #: The targets, in the table's order: full checking (check s, check MiB, full/off, BuiltDR s,
-#: peer/dr, plan s), monitoring (samples/s, its peak growth), proving (make prove s,
-#: obligations alone s).
-LIMITS = [5.0, 1024.0, 5.0, 0.15, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0]
+#: the first run / a later one, peer/dr, plan s), monitoring (samples/s, its peak growth),
+#: proving (make prove s, obligations alone s).
+LIMITS = [5.0, 1024.0, 5.0, 0.10, 2.0, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0]
 
 
 def made_up(default_mode: str = "full") -> dict[str, Any]:
@@ -106,7 +107,10 @@ def made_up(default_mode: str = "full") -> dict[str, Any]:
         return {"median_s": s, "min_s": s, "max_s": s, "runs": 1, "peak_rss_mb": 300.0, **kw}
     stages = dict.fromkeys(run.PROFILE_STAGES, 0.01) | {"right_regions": 0.19, "total": 0.5}
     return {
-        "builtdr": {v: {"fast": t(x)} for v, x in zip(run.VARIANTS, (0.5, 0.55, 0.45))},
+        "builtdr": {v: {"fast": t(x, cold_s=x + 0.2)}
+                    for v, x in zip(run.VARIANTS, (0.5, 0.55, 0.45))},
+        "first_run": {"first": t(12.0), "later": t(4.0), "ratio_first_over_later": 3.0,
+                      "compile_lines": ["cfmpa: compiling 3 groups ..."]},
         "builtdr_profile": {v: {"stages_median_s": stages, "kernel_threads": 1,
                                 "unsure_pairs": 0,
                                 "build_dr_fast_median_s": 0.5} for v in run.VARIANTS},
@@ -135,28 +139,31 @@ def test_targets_are_the_issues_with_their_limits_and_verdicts():
     cfg = run.Config.of(False, None)
     rows = run.targets(made_up("full"), cfg)
     assert [r["limit"] for r in rows] == LIMITS
-    assert [r["cmp"] for r in rows] == ["<=", "<=", "<=", "<=", ">=", "<=", ">=", "<=", "<=",
-                                        "<="]
-    assert [r["measured"] for r in rows] == [3.3, 1500.0, 2.5, 0.55, 2.0, 4.5, 250_000.0, 2.0,
-                                             90.0, 70.0]
-    assert [r["met"] for r in rows] == [True, False, True, False, False, False, True, True, True,
-                                        False]
-    assert "full checking" in rows[0]["target"] and "monitoring" in rows[6]["target"]
-    assert "make prove" in rows[8]["target"]
+    assert [r["cmp"] for r in rows] == ["<=", "<=", "<=", "<=", "<=", ">=", "<=", ">=", "<=",
+                                        "<=", "<="]
+    assert [r["measured"] for r in rows] == [3.3, 1500.0, 2.5, 0.55, 3.0, 2.0, 4.5, 250_000.0,
+                                             2.0, 90.0, 70.0]
+    assert [r["met"] for r in rows] == [True, False, True, False, False, False, False, True,
+                                        True, True, False]
+    assert "full checking" in rows[0]["target"] and "monitoring" in rows[7]["target"]
+    assert "make prove" in rows[9]["target"] and "first run" in rows[4]["target"]
+    # BuiltDR: warm (the median) and cold (the first call) apart; the first run: both runs.
+    assert "warm" in rows[3]["target"] and "cold: original 0.700" in rows[3]["note"]
+    assert "first 12.0 s" in rows[4]["note"] and "later 4.0 s" in rows[4]["note"]
     # The BuiltDR miss is explained by the profile; the slowest variant is the one measured.
     assert "modified" in rows[3]["note"] and "right regions 0.190 s" in rows[3]["note"]
     # The monitor row reports wall time and peak memory of the whole process.
-    assert rows[6]["wall_s"] == 4.0 and rows[6]["peak_rss_mb"] == 120.0
+    assert rows[7]["wall_s"] == 4.0 and rows[7]["peak_rss_mb"] == 120.0
     assert all("quick run" not in r["note"] for r in rows)
     lines = run.target_lines(rows)
-    assert sum(" MISSED" in line for line in lines) == 5
+    assert sum(" MISSED" in line for line in lines) == 6
 
 
 def test_plan_target_follows_the_cli_default_contract_mode():
     run = bench_module()
     cfg = run.Config.of(False, None)
-    full = run.targets(made_up("full"), cfg)[5]
-    sampled = run.targets(made_up("sampled"), cfg)[5]
+    full = run.targets(made_up("full"), cfg)[6]
+    sampled = run.targets(made_up("sampled"), cfg)[6]
     assert "--contracts full" in full["target"] and full["measured"] == 4.5
     assert "--contracts sampled" in sampled["target"] and sampled["measured"] == 3.0
     assert "build_dr 0.60" in full["note"]      # the miss with plan.json's stages

@@ -107,7 +107,7 @@ def test_controls_are_results_and_gate_the_run(tmp_path):
 
 def test_only_selects_controls_by_id_or_by_their_composition():
     assert [c.id for c in collect_controls(["Control.witness"])] == [
-        "Control.witness.forged", "Control.witness.worse_path"]
+        "Control.witness.forged", "Control.witness.worse_path", "Control.witness.raised_start"]
     picked = collect_controls(["Safety.tight.composition"])
     assert picked and all(c.checker == "Safety.tight.composition" for c in picked)
     assert collect_controls(["Thm1"]) == []

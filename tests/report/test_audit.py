@@ -42,12 +42,12 @@ from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
 from cfmpa.report._audit import (SECTIONS, _controls_item, _proof_sections, _verdict,
-                                 contract_rows, workcell_summary)
+                                 contract_rows, row_requirements, workcell_summary)
 from cfmpa.report._sections import Section, compute_order, verdict_of
 from cfmpa.report._figures import workcell_instants
-from cfmpa.report._obligations import load_proofs
+from cfmpa.report._obligations import BADGES, audited_ids, load_proofs
 from cfmpa.gitstate import MAX_PATHS, git_state
-from cfmpa.report._provenance import REPORTED_DISTRIBUTIONS
+from cfmpa.report._provenance import REPORTED_DISTRIBUTIONS, VERSION_GROUPS
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
@@ -195,6 +195,9 @@ def test_schema_rejects_a_report_missing_a_part(report):
 
 def test_report_passes_and_both_files_are_written_atomically(report):
     assert report["doc"]["verdict"]["ok"] is True, report["doc"]["verdict"]
+    # Nothing failed, but the fixture's prove run is a subset: the rows rest on more than ran.
+    assert report["doc"]["verdict"]["status"] == "incomplete"
+    assert report["doc"]["verdict"]["not_available"] == ["verdict rows rest on what ran"]
     assert sorted(p.name for p in report["out"].iterdir()) == ["report.html", "report.json"]
     assert report["doc"] == json.loads(dumps_json(report["result"].doc))
 
@@ -222,7 +225,7 @@ def test_html_has_no_external_url(report):
     assert "url(" not in html
 
 
-def test_sections_come_in_the_issue_order(report):
+def test_sections_come_in_the_order_of_the_model(report):
     html = report["html"]
     marks = ['id="workcells"', 'id="provenance"', 'id="summary"', 'id="obligations"', 'id="assumptions"',
              'id="findings"', 'id="selftest"', 'id="scenarios"', 'id="compare"']
@@ -242,9 +245,18 @@ def test_provenance_records_the_run(report, tiny_file):
                               capture_output=True, text=True, check=False).stdout.strip()
         assert kind == "commit"
         assert p["git"]["clean"] is (p["git"]["modified"] + p["git"]["untracked"] == 0)
-    for lib in ("python", "numpy", "z3", "shapely", *REPORTED_DISTRIBUTIONS):
+    for lib in ("python", "numpy", "z3", "cvc5", "shapely", "python-flint", "numba",
+                *REPORTED_DISTRIBUTIONS):
         assert p["versions"][lib] and p["versions"][lib] != "not installed", lib
         assert f"{lib} {p['versions'][lib]}" in report["html"], lib
+    # Every version is shown in one group: the solvers and the numerics libraries by name.
+    grouped = [k for _, keys in VERSION_GROUPS for k in keys]
+    assert sorted(grouped) == sorted(p["versions"]), "each version in exactly one group"
+    rows = dict(re.findall(r"<tr><th>versions: (\w+)</th><td>([^<]*)</td></tr>", report["html"]))
+    assert rows["solvers"] == "; ".join(f"{k} {p['versions'][k]}" for k in ("z3", "cvc5", "sympy"))
+    for k in ("numpy", "shapely", "python-flint", "numba"):
+        assert f"{k} {p['versions'][k]}" in rows["numerics"], k
+    assert "other" not in rows
     for entry in p["git"]["paths"]:
         assert str(escape(entry["path"])) in report["html"]
 
@@ -317,18 +329,29 @@ def test_scenario_section_reports_each_variant(report):
                                                                 "clearance"}
 
 
-def test_section_one_gives_the_verdict_per_workcell_first(report, tiny_file):
+def test_section_one_gives_the_verdict_per_workcell_first(report, tiny_file, complete_proofs):
     doc, html = report["doc"], report["html"]
     (s,) = doc["scenarios"]
     rows = doc["summary"]
     assert [(r["scenario"], r["variant"]) for r in rows] == [
         (s["name"], v["variant"]) for v in s["variants"]]
     ledger = {e["id"] for e in doc["assumptions"]["entries"]}
-    for r, v in zip(rows, s["variants"]):
+    # The fixture's prove run is a subset: no found plan's row is "safe" on it (see the partial
+    # runs' tests below); with every obligation and control it rests on, each is.
+    whole = workcell_summary([_scenario_of(report)],
+                             complete_proofs(report["result"].doc, [tiny_file.stem]))
+    for r, v, w in zip(rows, s["variants"], whole):
         assert r["status"] == v["status"]
         if v["status"] == "found":
             cl, tol = v["clearance"], v["tolerance_rad"]
-            assert r["ok"] is True and r["verdict"] == "safe", r
+            assert r["ok"] is None and r["verdict"] == "incomplete", r
+            assert f"Safety.{v['variant']}.composition" in r["missing"]
+            assert w["ok"] is True and w["verdict"] == "safe" and w["missing"] == [], w
+            rest = ("ok", "verdict", "missing", "why", "assumptions")
+            assert {k: x for k, x in w.items() if k not in rest} == {
+                k: x for k, x in r.items() if k not in rest}
+            # The translation check of the workcell and variant ran: A5 is not assumed.
+            assert set(r["assumptions"]) - set(w["assumptions"]) == {"A5.while_model"}
             assert r["lower_bound_mm"] == pytest.approx(1000 * cl["lower_bound_m"], rel=1e-12)
             assert r["min_mm"] == pytest.approx(1000 * cl["min_m"], rel=1e-12)
             # The proved bound is below the sampled minimum (a bound, and an upper bound on it).
@@ -336,15 +359,18 @@ def test_section_one_gives_the_verdict_per_workcell_first(report, tiny_file):
             assert (r["tolerance_rad"], r["tolerance_deg"]) == (tol, pytest.approx(
                 tol * 180 / 3.141592653589793, rel=1e-12))
             lip = s["tube"]["lipschitz_m_per_rad"]
-            assert r["tolerance_tip_mm"] == pytest.approx(1000 * lip * tol, rel=1e-12)
+            assert r["tolerance_farthest_point_mm"] == pytest.approx(1000 * lip * tol, rel=1e-12)
+            # The former name, kept for format version 1: the same number.
+            assert r["tolerance_tip_mm"] == r["tolerance_farthest_point_mm"]
             # Each arm may stray by L delta, and 2 L delta stays below the proved clearance.
-            assert 2 * r["tolerance_tip_mm"] < r["lower_bound_mm"]
+            assert 2 * r["tolerance_farthest_point_mm"] < r["lower_bound_mm"]
             assert {"A1.rectangles", "A11.safety_scope"} <= set(r["assumptions"])
             # The subset of obligations proved for the fixture has no translation check of it.
             assert "A5.while_model" in r["assumptions"]
             assert f"{r['lower_bound_mm']:.2f} mm" in html and f"{r['min_mm']:.2f} mm" in html
         else:
             assert r["ok"] is None and r["lower_bound_mm"] is None and r["tolerance_rad"] is None
+            assert r["verdict"] == w["verdict"] == "no plan" and r["missing"] == []
         assert r["assumptions"] and set(r["assumptions"]) <= ledger
         for a in r["assumptions"]:
             assert f'href="#assumption-{a.replace(".", "-").replace("_", "-").lower()}"' in html
@@ -372,6 +398,93 @@ def test_section_one_fails_a_plan_whose_proof_or_certificate_fails(report):
     assert "not certified clear" in rows[found[1]]["why"]
     again = workcell_summary(loaded, report["result"].doc)
     assert all(r["ok"] is not False for r in again)
+
+
+def test_a_partial_proofs_file_leaves_every_row_incomplete_naming_what_is_missing(
+        report, tiny_file, tmp_path, complete_proofs):
+    # A results.json holding 7 obligations, the workcell's own checks on data: they hold, yet
+    # the rows rest on the safety theorem, the tube and the controls too, which did not run.
+    out = tmp_path / "proofs"
+    assert run_prove(out_dir=out, scenarios_dir=tiny_file.parent, only=[f"Scenario.{tiny_file.stem}"],
+                     stream=io.StringIO()) == 0
+    results = out / "results.json"
+    assert len(json.loads(results.read_text())["obligations"]) == 7
+    loaded = [_scenario_of(report)]
+    found = [v["variant"] for v in report["doc"]["scenarios"][0]["variants"]
+             if v["status"] == "found"]
+    assert found
+
+    def audited(expected):
+        audit = copy.deepcopy(report["result"].doc)
+        audit.update(_proof_sections(load_proofs(str(results), ROOT / "scenarios", expected,
+                                                 files=[tiny_file])))
+        audit["summary"] = workcell_summary(loaded, audit)
+        audit["verdict"] = _verdict(audit)
+        return audit
+    # As `cfmpa audit TINY --proofs results.json` reads it: every obligation expected.
+    audit = audited(None)
+    for r in audit["summary"]:
+        if r["variant"] not in found:
+            assert r["verdict"] == "no plan"
+            continue
+        assert (r["ok"], r["verdict"]) == (None, "incomplete"), r
+        obligations, controls = row_requirements(tiny_file.stem, r["variant"])
+        mine = [i for i in obligations if i.startswith(f"Scenario.{tiny_file.stem}.")]
+        assert r["missing"] == [i for i in obligations if i not in mine] + list(controls)
+        for i in (f"Safety.{r['variant']}.composition", "Safety.region_soundness",
+                  "Safety.region_statement", "Tolerance.tube"):
+            assert i in r["missing"] and i in r["why"], i
+        assert f"{len(mine)} of {len(obligations) + len(controls)} of its obligations" in r["why"]
+        assert f"{len(controls)} negative controls not in this run" in r["why"]
+        assert not any(i.startswith("Scenario.") for i in r["missing"])
+    assert audit["verdict"]["status"] == "FAILED"        # the ids a whole run has are missing
+    # Read for exactly those 7 ids: nothing failed, nothing is safe, and the page says so.
+    audit = audited([i for i in audited_ids([tiny_file]) if i.startswith("Scenario.")])
+    assert audit["verdict"]["ok"] is True and audit["verdict"]["status"] == "incomplete"
+    assert "verdict rows rest on what ran" in audit["verdict"]["not_available"]
+    assert all(r["verdict"] == "incomplete" for r in audit["summary"] if r["variant"] in found)
+    text = render_html(AuditResult(audit, report["result"].figures))
+    first = text[:text.index('id="provenance"')]
+    assert first.count('<span class="badge incomplete">incomplete</span>') == len(found)
+    assert ">safe<" not in first and _pills(text) == ["incomplete", "incomplete"]
+    # Under each badge, what did not run: the first obligations by name, the controls counted.
+    for r in audit["summary"]:
+        if r["variant"] in found:
+            mo = [i for i in r["missing"] if not i.startswith("Control.")]
+            mc = len(r["missing"]) - len(mo)
+            assert (f"not run: {mo[0]}, {mo[1]} and {len(mo) - 2} more; {mc} negative "
+                    "controls</span>") in first
+            assert str(escape(r["why"])) in first          # the tooltip names every id
+    # The seeded fault's repair: with every id present and as expected, the same rows are safe.
+    whole = workcell_summary(loaded, complete_proofs(audit, [tiny_file.stem]))
+    assert all(r["verdict"] == "safe" for r in whole if r["variant"] in found)
+    # One of them not as expected: that row FAILED, naming it.
+    bad = complete_proofs(audit, [tiny_file.stem])
+    (ctl,) = [c for c in bad["controls"]["items"]
+              if c["id"] == f"Control.Safety.{found[0]}.composition.without[0]"]
+    ctl.update(outcome="proved", ok=False)
+    rows = {r["variant"]: r for r in workcell_summary(loaded, bad)}
+    assert rows[found[0]]["verdict"] == "FAILED" and ctl["id"] in rows[found[0]]["why"]
+    assert all(rows[v]["verdict"] == "safe" for v in found[1:])
+
+
+def test_a_row_is_incomplete_when_its_results_were_carried_over_or_of_another_tree(
+        report, tiny_file, complete_proofs):
+    loaded = [_scenario_of(report)]
+    whole = complete_proofs(report["result"].doc, [tiny_file.stem])
+    assert all(r["verdict"] in ("safe", "no plan") for r in workcell_summary(loaded, whole))
+    carried = copy.deepcopy(whole)
+    (item,) = [i for i in carried["obligations"]["items"] if i["id"] == "Tolerance.tube"]
+    item["change"] = "not run"
+    rows = [r for r in workcell_summary(loaded, carried) if r["status"] == "found"]
+    assert rows and all(r["verdict"] == "incomplete" and r["missing"] == ["Tolerance.tube"]
+                        for r in rows)
+    other = copy.deepcopy(whole)
+    other["obligations"]["run"]["git"]["commit"] = "0" * 40
+    rows = [r for r in workcell_summary(loaded, other) if r["status"] == "found"]
+    assert rows and all(r["verdict"] == "incomplete" and r["missing"] == [] for r in rows)
+    assert all("proof results not of this tree (proved at commit " + "0" * 40 in r["why"]
+               for r in rows)
 
 
 def test_a_plan_stopped_by_a_contract_fails_its_row_and_the_report(report):
@@ -415,6 +528,78 @@ def test_obligation_cards_are_plain_grouped_and_collapsed(report):
                                       if i["id"] in ob["cards"][keys.index("findings")]["ids"])
     # Everything as expected: every group and card collapsed.
     assert '<details class="group" id="cards-' in html and " open>" not in html
+
+
+#: What a proved obligation's badge must say, by its method: only a solver's proof is "proved".
+_PROVED_BY_METHOD = {"z3": "proved", "sympy": "proved", "data": "checked on data",
+                     "test": "tested only"}
+
+
+def _card_heads(html):
+    """Each obligation card's head (id -> the HTML before its summary)."""
+    out = {}
+    for m in re.finditer(r'<div class="obligation" id="ob-[^"]*">\s*<div class="head">(.*?)'
+                         r'<p class="summary">', html, re.S):
+        out[re.search(r'<span class="id">([^<]*)</span>', m.group(1)).group(1)] = m.group(1)
+    return out
+
+
+def _badge_problems(doc, html):
+    """Where a badge does not say what was done: report.json's obligations (by method and
+    verdict), the ledger ("assumed"), the findings' related obligations, and each card's head."""
+    out = []
+    items = doc["obligations"]["items"]
+    for i in items:
+        want = (_PROVED_BY_METHOD.get(i["method"], "unknown") if i["verdict"] == "proved"
+                else i["verdict"])
+        if i["badge"] != want:
+            out.append(f"{i['id']}: badge {i['badge']!r}, method {i['method']}")
+    out += [f"ledger {e['id']}: {e['badge']!r}" for e in doc["assumptions"]["entries"]
+            if e["badge"] != "assumed"]
+    badge = {i["id"]: i["badge"] for i in items}
+    out += [f"finding's {r['id']}: {r['badge']!r}" for f in doc["findings"]
+            for r in f["related_obligations"] if r["badge"] != badge[r["id"]]]
+    heads = _card_heads(html)
+    for i in items:
+        shown = re.findall(r'<span class="badge v-[^"]*"[^>]*>([^<]*)</span>', heads[i["id"]])
+        if shown != [i["badge"]]:
+            out.append(f"{i['id']}'s card shows {shown}, not {i['badge']!r}")
+    return out
+
+
+def test_every_badge_says_what_was_done(report):
+    doc, html = report["doc"], report["html"]
+    methods = {i["method"] for i in doc["obligations"]["items"]}
+    assert {"z3", "data"} <= methods, methods          # solver proofs and checks on data
+    assert _badge_problems(doc, html) == []
+    data = [i for i in doc["obligations"]["items"] if i["method"] == "data"]
+    assert data and all(i["badge"] == "checked on data" for i in data)
+    heads = _card_heads(html)
+    assert all(">proved<" not in heads[i["id"]] for i in data)
+    assert {i["badge"] for i in doc["obligations"]["items"]} <= set(BADGES)
+    # The ledger's entries are "assumed" on the page too.
+    ledger = html[html.index('id="assumptions"'):html.index('id="findings"')]
+    assert ledger.count('<span class="badge v-assumed">assumed</span>') == len(
+        doc["assumptions"]["entries"]) > 0
+    # Seeded faults: a check on data badged "proved" is caught by this test and by the schema.
+    bad = copy.deepcopy(report["result"].doc)
+    (first,) = [i for i in bad["obligations"]["items"] if i["id"] == data[0]["id"]]
+    first["badge"] = "proved"
+    text = render_html(AuditResult(bad, report["result"].figures))
+    assert any(p.startswith(first["id"]) for p in _badge_problems(bad, text))
+    errors = list(jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text())).iter_errors(
+        json.loads(dumps_json(bad))))
+    assert any("'checked on data' was expected" in e.message for e in errors), errors[:3]
+
+
+def test_a_cards_scope_label_is_on_its_face(report):
+    html = report["html"]
+    heads = _card_heads(html)
+    labelled = [i for i in report["doc"]["obligations"]["items"] if i["label"]]
+    assert any(i["label"] == "wrapper proved, search assumed" for i in labelled), labelled
+    for i in labelled:
+        assert f'<span class="badge scope-label" title="the scope of this proof or check">' \
+               f'{escape(i["label"])}</span>' in heads[i["id"]], i["id"]
 
 
 def test_a_failed_obligation_opens_its_group_and_card(report, tmp_path):
@@ -576,12 +761,14 @@ def test_ids_of_a_doctored_results_json_are_checked_not_copied(report, tmp_path)
 def test_negative_controls_are_shown_from_results_json(report):
     doc, html = report["doc"], report["html"]
     recorded = json.loads(_results(report)["text"])["controls"]
-    assert len(recorded) == 4, [c["id"] for c in recorded]   # witness x2, dr, path
+    n = len(recorded)         # the witness checker's, the D_R postcondition's, the path's
+    assert {"Control.witness.forged", "Control.dr.unsound_free_cell",
+            "Control.path.through_blocked"} <= {c["id"] for c in recorded}, recorded
     ctl = doc["controls"]
     assert ctl["available"] and not ctl["missing_ids"]
     assert [(c["id"], c["outcome"], c["expected"], c["what"]) for c in ctl["items"]] == [
         (c["id"], c["outcome"], c["expected"], c["what"]) for c in recorded]
-    assert ctl["summary"] == {"total": 4, "as_expected": 4, "rejected": 4}
+    assert ctl["summary"] == {"total": n, "as_expected": n, "rejected": n}
     table = html[html.index('id="controls"'):]
     table = table[:table.index("</table>")]
     for c in recorded:
@@ -589,9 +776,9 @@ def test_negative_controls_are_shown_from_results_json(report):
         row = row[:row.index("</tr>")]
         assert c["id"] in row and str(escape(c["what"])) in row and ">rejected<" in row
         assert "as expected" in row and "FAILED" not in row
-    assert "4 of 4 as expected: rejected 4." in table
+    assert f"{n} of {n} as expected: rejected {n}." in table
     item = _check(doc, "negative controls as expected")
-    assert item["ok"] is True and item["detail"] == "4 of 4 (rejected 4)"
+    assert item["ok"] is True and item["detail"] == f"{n} of {n} (rejected {n})"
 
 
 def test_a_control_not_as_expected_fails_the_verdict(report, tmp_path):
@@ -607,7 +794,7 @@ def test_a_control_not_as_expected_fails_the_verdict(report, tmp_path):
     assert audit["verdict"]["ok"] is False and item["ok"] is False
     cid = doc["controls"][0]["id"]
     assert f"not as expected: {cid} (accepted, expected rejected)" in item["detail"]
-    assert audit["controls"]["summary"]["as_expected"] == 3
+    assert audit["controls"]["summary"]["as_expected"] == len(doc["controls"]) - 1
     text = render_html(AuditResult(audit, report["result"].figures))
     row = text[text.index(f'id="control-{cid.replace(".", "-").replace("_", "-").lower()}"'):]
     assert "FAILED" in row[:row.index("</tr>")]
@@ -615,7 +802,7 @@ def test_a_control_not_as_expected_fails_the_verdict(report, tmp_path):
     doc["controls"][0].update(outcome="rejected", ok=False)
     bad.write_text(json.dumps(doc))
     again = load_proofs(str(bad), ROOT / "scenarios", EXPECTED)
-    assert [c.ok for c in again.controls] == [False, True, True, True]
+    assert [c.ok for c in again.controls] == [False] + [True] * (len(doc["controls"]) - 1)
 
 
 def test_premise_controls_are_folded_unless_one_fails(report):
@@ -701,6 +888,50 @@ def test_a_fresh_run_shows_no_controls_and_does_not_count_them():
                     "summary": {"total": 0, "as_expected": 0}, "items": [], "missing_ids": []}
 
 
+def test_a_fresh_run_of_every_obligation_runs_the_controls_too(monkeypatch):
+    # The prove runner stood in for (a whole run takes minutes): what the fresh run asks of it.
+    import types
+
+    import cfmpa.proofs as proofs
+    from cfmpa.proofs import ControlResult, collect_controls
+    from cfmpa.report._obligations import _fresh
+
+    asked = {}
+
+    def run(obligations, out, expected, *, workers, controls=()):
+        asked["controls"] = [c.id for c in controls]
+        return types.SimpleNamespace(proofs=(), controls=tuple(
+            ControlResult(c.id, c.checker, c.what, c.expected, c.expected[0], "", 0.1)
+            for c in controls))
+    monkeypatch.setattr(proofs, "run_obligations", run)
+    # Every scenario-independent obligation in the run (none here, as there are none to run).
+    monkeypatch.setattr(proofs, "FIXED_IDS", ())
+    data = _fresh([], [])
+    every = [c.id for c in collect_controls()]
+    assert asked["controls"] == every and [c.id for c in data.controls] == every
+    assert all(c.ok for c in data.controls) and data.controls_note.startswith("run for this")
+    part = _proof_sections(data)["controls"]
+    assert part["available"] and part["summary"]["as_expected"] == len(every)
+    # A narrower run (a test's stand-in for the user's checks) has none to run, and says so.
+    monkeypatch.undo()
+    monkeypatch.setattr(proofs, "run_obligations", run)
+    data = _fresh([], [])
+    assert asked["controls"] == [] and data.controls is None
+    assert data.controls_note.startswith("not run for this report")
+
+
+def test_run_audit_prints_the_overall_status_last(report, tmp_path, monkeypatch):
+    import cfmpa.report._audit as audit
+
+    monkeypatch.setattr(audit, "build_audit", lambda *a, **k: report["result"])
+    printed = io.StringIO()
+    assert run_audit(None, str(tmp_path / "a"), stdout=printed) == 0
+    lines = printed.getvalue().splitlines()
+    assert lines[-2] == (f"{'overall':<38} incomplete (not available: verdict rows rest on what "
+                         "ran)")
+    assert lines[0].startswith("verdict rows rest on what ran          not available: ")
+
+
 def _check(audit, name):
     return next(i for i in audit["verdict"]["items"] if i["check"] == name)
 
@@ -742,15 +973,34 @@ def test_results_of_another_tree_fail_the_audit(report, tmp_path):
     assert unknown["ok"] is None and "records no run" in unknown["detail"]
 
 
-def test_missing_parts_are_labelled_not_available(report):
-    audit = copy.deepcopy(report["result"].doc)
+def test_missing_parts_are_labelled_not_available(report, tiny_file, complete_proofs):
+    # Everything the rows rest on ran: the overall pill says "no failure".
+    audit = complete_proofs(report["result"].doc, [tiny_file.stem])
+    audit["summary"] = workcell_summary([_scenario_of(report)], audit)
+    audit["verdict"] = _verdict(audit)
+    assert audit["verdict"]["status"] == "no failure", audit["verdict"]
+    text = render_html(AuditResult(audit, report["result"].figures))
+    assert _pills(text) == ["no failure", "no failure"]
+    # `--compare-n 0`: the campaign is not available, so the verdict is incomplete, not green.
     audit["compare"] = {"available": False, "note": "not run for this report (compare_n = 0)"}
     audit["verdict"] = _verdict(audit)
-    assert audit["verdict"]["ok"] is True
+    assert audit["verdict"]["ok"] is True          # nothing failed: exit code 0
+    assert audit["verdict"]["status"] == "incomplete"
+    assert audit["verdict"]["not_available"] == ["campaign checks"]
     text = render_html(AuditResult(audit, report["result"].figures))
     assert "not run for this report (compare_n = 0)" in text
+    # Both pills, section 1's and the provenance's, say so, with what is not available.
+    assert _pills(text) == ["incomplete", "incomplete"]
+    first = text[:text.index('id="provenance"')]
+    assert "not available: campaign checks" in first and '"badge ok">no failure<' not in text
     if not audit["selftest"]["available"]:
         assert "Not available in this run" in text
+
+
+def _pills(html):
+    """The overall pills of the page (section 1's total row, then "What this run checked")."""
+    return re.findall(r'<tr class="total"><td[^>]*>(?:overall).*?<span class="badge [^"]*"'
+                      r'(?: title="[^"]*")?>([^<]*)</span>', html, re.S)
 
 
 def test_unreadable_proofs_json_is_an_input_error(tmp_path, tiny_file):
@@ -856,14 +1106,22 @@ window.addEventListener("load", () => {
     const p = c.querySelector(":scope > p.summary");
     return {id: c.querySelector(".id").textContent,
             summary: p ? p.textContent.trim() : null,
-            placeholder: p ? p.querySelector("em") !== null : true};
+            placeholder: p ? p.querySelector("em") !== null : true,
+            badges: Array.from(c.querySelectorAll(".head .badge")).map(b => b.textContent.trim())};
   });
+  // Section 1's verdicts as laid out: each row's last cell's badge, with its box on the page.
+  const verdicts = table ? Array.from(table.querySelectorAll("tr")).slice(1).map(tr => {
+    const b = tr.lastElementChild.querySelector(".badge");
+    const r = b ? b.getBoundingClientRect() : null;
+    return {text: b ? b.textContent.trim() : null, shown: !!r && r.width > 0 && r.height > 0,
+            top: r && r.top};
+  }) : [];
   const out = document.createElement("pre");
   out.id = "screen-probe";
   out.textContent = JSON.stringify({
     width: window.innerWidth, height: window.innerHeight,
     top: box && box.top, table_top: table && table.getBoundingClientRect().top,
-    heading: s1 && s1.querySelector("h2").textContent, cards: cards});
+    heading: s1 && s1.querySelector("h2").textContent, cards: cards, verdicts: verdicts});
   document.body.appendChild(out);
 });
 </script>"""
@@ -883,8 +1141,17 @@ def _first_screen(tmp_path, html, name):
 
 def _screen_problems(got, doc):
     """What the first-screen reading shows wrong: section 1 not within the first 900 pixels,
-    a card missing, or a card without its short summary."""
+    a card missing, or a card without its short summary; a verdict of section 1 (its rows, then
+    the overall pill) that is not report.json's or not visible; a card of a check on data with
+    a "proved" badge."""
     out = []
+    want = [r["verdict"] for r in doc["summary"]] + [doc["verdict"]["status"]]
+    shown = [v["text"] for v in got["verdicts"]]
+    if shown != want or not all(v["shown"] for v in got["verdicts"]):
+        out.append(f"section 1 shows the verdicts {shown}, not {want} (or not all visibly)")
+    method = {i["id"]: i["method"] for i in doc["obligations"]["items"]}
+    out += [f"{c['id']}: a check on data badged proved" for c in got["cards"]
+            if method.get(c["id"]) == "data" and "proved" in c["badges"]]
     if got["heading"] != "1. Verdict per workcell" or not (0 <= got["top"] < 900):
         out.append(f"section 1 ({got['heading']!r}) starts at {got['top']} px")
     if got["table_top"] is None or not (0 <= got["table_top"] < 900):
@@ -907,16 +1174,29 @@ def test_section_one_is_on_the_first_screen_and_every_card_has_its_summary(repor
     assert got["width"] == 1400 and 0 < got["height"] <= 900, got
     assert got["table_top"] < got["height"], got
     assert _screen_problems(got, report["doc"]) == []
+    # The fixture's run is partial: its found plans' rows read "incomplete", on the first screen,
+    # and no check on data is called proved.
+    incomplete = [v for v in got["verdicts"] if v["text"] == "incomplete"]
+    assert len(incomplete) == 1 + sum(r["verdict"] == "incomplete" for r in report["doc"]["summary"])
+    assert all(v["top"] < got["height"] for v in incomplete[:-1]), got["verdicts"]
+    assert any(c["badges"][:1] == ["checked on data"] for c in got["cards"])
     # Seeded faults: a block that pushes section 1 below the first screen, a card without its
     # summary (rendered from a doc whose first obligation has none).
+    # A check on data badged "proved"; a found plan's row "safe" on the partial run.
     doc = copy.deepcopy(report["result"].doc)
     first = doc["obligations"]["items"][0]
     first["summary"] = None
+    (data,) = [i for i in doc["obligations"]["items"] if i["method"] == "data"][:1]
+    data["badge"] = "proved"
+    (row,) = [r for r in doc["summary"] if r["verdict"] == "incomplete"][:1]
+    row.update(ok=True, verdict="safe")
     html = render_html(AuditResult(doc, report["result"].figures)).replace(
         '<section id="workcells">', '<div style="height: 1000px"></div><section id="workcells">')
     bad = _screen_problems(_first_screen(tmp_path, html, "seeded"), report["doc"])
     assert any(b.startswith("section 1 (") for b in bad), bad
     assert f"{first['id']}: no short summary" in bad, bad
+    assert f"{data['id']}: a check on data badged proved" in bad, bad
+    assert any(b.startswith("section 1 shows the verdicts") for b in bad), bad
 
 
 # --- helpers --------------------------------------------------------------------------------------
@@ -1041,11 +1321,16 @@ def test_full_audit_of_the_bundled_scenarios(tmp_path, capsys):
     assert {s["path"].rsplit("/", 1)[-1][:-5] for s in doc["scenarios"]} == names
     assert doc["obligations"]["source"].startswith("a fresh run")
     assert not doc["obligations"]["missing_ids"] and doc["compare"]["n"] == 100
+    # A whole fresh run runs the negative controls too, so every row rests on what ran.
+    assert doc["controls"]["available"] and not doc["controls"]["missing_ids"]
+    assert doc["verdict"]["status"] == "no failure", doc["verdict"]["not_available"]
+    assert not [r for r in doc["summary"] if r["verdict"] == "incomplete"]
+    assert f"{'overall':<38} no failure" in printed
     html = (out / "report.html").read_text()
     assert all(f'<span class="id">{o["id"]}</span>' in html for o in doc["obligations"]["items"])
 
 
-# --- the sections (report/_sections.py, issue 25 item 2) ----------------------------------------
+# --- the sections (report/_sections.py, docs/model.md §8) ---------------------------------------
 # The order they are computed and shown in, the verdict made of their checks, and a planted extra
 # section, which must appear in report.json, the HTML and the verdict with nothing else touched
 # but its Section and its template.

@@ -38,19 +38,22 @@ def planned():
     return out
 
 
-def _summary(planned):
+def _summary(planned, complete=None):
+    """Section 1's rows of the plans: with every obligation and control each row rests on as
+    expected (``complete``: the ``complete_proofs`` fixture), or with no proof data (None)."""
     loaded = [planned[n][0] for n in NAMES]
     entries = []
     for n in NAMES:
         j = plan_json(planned[n][1])
         j["contracts"] = {"mode": "off", "violations": []}
         entries.append({"name": n, "variants": [j]})
-    doc = {"obligations": {"available": False, "items": []}, "scenarios": entries}
-    return workcell_summary(loaded, doc)
+    doc = {"obligations": {"available": False, "items": [], "source": "none"},
+           "scenarios": entries}
+    return workcell_summary(loaded, doc if complete is None else complete(doc, NAMES))
 
 
-def test_a_workcell_with_a_tool_or_heights_is_certified_not_safe(planned):
-    rows = {r["scenario"]: r for r in _summary(planned)}
+def test_a_workcell_with_a_tool_or_heights_is_certified_not_safe(planned, complete_proofs):
+    rows = {r["scenario"]: r for r in _summary(planned, complete_proofs)}
     for name, scope in SCOPES.items():
         r = rows[name]
         assert r["ok"] is True and r["scope"] == scope
@@ -60,12 +63,21 @@ def test_a_workcell_with_a_tool_or_heights_is_certified_not_safe(planned):
             assert r["verdict"] == "certified" and r["why"].startswith(scope)
     items = json.loads(SCHEMA.read_text())["properties"]["summary"]
     jsonschema.validate(list(rows.values()), items)
+    # Without its proofs, no row is certified or safe: each is incomplete, whatever its scope.
+    bare = {r["scenario"]: r for r in _summary(planned)}
+    for name, scope in SCOPES.items():
+        r = bare[name]
+        assert (r["ok"], r["verdict"], r["scope"]) == (None, "incomplete", scope), r
+        assert "Safety.modified.composition" in r["missing"] and r["why"].startswith(
+            scope or "incomplete: it would be safe")
+    jsonschema.validate(list(bare.values()), items)
 
 
-def test_section_one_shows_the_scope_on_the_workcells_row(planned):
-    rows = _summary(planned)
+def test_section_one_shows_the_scope_on_the_workcells_row(planned, complete_proofs):
+    rows = _summary(planned, complete_proofs)
     html = template_env().get_template("section_summary.html").render(
-        doc={"summary": rows, "verdict": {"ok": True}},
+        doc={"summary": rows, "verdict": {"ok": True, "status": "no failure",
+                                          "not_available": []}},
         number={"summary": 1, "provenance": 2, "assumptions": 5})
     body = html.split("<tr", 2)[2]                       # the rows, after the heading's
     cells = {n: body[body.index(f">{n}</a>"):] for n in NAMES}
@@ -87,8 +99,10 @@ def test_the_tolerance_in_mm_is_at_the_farthest_point_the_tool_tip(planned):
     assert sum(reach(s.right, 2)) == far == tube_lipschitz(s) == rows["gripper"]["reach_m_per_rad"]
     assert far > max(sum(reach(arm, p)) for arm in (s.left, s.right) for p in (0, 1))
     r = rows["gripper"]
-    assert r["tolerance_tip_mm"] == pytest.approx(1000 * far * r["tolerance_rad"], rel=1e-12)
-    assert 2 * r["tolerance_tip_mm"] < r["lower_bound_mm"]
+    assert r["tolerance_farthest_point_mm"] == pytest.approx(1000 * far * r["tolerance_rad"],
+                                                             rel=1e-12)
+    assert r["tolerance_tip_mm"] == r["tolerance_farthest_point_mm"]   # the former name
+    assert 2 * r["tolerance_farthest_point_mm"] < r["lower_bound_mm"]
 
 
 def test_the_clearance_picture_sees_the_tools(planned):

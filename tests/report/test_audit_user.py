@@ -139,7 +139,7 @@ def test_cfmpa_audit_on_a_users_workcell_shows_and_fails_on_its_checks(mine: Pat
     assert item["ok"] is False and "Scenario.mine.cspace_grid" in item["detail"]
 
 
-# --- the monitored runs are of the audited workcells (issue 22.5) --------------------------------
+# --- the monitored runs are of the audited workcells (docs/model.md §8) -------------------------
 
 def test_the_audit_monitors_each_audited_workcell_and_names_it(mine: Path, tmp_path: Path,
                                                                monkeypatch) -> None:
@@ -230,7 +230,7 @@ def test_a_narrow_tube_scales_the_simulation_to_fit_it() -> None:
     assert isinstance(why, str) and f"more than the report's {MONITOR_MAX_SAMPLES}" in why
 
 
-# --- provenance: a commit must be known on both sides (issue 22.8) --------------------------------
+# --- provenance: a commit must be known on both sides (docs/model.md §8) ------------------------
 
 def _tree_check(mine: str | None, theirs: str | None, note: str = "n") -> dict:
     ob = {"available": True, "source": "read from x", "not_run": [],

@@ -1,0 +1,243 @@
+"""The fast kernels' machine code: compiled once per machine, the groups at once in their own
+processes, then loaded from numba's cache; one line on stderr while anything compiles.
+
+numba compiles a kernel at its first call and keeps the machine code (``cache=True``) in a folder
+beside the source (``__pycache__``) or under NUMBA_CACHE_DIR: a cold cache costs seconds per group
+of kernels (GROUPS: the regions' hulls, BuiltDR's layer kernel, the search). So the first fast
+kernel a process calls runs ``ensure_compiled``. Each group has a stamp in numba's cache folder:
+a file holding a hash of what that cache depends on (cfmpa's, Python's, numba's, llvmlite's and
+numpy's versions; the group's module: its source, and its size and modification time, numba's
+own key; the host CPU's name and features). The groups whose stamp is missing or stale are
+compiled each in its own process, all at once (each writes numba's cache; warm-up calls on a tiny
+workcell with the same types as a real run), while stderr says so with a count, and their stamps
+written; this process then loads the kernels from the cache as they are called. A lock file makes
+processes that start cold together (a campaign's workers) wait for one compile. With a warm cache
+it costs a few file reads and prints nothing. docs/model.md §7.5.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import importlib
+import os
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+__all__ = ["GROUPS", "WARM_UP", "cold_groups", "ensure_compiled", "load_fast_kernels"]
+
+#: The groups of kernels compiled apart, and their modules (none calls another's kernels).
+GROUPS: dict[str, str] = {"regions": "._fast_regions", "builtdr": "._fast_builtdr",
+                          "search": "._fast_search"}
+
+#: A workcell with a 4 x 14 x 14 grid: calling the fast kernels on it compiles (or loads) every
+#: numba specialisation a real run uses (same dtypes and layouts), in milliseconds of work.
+WARM_UP: dict[str, Any] = {
+    "name": "kernel-warm-up", "purpose": "load the fast kernels", "dt": 0.5,
+    "left": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.0, 0.0],
+             "start": [0.3, 0.8], "goal": [1.6, 2.2]},
+    "right": {"links": [0.35, 0.30], "width": 0.06, "omega": [1.0, 1.0], "base": [0.6, 0.0],
+              "limits": [[0.0, 6.283185307179586], [0.0, 6.283185307179586]],
+              "start_cell": [0, 4], "goal_cell": [7, 4]},
+}
+
+#: Bumped when the stamp's meaning changes.
+_STAMP_FORMAT = "cfmpa kernel stamp 1"
+_READY = [False]          # this process has made sure (or is a compile process itself)
+_LOCK = threading.Lock()
+_LOADED: list[float] = []
+
+
+def ensure_compiled() -> None:
+    """Compile the groups whose cache is cold (see the module docstring); at once after the
+    first call in a process. Called by every fast kernel's entry point."""
+    if _READY[0]:
+        return
+    with _LOCK:
+        if not _READY[0]:
+            _compile_cold()
+            _READY[0] = True
+
+
+def load_fast_kernels() -> float:
+    """Seconds spent making the fast kernels ready in this process by this call: compiling
+    any cold group, then loading every kernel from the cache by calling it on WARM_UP (0.0 if
+    done before in this process)."""
+    if _LOADED:
+        return 0.0
+    t0 = time.perf_counter()
+    ensure_compiled()
+    for name in GROUPS:
+        _warm(name)
+    _LOADED.append(time.perf_counter() - t0)
+    return _LOADED[0]
+
+
+def cold_groups() -> list[str]:
+    """The groups whose stamp is missing or stale (numba's cache off: none)."""
+    return [name for name in GROUPS if not _stamp_ok(name)]
+
+
+# ------------------------------------------------------------------------------- stamps ----
+
+def _module(name: str) -> ModuleType:
+    return importlib.import_module(GROUPS[name], __package__)
+
+
+def _cache_dir(mod: ModuleType) -> Path | None:
+    """numba's cache folder for the kernels of ``mod`` (None: caching is off)."""
+    for obj in vars(mod).values():
+        path = getattr(getattr(obj, "_cache", None), "_cache_path", None)
+        if path:
+            return Path(path)
+    return None
+
+
+def _stamp_path(name: str) -> Path | None:
+    folder = _cache_dir(_module(name))
+    return None if folder is None else folder / f"cfmpa-{name}.stamp"
+
+
+def _key(name: str) -> str:
+    """The hash the stamp of group ``name`` holds: what numba's cache of it depends on."""
+    import llvmlite  # type: ignore[import-untyped]  # no py.typed: read for versions only
+    import llvmlite.binding as ll  # type: ignore[import-untyped]  # the host CPU, likewise
+    import numba
+    import numpy
+
+    from .. import __version__
+
+    source = Path(_module(name).__file__ or "")
+    st = source.stat()
+    h = hashlib.sha256()
+    for part in (_STAMP_FORMAT, __version__, sys.version, numba.__version__,
+                 llvmlite.__version__, numpy.__version__, str(st.st_size), str(st.st_mtime_ns),
+                 os.environ.get("NUMBA_CPU_NAME", ""), os.environ.get("NUMBA_CPU_FEATURES", ""),
+                 ll.get_host_cpu_name(), ll.get_host_cpu_features().flatten()):
+        h.update(part.encode() + b"\0")
+    h.update(source.read_bytes())
+    return h.hexdigest()
+
+
+def _stamp_ok(name: str) -> bool:
+    path = _stamp_path(name)
+    if path is None:
+        return True
+    try:
+        return path.read_text() == _key(name)
+    except OSError:
+        return False
+
+
+def _write_stamp(name: str) -> None:
+    path = _stamp_path(name)
+    if path is None:
+        return
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    with contextlib.suppress(OSError):     # an unwritable cache: compiled again next time
+        tmp.write_text(_key(name))
+        os.replace(tmp, path)
+
+
+@contextlib.contextmanager
+def _file_lock(folder: Path | None) -> Iterator[None]:
+    """Held by one process at a time (where fcntl and the folder allow it)."""
+    try:
+        import fcntl
+    except ImportError:   # pragma: no cover - not on Linux
+        yield
+        return
+    if folder is None:
+        yield
+        return
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fh = open(folder / "cfmpa-kernels.lock", "a")   # noqa: SIM115 - closed below
+    except OSError:
+        yield
+        return
+    with fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+# ------------------------------------------------------------------------------ compiling ----
+
+def _compile_cold() -> None:
+    cold = cold_groups()
+    if not cold:
+        return
+    with _file_lock(_cache_dir(_module(cold[0]))):
+        cold = cold_groups()                  # another process may have compiled them
+        if not cold:
+            return
+        t0 = time.perf_counter()
+        groups = f"{len(cold)} group{'s' if len(cold) > 1 else ''}"
+        print(f"cfmpa: compiling {groups} of fast kernels for this machine (first run only)...",
+              file=sys.stderr, flush=True)
+        failed = _compile_in_processes(cold)
+        for name in failed:                   # compiled here instead (the cache is written too)
+            _warm(name)
+        for name in cold:
+            _write_stamp(name)
+        print(f"cfmpa: fast kernels compiled in {time.perf_counter() - t0:.1f} s "
+              "(cached for later runs)", file=sys.stderr, flush=True)
+
+
+def _compile_in_processes(names: list[str]) -> list[str]:
+    """Compile each group in a process of its own, all at once; the names that failed (they are
+    compiled in this process instead, so a failure here costs time, not the run)."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)   # this process's cfmpa
+    procs: list[tuple[str, subprocess.Popen[bytes] | None]] = []
+    for name in names:
+        code = f"import {__name__} as k; k._compile_here({name!r})"
+        try:
+            proc: subprocess.Popen[bytes] | None = subprocess.Popen(
+                [sys.executable, "-c", code], env=env, stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        except OSError:
+            proc = None
+        procs.append((name, proc))
+    return [name for name, proc in procs if proc is None or proc.wait() != 0]
+
+
+def _compile_here(name: str) -> None:
+    """A compile process's work: group ``name``'s kernels on WARM_UP (numba writes its cache)."""
+    _READY[0] = True
+    _warm(name)
+
+
+def _warm(name: str) -> None:
+    """Call group ``name``'s kernels on WARM_UP with the types of a real run (compiling them or
+    loading them from the cache); only its own kernels: the inputs come from the reference."""
+    from ..spec import Variant, make_grid, parse_scenario
+    from ._builtdr import build_dr, left_regions, right_regions
+
+    s = parse_scenario(WARM_UP, check_budget=False)
+    g = make_grid(s)
+    v = Variant.MODIFIED
+    if name == "regions":
+        from ._fast_regions import left_regions_fast, right_regions_fast
+        right_regions_fast(s, g)
+        left_regions_fast(s, v, g)
+    elif name == "builtdr":
+        from ._fast_builtdr import build_from_regions
+        build_from_regions(s, g, right_regions(s, g), left_regions(s, v, g), progress=False)
+    elif name == "search":
+        from ._fast_search import search_opt_path_fast
+        dr = build_dr(s, v, g)
+        search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False)
+        search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False,
+                             with_witness=True)
+    else:
+        raise ValueError(f"no kernel group {name!r} (known: {', '.join(GROUPS)})")
