@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from cfmpa import cli
-from cfmpa.impl import build_dr, search_opt_path
+from cfmpa.impl import build_dr, build_dr_fast, search_opt_path
 from cfmpa.spec import Variant, load_scenario, make_grid
 from cfmpa.spec._certificate import certify
 from cfmpa.spec._paths import J1, J2, SearchStatus, is_path, is_path_paper, path_violations
@@ -109,7 +109,9 @@ def test_gripper_a_plan_made_without_the_tools_collides_through_them(variant):
     s, g, _, best = planned("gripper", variant)
     assert best.status is SearchStatus.FOUND and certify(s, g, best.path).clear
     planar = _without(s, "tool")
-    blind = search_opt_path(build_dr(planar, variant, g), s.right.start_cell, s.right.goal_cell)
+    # The fast kernel (bit-identical to the reference: tests/impl/test_fast_builtdr.py).
+    blind = search_opt_path(build_dr_fast(planar, variant, g, progress=False), s.right.start_cell,
+                            s.right.goal_cell)
     assert blind.status is SearchStatus.FOUND
     assert certify(planar, g, blind.path).clear          # safe for arms that carry nothing
     cert = certify(s, g, blind.path)                      # but the real arms carry tools
@@ -141,15 +143,15 @@ def test_levels_heights_shorten_the_plan():
     for variant in ORDER:
         s, g, dr, best = planned("levels", variant)
         flat = _without(s, "z")
-        flat_best = search_opt_path(build_dr(flat, variant, g), s.right.start_cell,
-                                    s.right.goal_cell)
+        flat_dr = build_dr_fast(flat, variant, g, progress=False)   # = the reference's
+        flat_best = search_opt_path(flat_dr, s.right.start_cell, s.right.goal_cell)
         assert best.status is SearchStatus.FOUND and flat_best.status is SearchStatus.FOUND
         # The subordinate no longer waits for the principal's forearm: J1 drops to the
         # Manhattan distance, and fewer cells are blocked.
         assert (best.J1, best.J2) < (flat_best.J1, flat_best.J2)
         assert best.J1 == abs(s.right.goal_cell[0] - s.right.start_cell[0]) + abs(
             s.right.goal_cell[1] - s.right.start_cell[1])
-        assert 0 < dr.sum() < build_dr(flat, variant, g).sum()
+        assert 0 < dr.sum() < flat_dr.sum()
         assert certify(s, g, best.path).clear
         # Planned with the heights, the motion touches in the plane (the forearms cross above
         # one another): without the heights it would not be clear.
