@@ -306,6 +306,10 @@ def _mcap_log_times(f: Path, topic: str) -> list[int] | None:
     indexes) and the message index records they point to; None without them."""
     def record(fh: Any) -> tuple[int, bytes]:
         op, length = struct.unpack("<BQ", fh.read(9))
+        # A record's length is the file's word: never read more than the file still holds (a
+        # forged length of 2^62 would otherwise ask for that much memory).
+        if length > file_bytes - fh.tell():
+            raise ValueError(f"an mcap record of {length} bytes runs past the file's end")
         return op, fh.read(length)
 
     def string(buf: bytes, at: int) -> tuple[str, int]:
@@ -313,6 +317,7 @@ def _mcap_log_times(f: Path, topic: str) -> list[int] | None:
         return buf[at + 4:at + 4 + n].decode("utf-8", "replace"), at + 4 + n
 
     with open(f, "rb") as fh:
+        file_bytes = os.fstat(fh.fileno()).st_size
         fh.seek(-(len(MCAP_MAGIC) + 29), os.SEEK_END)
         op, body = record(fh)
         if op != OP_FOOTER or fh.read(len(MCAP_MAGIC)) != MCAP_MAGIC:

@@ -453,7 +453,7 @@ def _tool_polygon(r: _Reader, value: Any, field: str) -> tuple[Pair, ...]:
     doubles (every other vertex strictly to the left of every edge, after orienting it
     counter-clockwise), returned counter-clockwise."""
     if not isinstance(value, list) or not 3 <= len(value) <= MAX_TOOL_VERTICES:
-        raise r.fail(field, _short_list(value),
+        raise r.fail(field, value,
                      f"must be a list of 3 to {MAX_TOOL_VERTICES} [x, y] vertices (m)")
     pts = [r.pair(v, f"{field}[{k}]", bound=MAX_LENGTH_M, unit=" m") for k, v in enumerate(value)]
     pts = [(float(x), float(y)) for x, y in pts]
@@ -477,12 +477,6 @@ def _tool_polygon(r: _Reader, value: Any, field: str) -> tuple[Pair, ...]:
                              "must be a strictly convex polygon (vertices in order, either "
                              "orientation, no three on a line, no repeated vertex)")
     return tuple(pts)
-
-
-def _short_list(value: Any) -> Any:
-    """A long list shown by its length only."""
-    return f"<a list of {len(value)} items>" if isinstance(value, list) and len(value) > 20 \
-        else value
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:

@@ -4,17 +4,14 @@ its obligation; each VC is false without its key premise."""
 
 from __future__ import annotations
 
-import importlib
-import linecache
 import sys
-import types
-from pathlib import Path
 
 import pytest
 import z3
 
 import cfmpa.spec
 from z3answer import answer
+from mutant_module import mutated_module, source
 from cfmpa.proofs import Verdict, discharge
 from cfmpa.proofs._obl_constants import (ExtractionError, constants_obligations, on_terms,
                                          sqrt_free, tolerance_parts)
@@ -64,28 +61,12 @@ def _proof_answer(vc: VC, pins=()) -> z3.CheckSatResult:
                   + [c == v for c, v in pins])
 
 
-def _source(file: str) -> tuple[str, str]:
-    """(module name, source text) of a package file such as ``spec/_exact.py``."""
-    folder, stem = file.split("/")[0], Path(file).stem
-    name = f"cfmpa.{folder}.{stem}"
-    return name, Path(importlib.import_module(name).__file__).read_text()  # type: ignore[arg-type]
-
-
 def _plant(monkeypatch: pytest.MonkeyPatch, mutant: tuple) -> None:
     """Load the mutated copy of the mutant's file as a module of its package (its source
     registered for inspect) and point the public names the obligations read at it."""
     name, what, file, edits = mutant
-    modname, src = _source(file)
-    for old, new in edits:
-        assert src.count(old) == 1, (name, old)
-        src = src.replace(old, new)
-    fname = f"<mutant {name} of {file}>"
-    linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
-    mod = types.ModuleType(f"{modname}_mutant_{name}")
-    mod.__package__ = modname.rsplit(".", 1)[0]
-    mod.__file__ = fname
-    monkeypatch.setitem(sys.modules, mod.__name__, mod)
-    exec(compile(src, fname, "exec"), mod.__dict__)
+    mod = mutated_module(name, file, edits,
+                         lambda key, value: monkeypatch.setitem(sys.modules, key, value))
     for attr in READS[file]:
         monkeypatch.setattr(cfmpa.spec, attr, getattr(mod, attr))
 
@@ -138,7 +119,7 @@ def test_each_mutant_edits_todays_source_once_and_is_checked_here():
     assert {m[0] for m in CONSTANT_MUTANTS} == set(CAUGHT_BY)
     for name, what, file, edits in CONSTANT_MUTANTS:
         assert file in READS and what and edits
-        _, src = _source(file)
+        _, src = source(file)
         for old, new in edits:
             assert src.count(old) == 1, (name, old)
             assert old != new

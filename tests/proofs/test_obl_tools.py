@@ -5,7 +5,6 @@ the code is, each VC false without its key premise, and each seeded fault of sel
 from __future__ import annotations
 
 import importlib
-import linecache
 import sys
 import types
 from pathlib import Path
@@ -16,6 +15,7 @@ import z3
 
 import cfmpa.spec
 from z3answer import answer
+from mutant_module import mutated_module
 from cfmpa.impl import link_reach, link_rectangles, sweep_margin
 from cfmpa.proofs import FIXED_IDS, Verdict, collect_obligations
 from cfmpa.proofs import _obl_tools as T
@@ -49,20 +49,7 @@ def _planted(name: str) -> types.ModuleType:
     """The mutant's file, edited, loaded as a module of its package (its source registered for
     inspect, which the readings use)."""
     m = MUTANTS[name]
-    folder, stem = m.file.split("/")[0], Path(m.file).stem
-    modname = f"cfmpa.{folder}.{stem}"
-    src = Path(importlib.import_module(modname).__file__).read_text()  # type: ignore[arg-type]
-    for old, new in m.edits:
-        assert src.count(old) == 1, (name, old)
-        src = src.replace(old, new)
-    fname = f"<mutant {name} of {m.file}>"
-    linecache.cache[fname] = (len(src), None, src.splitlines(True), fname)
-    mod = types.ModuleType(f"{modname}_mutant_{name}")
-    mod.__package__ = modname.rsplit(".", 1)[0]
-    mod.__file__ = fname
-    sys.modules[mod.__name__] = mod
-    exec(compile(src, fname, "exec"), mod.__dict__)
-    return mod
+    return mutated_module(name, m.file, m.edits, sys.modules.__setitem__)
 
 
 @pytest.fixture(scope="module")

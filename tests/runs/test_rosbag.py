@@ -480,3 +480,18 @@ def test_a_corrupt_metadata_yaml_is_one_line(cell, tmp_path, capsys):
     assert main(["monitor", str(scen), "--traj", str(traj_csv), "--log", str(bag)]) == 2
     err = capsys.readouterr().err
     assert "is not a readable ROS 2 bag" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_forged_mcap_record_length_is_not_read_into_memory(tmp_path):
+    # Seeded fault in the bag: the summary's first record claims 2^62 bytes. The index reader
+    # gives up on the index (None: no declared times) instead of asking for that memory.
+    import struct
+
+    from cfmpa.runs._rosbag import MCAP_MAGIC, OP_FOOTER, _declared_log_times
+
+    summary_start = len(MCAP_MAGIC) + 8
+    body = MCAP_MAGIC + b"\x00" * 8 + struct.pack("<BQ", 0x04, 2**62)
+    footer = struct.pack("<BQ", OP_FOOTER, 20) + struct.pack("<QQI", summary_start, 0, 0)
+    bag = tmp_path / "forged.mcap"
+    bag.write_bytes(body + footer + MCAP_MAGIC)
+    assert _declared_log_times(bag, "/joint_states") is None
