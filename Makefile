@@ -15,8 +15,12 @@ $(STAMP): pyproject.toml
 prove: $(STAMP)
 	$(VENV)/bin/cfmpa prove --audit build/audit
 
+# Two pytest workers, a test file each at a time (a module's fixtures are built once): the suite
+# is CPU-bound, so two cores take about half the time (docs/contributing.md). TEST_WORKERS=0 runs
+# it in one process.
+TEST_WORKERS ?= 2
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -m slow

@@ -63,8 +63,8 @@ class Config:
     sample: int = 2000                     # per-cell shapely loop
     dwithin_stride: int = 8                # vectorised dwithin: every 8th layer, extrapolated
     scaling_dts: tuple[float, ...] = (0.04, 0.02, 0.01)
-    #: `cfmpa plan --contracts full` of the default workcell per dt, fresh processes (item 1 of
-    #: issue 24: bytes a cell); 0.005 (381 M cells) is left to a quiet machine.
+    #: `cfmpa plan --contracts full` of the default workcell per dt, fresh processes (seconds,
+    #: peak MiB, bytes a cell); 0.005 (381 M cells) is left to a quiet machine.
     plan_scaling_dts: tuple[float, ...] = (0.02, 0.01, 0.0075, 0.005)
     one_degree: dict[str, Any] = field(default_factory=dict)
     prove: bool = False                    # time `make prove` (cfmpa prove --audit): one run
@@ -417,7 +417,7 @@ def first_run_lines(sec: dict[str, Any]) -> list[str]:
                 + "; ".join(sec.get("compile_lines", []))]
 
 
-#: `cfmpa certify` of a long slow trajectory (issue 24.4): rows, and the targets.
+#: `cfmpa certify` of a long slow trajectory: rows, and the targets.
 CERTIFY_STREAM = {"rows": (100_000, 1_000_000), "quick_rows": (2_000, 20_000), "dt": 0.01,
                   "target_s": 20.0, "target_mib": 300.0}
 

@@ -252,7 +252,7 @@ def test_prove_that_stops_opens_the_gate_with_stop_and_the_report_writes_nothing
 
 
 def test_prove_audit_prints_the_reports_stage_lines_on_stderr(tmp_path, capfd, monkeypatch):
-    # As `cfmpa audit` does (issue 26 item 5): the report process (forked) writes a line per
+    # As `cfmpa audit` does: the report process (forked) writes a line per
     # stage on its stderr. A stand-in report writes a stage line to the progress stream it is
     # given; a stand-in prove run succeeds. capfd: the child writes to the inherited fd 2.
     import cfmpa.proofs
@@ -270,7 +270,7 @@ def test_prove_audit_prints_the_reports_stage_lines_on_stderr(tmp_path, capfd, m
     assert "audit: proofs (read from the prove run)" in err and "audit: " not in out
 
 
-# --- outputs checked before the work (issue 22.6) ---------------------------------------------
+# --- outputs checked before the work -----------------------------------------------------------
 
 def _no_work(monkeypatch):
     """Every computation a command could start raises: a command that gets past its checks
@@ -420,7 +420,7 @@ def test_handled_lets_a_bug_keep_its_traceback():
         handled(run)
 
 
-# --- numeric budgets (issue 22.3) ----------------------------------------------------------------
+# --- numeric budgets ------------------------------------------------------------------------------
 
 @pytest.fixture
 def rest_traj(tmp_path):
@@ -525,7 +525,7 @@ def test_every_numeric_option_is_budgeted():
     assert unbudgeted == []
 
 
-# --- help for users (issue 22.9) -----------------------------------------------------------------
+# --- help for users -------------------------------------------------------------------------------
 
 def _subparsers():
     import argparse

@@ -1,4 +1,4 @@
-"""cfmpa.files' one JSON writer (issue 25 item 4): its styles give the bytes each file had."""
+"""cfmpa.files' one JSON writer: its styles give the bytes each file had."""
 
 from __future__ import annotations
 

@@ -8,8 +8,9 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-#: What is shipped or read as the project's text (tests/ and bench/ are not).
-TREE = ("spec", "impl", "proofs", "runs", "report", "cfmpa", "scenarios", "docs", "README.md")
+#: The project's text: what is shipped, and its tests, bench and build files.
+TREE = ("spec", "impl", "proofs", "runs", "report", "cfmpa", "scenarios", "docs", "tests", "bench",
+        "README.md", "Makefile", ".ci")
 #: A tracker reference: "issue 24", "issues 21", "issue #7".
 TRACKER = re.compile(r"\bissues?\s*#?\d+", re.IGNORECASE)
 #: A tag naming who wrote a part: "helper h21c", "(h21c)", "by agent 3", "session s2".
@@ -24,7 +25,7 @@ def _files() -> list[Path]:
         p = ROOT / name
         found = [p] if p.is_file() else sorted(x for x in p.rglob("*") if x.is_file())
         out += [x for x in found if x.suffix not in BINARY and "__pycache__" not in x.parts
-                and not x.name.endswith(".egg-info")]
+                and not x.name.endswith(".egg-info") and x != Path(__file__).resolve()]
     return out
 
 

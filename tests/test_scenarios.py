@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from cfmpa import cli
-from cfmpa.impl import build_dr, build_dr_fast, search_opt_path
+from cfmpa.impl import build_dr_fast, search_opt_path
 from cfmpa.spec import Variant, load_scenario, make_grid
 from cfmpa.spec._certificate import certify
 from cfmpa.spec._paths import J1, J2, SearchStatus, is_path, is_path_paper, path_violations
@@ -25,7 +25,10 @@ ORDER = (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT)
 def planned(name: str, variant: Variant):
     s = load_scenario(ROOT / f"{name}.toml")
     g = make_grid(s)
-    dr = build_dr(s, variant, g)
+    # The fast kernel: bit-identical to the reference build_dr on every bundled workcell and
+    # variant (tests/impl/test_fast_builtdr.py; the default workcell's under the slow marker),
+    # and a tenth of its time on the tool workcells.
+    dr = build_dr_fast(s, variant, g, progress=False)
     return s, g, dr, search_opt_path(dr, s.right.start_cell, s.right.goal_cell)
 
 

@@ -1,4 +1,4 @@
-"""Start-up (issue 24.6): a command imports what it needs. After what `cfmpa dr`, `plan` and
+"""Start-up (docs/model.md §7.5): a command imports what it needs. After what `cfmpa dr`, `plan` and
 `certify` import and run (the parser of every command, their run_* functions, plan.json's versions,
 a certify), a fresh interpreter holds no z3, matplotlib, dask or distributed, and certify no numba,
 python-flint or shapely either. The packages spec, impl and runs import their modules on first use

@@ -1,4 +1,4 @@
-"""Certificate.lipschitz, Tolerance.tube_factor and Exact.gap_formula (issue 21 item 5): proved as
+"""Certificate.lipschitz, Tolerance.tube_factor and Exact.gap_formula: proved as
 the code is; each seeded fault of CONSTANT_MUTANTS, applied to a copy of its source file, refutes
 its obligation; each VC is false without its key premise."""
 

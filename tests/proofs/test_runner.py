@@ -31,7 +31,7 @@ def _strip_times(doc: dict) -> dict:
 
 
 def test_fixed_ids_match_the_collected_obligations_exactly():
-    # Compared as a mapping id -> verdict (issue 25 item 4): EXPECTED_VERDICTS need not follow
+    # Compared as a mapping id -> verdict: EXPECTED_VERDICTS need not follow
     # the order the obligations are collected in, but every id and its verdict must match.
     from cfmpa.proofs import EXPECTED_VERDICTS
 

@@ -1,4 +1,4 @@
-"""Campaigns that lose their workers (issue 22.7): `cfmpa compare --scheduler` and `cfmpa check
+"""Campaigns that lose their workers: `cfmpa compare --scheduler` and `cfmpa check
 --batch --scheduler` whose cluster loses its last worker mid-run warn, stop after
 --worker-timeout seconds with exit 2 and the command that resumes, and keep what was recorded;
 a refused --scheduler writes nothing.

@@ -1,4 +1,4 @@
-"""The constants' formulas restructured to run on Z3 terms (issue 21 item 5) give, on floats and on
+"""The constants' formulas restructured to run on Z3 terms give, on floats and on
 balls, exactly what the code computed before: reach through hypot_of, the certificate's interval
 bound and L_ab, the exact re-decision's separating-axis gap."""
 

@@ -1,4 +1,4 @@
-"""Round numbers are never refused (issue 22, item 4; docs/model.md §2, §3).
+"""Round numbers are never refused (docs/model.md §2, §3).
 
 A workcell file whose ranges, speeds and dt have at most three decimals, whose subordinate
 ranges are whole multiples of omega dt in decimal, and whose right start and goal are angles on

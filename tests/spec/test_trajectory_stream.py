@@ -1,4 +1,4 @@
-"""Streaming certify (issue 24.4, docs/model.md §12): `cfmpa certify` reads a CSV trajectory a part
+"""Streaming certify (docs/model.md §12): `cfmpa certify` reads a CSV trajectory a part
 of CHUNK_ROWS rows at a time and certifies each as it comes. Up to CHUNK_ROWS rows the result is
 the one-piece-list certificate of the whole loaded trajectory, byte for byte (JSON, exit code,
 messages); in smaller parts the verdict, the contact and every error stay the same; no part holds
