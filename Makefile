@@ -40,7 +40,7 @@ bench: $(STAMP)
 
 # Seeded source mutations of a copy of the packages: which of prove, contracts, tests catch each.
 mutants: $(STAMP)
-	$(VENV)/bin/cfmpa selftest --code --json build/mutants.json
+	$(VENV)/bin/cfmpa mutants --json build/mutants.json
 
 clean:
 	rm -rf build .pytest_cache

@@ -21,12 +21,15 @@ results.json); --quick leaves it out (its cluster start alone is seconds). Likew
 ``plan_scaling`` (``--only plan_scaling``): `cfmpa plan --contracts full` of the default
 workcell at dt = 0.02, 0.01, 0.0075, 0.005 in fresh processes, with cells, seconds, peak resident
 memory and bytes a cell (docs/model.md §3's cell budget rests on it). And ``certify_stream``
-(``--only certify_stream``): `cfmpa certify` of a long slow trajectory of 10^6 rows (and of
-10^5, to show the peak does not grow with the rows), seconds and the child's peak memory. And
+(``--only certify_stream``): `cfmpa certify` of a long slow trajectory of 10^6 and 10^7 rows
+by default (and of 10^5, to show the peak does not grow with the rows), seconds and the child's
+peak memory, against their targets. And
 ``tools`` (``--only tools``): BuiltDR fast of the bundled gripper and levels workcells, with
 their ratio to the default workcell's. And ``first_run`` (``--only first_run``; --quick too):
 `cfmpa plan default` with a fresh NUMBA_CACHE_DIR (the kernels compiled) against later runs
-with that cache, the first at most 2x a later one.
+with that cache, the first at most 2x a later one. And ``dr_dask`` (``--only dr_dask``):
+`cfmpa dr` at dt = 0.005 in one process and on 1 and 2 local Dask workers, and `cfmpa plan
+--contracts full --store zarr` at dt = 0.0035 (1.11 G cells), with their targets.
 """
 
 from __future__ import annotations
@@ -300,6 +303,7 @@ def bench(cfg: Config, tmp: Path) -> dict[str, Any]:
     }
     if not cfg.quick:   # the smoke run's key set stays as it was (see the module docstring)
         res["campaign"] = campaign_section(cfg, tmp)
+        res["dr_dask"] = dr_dask_section(cfg, tmp)
     res["monitor"] = monitor_section(cfg, tmp, base, have_cli and cli_has("monitor"))
     res["plan_scaling"] = plan_scaling_section(cfg, tmp) if have_cli else no_cli
     res["certify_stream"] = certify_stream_section(cfg, tmp) if have_cli else no_cli
@@ -417,9 +421,11 @@ def first_run_lines(sec: dict[str, Any]) -> list[str]:
                 + "; ".join(sec.get("compile_lines", []))]
 
 
-#: `cfmpa certify` of a long slow trajectory: rows, and the targets.
-CERTIFY_STREAM = {"rows": (100_000, 1_000_000), "quick_rows": (2_000, 20_000), "dt": 0.01,
-                  "target_s": 20.0, "target_mib": 300.0}
+#: `cfmpa certify` of a long slow trajectory, by default (no limit raised): rows, and the
+#: targets by rows (seconds, peak MiB of the child process).
+CERTIFY_STREAM = {"rows": (100_000, 1_000_000, 10_000_000), "quick_rows": (2_000, 20_000),
+                  "dt": 0.01, "target_s": 20.0, "target_mib": 300.0,
+                  "targets": {1_000_000: (20.0, 300.0), 10_000_000: (200.0, 300.0)}}
 
 
 def slow_trajectory_csv(path: Path, rows: int, dt: float) -> int:
@@ -442,9 +448,10 @@ def slow_trajectory_csv(path: Path, rows: int, dt: float) -> int:
 
 def certify_stream_section(cfg: Config, tmp: Path) -> dict[str, Any]:
     """`cfmpa certify` of ``slow_trajectory_csv`` at each row count, one run each in a fresh
-    process (CFMPA_MAX_TRAJECTORY_BYTES raised to the file's size): seconds, the child's peak
-    resident memory (ru_maxrss), bytes a row of that peak, and the command's own split into
-    reading and certifying (timings_s); ``peak_growth_mib``: the largest minus the smallest."""
+    process with the default limits (a streamed trajectory has no byte limit, docs/model.md
+    §12): seconds, the child's peak resident memory (ru_maxrss), bytes a row of that peak, and
+    the command's own split into reading and certifying (timings_s); ``peak_growth_mib``: the
+    largest minus the smallest."""
     rows_list = CERTIFY_STREAM["quick_rows"] if cfg.quick else CERTIFY_STREAM["rows"]
     out: dict[str, Any] = {"runs": [], "target_s": CERTIFY_STREAM["target_s"],
                            "target_mib": CERTIFY_STREAM["target_mib"],
@@ -455,8 +462,7 @@ def certify_stream_section(cfg: Config, tmp: Path) -> dict[str, Any]:
         size = slow_trajectory_csv(traj, rows, CERTIFY_STREAM["dt"])
         report = tmp / f"certify-{rows}.json"
         run = cli_run(cfg, ["certify", "default", "--traj", str(traj), "--json", str(report)],
-                      runs=1, warmup=0,
-                      env={"CFMPA_MAX_TRAJECTORY_BYTES": str(max(size, 32 * 2**20))})
+                      runs=1, warmup=0)
         entry: dict[str, Any] = {"rows": rows, "bytes": size}
         if "median_s" in run:
             doc = json.loads(report.read_text())
@@ -488,7 +494,8 @@ def certify_stream_lines(sec: dict[str, Any]) -> list[str]:
             lines.append(f"{r['rows']:9d} {r.get('error')}")
     if "peak_growth_mib" in sec:
         lines.append(f"peak growth over the rows: {sec['peak_growth_mib']} MiB (targets: "
-                     f"10^6 rows in {sec['target_s']:g} s and {sec['target_mib']:g} MiB)")
+                     + ", ".join(f"{n:,} rows in {lim[0]:g} s and {lim[1]:g} MiB" for n, lim in
+                                 CERTIFY_STREAM["targets"].items()) + ")")
     return lines
 
 
@@ -666,6 +673,123 @@ def monitor_section(cfg: Config, tmp: Path, base: dict[str, Any], have_cli: bool
     if "peak_rss_mb" in out["log"] and "peak_rss_mb" in out["log_tenth"]:
         out["peak_growth_mb"] = round(out["log"]["peak_rss_mb"] - out["log_tenth"]["peak_rss_mb"], 1)
     return out
+
+
+#: D_R on Dask (docs/model.md §9): `cfmpa dr --workers K` of the default workcell at
+#: ``workers_dt`` in this process and on 1 and 2 local workers, and `cfmpa plan --contracts full
+#: --store zarr` at ``store_dt`` (about 344 x 1796 x 1796 = 1.11 G cells); --quick: coarse grids.
+DR_DASK = {"workers_dt": 0.005, "workers": (0, 1, 2), "store_dt": 0.0035,
+           "quick_dts": (0.04, 0.04)}
+
+
+def dr_dask_section(cfg: Config, tmp: Path) -> dict[str, Any]:
+    """`cfmpa dr --variant modified --store zarr` of the default workcell at
+    DR_DASK["workers_dt"] in a fresh process per run with --workers 0 (the one-process build)
+    and K local workers, and `cfmpa plan --contracts full --store zarr` at DR_DASK["store_dt"]
+    (one run): seconds, the peak resident memory of the largest process waited for (ru_maxrss:
+    the client, or a worker the client's cluster waited for), bytes a cell; every dr.zarr the
+    same (dr_sha256 of each store, read back). Speed-up = 1 worker's median / 2 workers'."""
+    if not cli_has("dr"):
+        return skipped("no `cfmpa dr` in this checkout")
+    from cfmpa.runs._drstore import open_zarr
+
+    workers_dt, store_dt = DR_DASK["quick_dts"] if cfg.quick else (DR_DASK["workers_dt"],
+                                                                     DR_DASK["store_dt"])
+    runs = 1 if cfg.quick else min(cfg.runs, 3)
+    toml = scenario_file(default_at(workers_dt), tmp)
+    out: dict[str, Any] = {"workers_dt": workers_dt, "store_dt": store_dt}
+    shas = set()
+    for k in DR_DASK["workers"]:
+        folder = tmp / f"dr-dask-{k}"
+        r = cli_run(cfg, ["dr", str(toml), "--variant", "modified", "--out", str(folder),
+                          "--store", "zarr", *(["--workers", str(k)] if k else [])],
+                    runs=runs, warmup=0)
+        if "median_s" in r:
+            z = open_zarr(folder / "dr.zarr")
+            r["cells"] = math.prod(z.shape)
+            shas.add(z.sha256())
+        out[f"workers_{k}"] = r
+    one, two = out.get("workers_1", {}), out.get("workers_2", {})
+    out["speedup_2_over_1"] = (one["median_s"] / two["median_s"]
+                               if "median_s" in one and "median_s" in two else None)
+    out["same_store"] = len(shas) == 1
+    toml = scenario_file(default_at(store_dt), tmp)
+    folder = tmp / "dr-dask-store"
+    run = cli_run(cfg, ["plan", str(toml), "--variant", "modified", "--out", str(folder),
+                        "--contracts", "full", "--store", "zarr"], runs=1, warmup=0)
+    doc = plan_json_of(folder)
+    g = doc.get("grid") or {}
+    cells = (g["N"] + 1) * g["m"] * g["n"] if g else None
+    store: dict[str, Any] = {"dt": store_dt, "cells": cells,
+                             "grid": [g["N"] + 1, g["m"], g["n"]] if g else None}
+    if "median_s" in run and cells:
+        store |= {"seconds": round(run["median_s"], 3), "peak_mib": run["peak_rss_mb"],
+                  "bytes_per_cell": round(run["peak_rss_mb"] * 2**20 / cells, 2),
+                  "status": doc.get("status"), "timings_s": doc.get("timings_s")}
+    else:
+        store["error"] = run.get("error") or "no plan.json"
+    out["plan_store"] = store
+    out["note"] = ("fresh processes on this machine's shared CPUs; workers_0 is the one-process "
+                   "build, workers_K a local Dask cluster of K processes (cluster start and the "
+                   "workers' kernel load included); peak_rss_mb is ru_maxrss, the largest single "
+                   "process waited for, not the sum over the workers")
+    return out
+
+
+def dr_dask_lines(sec: dict[str, Any]) -> list[str]:
+    """The D_R-on-Dask item's lines of the table."""
+    if "skipped" in sec or "error" in sec:
+        return [f"dr on dask: {sec.get('skipped') or sec.get('error')}"]
+    lines = []
+    for k in DR_DASK["workers"]:
+        d = sec.get(f"workers_{k}", {})
+        lines.append(f"cfmpa dr dt={sec['workers_dt']}, --workers {k}: "
+                     + (f"{d['median_s']:.1f} s ({d['runs']} run(s)), peak "
+                        f"{d['peak_rss_mb']:.0f} MiB" if "median_s" in d else failed(d)))
+    sp = sec.get("speedup_2_over_1")
+    lines.append("dr speed-up, 2 workers over 1: "
+                 + (f"{sp:.2f}x" if sp is not None else "n/a")
+                 + f"; the same dr.zarr: {sec.get('same_store')}")
+    st = sec.get("plan_store", {})
+    lines.append(f"cfmpa plan --contracts full --store zarr dt={st.get('dt')}: "
+                 + (f"{st.get('cells', 0) / 1e9:.2f} G cells, {st['seconds']:.1f} s, "
+                    f"{st['peak_mib']:.0f} MiB, {st['bytes_per_cell']} bytes a cell"
+                    if "seconds" in st else str(st.get("error"))))
+    return lines
+
+
+def dr_dask_targets(res: dict[str, Any]) -> list[dict[str, Any]]:
+    """D_R on Dask and the store at scale: 2 local workers faster than 1 at dt = 0.005; the
+    1.11 G-cell workcell planned with full contracts in 300 s and 4 GiB; dt = 0.005 in 2 GiB
+    (plan_scaling's row)."""
+    sec = res.get("dr_dask") or {}
+    why = str(sec.get("skipped") or sec.get("error") or "")
+    sp = sec.get("speedup_2_over_1")
+    one, two = sec.get("workers_1", {}), sec.get("workers_2", {})
+    rows = [row("D_R on Dask: cfmpa dr dt=0.005, 1 worker / 2 workers (x)", sp, 1.0, False,
+                note=why or ("not measured: " + (failed(one) or failed(two))
+                             if sp is None else
+                             f"fresh processes, local clusters: 1 worker {one['median_s']:.1f} "
+                             f"s, 2 workers {two['median_s']:.1f} s (medians); one process "
+                             f"{med(sec.get('workers_0')) or float('nan'):.1f} s; the same "
+                             f"dr.zarr: {sec.get('same_store')}"))]
+    st = sec.get("plan_store", {})
+    what = (f"`cfmpa plan --contracts full --store zarr` of the default workcell at dt = "
+            f"{st.get('dt')} ({st.get('cells') or 0:,} cells), one run, fresh process")
+    note = why or (str(st.get("error")) if "error" in st else what)
+    rows.append(row("store: plan dt=0.0035 (1.11 G cells), full contracts (s)",
+                    st.get("seconds"), 300.0, note=note))
+    rows.append(row("store: plan dt=0.0035 (1.11 G cells), full contracts (peak MiB)",
+                    st.get("peak_mib"), 4 * GIB, note=note))
+    ps = res.get("plan_scaling") or {}
+    r5 = next((r for r in ps.get("rows", []) if r.get("dt") == 0.005), {})
+    rows.append(row("store: plan dt=0.005 (381 M cells), full contracts (peak MiB)",
+                    r5.get("peak_mib"), 2 * GIB,
+                    note=(str(r5.get("error") or "not measured: no plan_scaling row at dt = "
+                                                 "0.005") if "peak_mib" not in r5 else
+                          "plan_scaling's row (`cfmpa plan --contracts full`, default store "
+                          "zarr above 100 M cells), one run, fresh process")))
+    return rows
 
 
 #: The fixed campaign timed with 1 and 2 workers: `cfmpa compare --n 40 --dt 0.1 --seed 0`.
@@ -990,12 +1114,40 @@ def targets(res: dict[str, Any], cfg: Config) -> list[dict[str, Any]]:
                           "the same run's results.json `seconds`: the obligations' discharge as "
                           "the prove summary times it, without the interpreter's start and "
                           "imports or the audit report")))
+
+    # certify: a long trajectory streamed, by default
+    rows += certify_stream_targets(res.get("certify_stream") or {})
+    rows += dr_dask_targets(res)
     if cfg.quick:
         for r in rows:
             r["note"] = ("quick run (the full bench's command, the same measurement); "
                          if r["target"].startswith(PROVE_ROWS) else
                          "quick run on a coarse grid: not the target's measurement; ") + r["note"]
     return rows
+
+
+def certify_stream_targets(sec: dict[str, Any]) -> list[dict[str, Any]]:
+    """The streamed certify's targets (CERTIFY_STREAM["targets"]): seconds and peak MiB of
+    `cfmpa certify` of the slow trajectory at each of their row counts, default limits; unmet
+    (None) when that run is missing or failed."""
+    out = []
+    by_rows = {r["rows"]: r for r in sec.get("runs", [])}
+    for n, (limit_s, limit_mib) in CERTIFY_STREAM["targets"].items():
+        r = by_rows.get(n, {})
+        why = (r.get("error") and f"FAILED: {str(r['error'])[:160]}") or (
+            "" if r else "not measured: " + str(sec.get("skipped") or sec.get("error")
+                                                or f"no run of {n:,} rows"))
+        note = why or (f"`cfmpa certify default --traj` of a {n:,}-row CSV "
+                       f"({r['bytes'] / 2**20:.0f} MiB, bench/run.py slow_trajectory_csv), "
+                       f"default limits, one run in a fresh process: read "
+                       f"{r['timings_s'].get('load', 0):.1f} s, certify "
+                       f"{r['timings_s'].get('certificate', 0):.1f} s; clear {r['clear']}")
+        out.append(row(f"certify: {n:,}-row trajectory streamed, default limits (s)",
+                       r.get("seconds"), limit_s, note=note))
+        out.append(row(f"certify: {n:,}-row trajectory streamed, default limits (peak MiB)",
+                       r.get("peak_mib"), limit_mib,
+                       note=why or "peak resident memory of the child (ru_maxrss)"))
+    return out
 
 
 #: The rows of `make prove`, whose command does not depend on the bench's grid.
@@ -1118,6 +1270,8 @@ def table(res: dict[str, Any]) -> str:
         lines += certify_stream_lines(res["certify_stream"])
     if "rows" in (res.get("tools") or {}):
         lines += tools_lines(res["tools"])
+    if "plan_store" in (res.get("dr_dask") or {}):
+        lines += dr_dask_lines(res["dr_dask"])
     if isinstance(res.get("first_run"), dict) and "skipped" not in res["first_run"]:
         lines += first_run_lines(res["first_run"])
     lines += profile_lines(res.get("builtdr_profile"))
@@ -1201,7 +1355,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="folder for results.json (default: bench/)")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per item (default 5)")
     ap.add_argument("--only", choices=["campaign", "plan_scaling", "certify_stream", "tools",
-                                        "first_run", "builtdr"],
+                                        "first_run", "builtdr", "dr_dask"],
                     default=None,
                     help="run only this item and merge it into OUT/results.json (the targets "
                          "are recomputed; meta.merged says what came from which run)")
@@ -1225,7 +1379,8 @@ def main(argv: list[str] | None = None) -> int:
                           "certify_stream": (certify_stream_section,
                                              certify_stream_lines),
                           "tools": (tools_section, tools_lines),
-                          "first_run": (first_run_section, first_run_lines)}[args.only]
+                          "first_run": (first_run_section, first_run_lines),
+                          "dr_dask": (dr_dask_section, dr_dask_lines)}[args.only]
         out = Path(args.out) / "results.json"
         res = json.loads(out.read_text()) if out.exists() else {}
         with tempfile.TemporaryDirectory(prefix="cfmpa-bench-") as tmp:

@@ -18,12 +18,46 @@ from typing import Any
 
 from .errors import InputError
 
-__all__ = ["FILE", "FOLDER", "Budget", "budgets", "check_log_output", "check_output", "checked",
-           "cpus",
-           "bag_arguments", "engine_arguments", "json_argument", "kernel_argument", "number", "out_argument",
-           "output", "positive", "run_checks", "scenario_argument", "store_argument",
-           "trajectory_arguments",
-           "variant_argument"]
+__all__ = ["FILE", "FOLDER", "Budget", "Formatter", "alias", "bag_arguments", "budgets",
+           "check_log_output", "check_output", "checked", "cpus", "engine_arguments", "json_argument",
+           "kernel_argument", "number", "out_argument", "output", "positive", "run_checks",
+           "scenario_argument", "store_argument", "trajectory_arguments", "variant_argument",
+           "visible_options"]
+
+
+#: The attribute of an argparse action that holds its old spellings: accepted, hidden from the
+#: help, listed in docs/model.md §7 ("old spellings").
+ALIASES = "cfmpa_aliases"
+
+
+def alias(action: argparse.Action, *old: str) -> argparse.Action:
+    """Mark ``old`` (option strings of ``action``, after its own name) as old spellings: they
+    still work, and the help shows the option's name only (``Formatter``)."""
+    assert set(old) <= set(action.option_strings[1:]), (old, action.option_strings)
+    setattr(action, ALIASES, frozenset(old))
+    return action
+
+
+def visible_options(action: argparse.Action) -> list[str]:
+    """The option strings the help shows: none for a hidden option, else all but its old
+    spellings."""
+    if action.help == argparse.SUPPRESS:
+        return []
+    hidden: frozenset[str] = getattr(action, ALIASES, frozenset())
+    return [o for o in action.option_strings if o not in hidden]
+
+
+class Formatter(argparse.RawDescriptionHelpFormatter):
+    """The help of every command: descriptions as written, and an option's old spellings
+    (``alias``) left out."""
+
+    def _format_action_invocation(self, action: argparse.Action) -> str:
+        if getattr(action, ALIASES, None) and action.option_strings:
+            import copy
+
+            action = copy.copy(action)
+            action.option_strings = visible_options(action)
+        return super()._format_action_invocation(action)
 
 
 def variant(value: str) -> str:
@@ -101,7 +135,8 @@ def out_argument(p: argparse.ArgumentParser, help: str, *, required: bool = True
 
 
 def json_argument(p: argparse.ArgumentParser, help: str = "write the result as JSON") -> None:
-    """--json OUT, a file a command writes its result to; checked before any work."""
+    """--json OUT, a file a command writes its result to; checked before any work (``help``
+    argparse.SUPPRESS: a hidden option of an old spelling)."""
     p.add_argument("--json", default=None, metavar="OUT", help=help)
     output(p, "json", "--json", FILE)
 
@@ -172,10 +207,12 @@ def budgets() -> dict[str, Budget]:
 
 
 def number(p: argparse.ArgumentParser, option: str, budget: Budget, *, type: Callable[[str], Any],
-           **kw: Any) -> None:
+           aliases: tuple[str, ...] = (), **kw: Any) -> None:
     """A numeric option: parsed by ``type``, its value checked against ``budget`` before the
-    command runs."""
-    action = p.add_argument(option, type=type, **kw)
+    command runs; ``aliases``: its old spellings (``alias``)."""
+    action = p.add_argument(option, *aliases, type=type, **kw)
+    if aliases:
+        alias(action, *aliases)
     checked(p, action.dest, option, budget)
 
 
@@ -227,25 +264,35 @@ def check_log_output(option: str, value: Any) -> None:
     or a file."""
     from .runs import log_output_kind
 
-    kind = log_output_kind(str(value))
+    try:
+        kind = log_output_kind(str(value))
+    except InputError as exc:          # runs._rosbag names the option by its old spelling
+        raise InputError(option, exc.value, exc.message, source=exc.source,
+                         line=exc.line) from None
     check_output(option, value, FOLDER if kind == "folder" else FILE)
 
 
-def engine_arguments(p: argparse.ArgumentParser) -> None:
-    """--workers, --scheduler, --connect-timeout, --worker-timeout (cfmpa compare, cfmpa check
-    --batch)."""
+def engine_arguments(p: argparse.ArgumentParser, *,
+                     default: str = "one per CPU; 0: run in this process, no cluster",
+                     hidden: bool = False) -> None:
+    """--workers, --scheduler, --connect-timeout, --worker-timeout (cfmpa compare, cfmpa
+    check-batch; cfmpa dr and plan, whose ``default`` is the build in this process). --workers
+    is always Dask workers (prove's processes are its --jobs). ``hidden``: options of an old
+    spelling (cfmpa check --batch), accepted and left out of the help."""
     b = budgets()
+
+    def text(t: str) -> str:
+        return argparse.SUPPRESS if hidden else t
     number(p, "--workers", b["workers"], type=positive, default=None, metavar="K",
-           help="worker processes of a local Dask cluster (default: one per CPU; 0: run in "
-                "this process, no cluster)")
+           help=text(f"worker processes of a local Dask cluster (default: {default})"))
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run on a running Dask cluster instead (tcp://HOST:PORT of `dask "
-                        "scheduler`; its workers need cfmpa installed)")
+                   help=text("run on a running Dask cluster instead (tcp://HOST:PORT of `dask "
+                             "scheduler`; its workers need cfmpa installed)"))
     number(p, "--connect-timeout", b["connect_timeout"], type=float, default=10.0, metavar="S",
-           help="seconds to wait for the scheduler and its first worker (default 10)")
+           help=text("seconds to wait for the scheduler and its first worker (default 10)"))
     number(p, "--worker-timeout", b["worker_timeout"], type=float, default=60.0, metavar="S",
-           help="seconds a run waits while the cluster has no worker, then stops with exit 2 "
-                "and the command that resumes (default 60)")
+           help=text("seconds a run waits while the cluster has no worker, then stops with "
+                     "exit 2 and the command that resumes (default 60)"))
 
 
 def trajectory_arguments(p: argparse.ArgumentParser, traj: str = "the planned trajectory",

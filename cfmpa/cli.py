@@ -64,7 +64,7 @@ def cmd_dr(args: argparse.Namespace) -> int:
     from .runs import run_dr
 
     return run_dr(resolve(args.scenario), args.variant, args.out, kernel=args.kernel,
-                  name=args.scenario, store=args.store)
+                  name=args.scenario, store=args.store, engine=_build_engine(args))
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -75,52 +75,71 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
     return run_plan(resolve(args.scenario), args.variant, args.out, contracts=args.contracts,
                     seed=args.seed, sample=args.sample, kernel=args.kernel,
-                    witness=args.witness, name=args.scenario, store=args.store)
+                    witness=args.witness, name=args.scenario, store=args.store,
+                    engine=_build_engine(args))
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """Check another planner's dr.npy and plan.json against the spec; with --batch DIR, every
-    plan folder under DIR, one task each (0 all pass, 1 any fails, 2 bad input)."""
+    """Check another planner's dr.npy and plan.json against the spec (0 all hold, 1 a check
+    fails, 2 bad input). The old spelling ``check --batch DIR`` is cmd_check_batch."""
     if args.batch is not None:
-        from .runs import run_batch
-
         for flag, value in (("--dr", args.dr), ("--plan", args.plan),
                             ("--witness", args.witness)):
             if value is not None:
                 raise InputError(flag, value, "cannot be combined with --batch (each plan "
                                  "folder's own dr.npy and plan.json are checked)")
-        if args.json is None:          # the summary goes into DIR: it must be writable first
-            opt.check_output("--batch", args.batch, opt.FOLDER)
-        workers, scheduler = _engine(args)
-        return run_batch(args.batch, None if args.scenario is None else resolve(args.scenario),
-                         json_out=args.json, workers=workers, scheduler=scheduler,
-                         connect_timeout=args.connect_timeout,
-                         worker_timeout=args.worker_timeout)
+        return _check_batch(args, args.batch, "--batch")
     from .runs import run_check
 
     for flag, value in (("SCENARIO", args.scenario), ("--dr", args.dr), ("--plan", args.plan)):
         if value is None:
             raise InputError(flag, MISSING, "is required (or check a folder of plans with "
-                             "--batch DIR [SCENARIO])")
+                             "cfmpa check-batch DIR [SCENARIO])")
     for flag in ("--json", "--workers", "--scheduler"):
         if getattr(args, flag[2:]) is not None:
-            raise InputError(flag, getattr(args, flag[2:]), "is an option of --batch")
+            raise InputError(flag, getattr(args, flag[2:]), "is an option of cfmpa check-batch")
     return run_check(resolve(args.scenario), args.dr, args.plan, args.witness)
 
 
-def cmd_selftest(args: argparse.Namespace) -> int:
-    """Seed faults and show which contract check catches each; with --code, seeded mutations
-    of a copy of the source, and which of prove, the contracts and the tests catch each."""
-    if not args.code:
-        for flag in ("mutant", "checks", "json", "prove_only"):
-            value = getattr(args, flag)
-            if value:
-                raise InputError("--" + flag.replace("_", "-"),
-                                 value[0] if isinstance(value, list) else value,
-                                 "is an option of --code")
-        from .runs import run_selftest
+def cmd_check_batch(args: argparse.Namespace) -> int:
+    """Check every plan folder under DIR, one task each (0 all pass, 1 any fails, 2 bad
+    input)."""
+    return _check_batch(args, args.folder, "DIR")
 
-        return run_selftest()
+
+def _check_batch(args: argparse.Namespace, folder: str, label: str) -> int:
+    """run_batch of ``folder`` (named ``label`` in a message: DIR, or the old --batch)."""
+    from .runs import run_batch
+
+    if args.json is None:          # the summary goes into DIR: it must be writable first
+        opt.check_output(label, folder, opt.FOLDER)
+    workers, scheduler = _engine(args)
+    return run_batch(folder, None if args.scenario is None else resolve(args.scenario),
+                     json_out=args.json, workers=workers, scheduler=scheduler,
+                     connect_timeout=args.connect_timeout, worker_timeout=args.worker_timeout,
+                     folder_option=label)
+
+
+def cmd_selftest(args: argparse.Namespace) -> int:
+    """Seed faults and show which contract check catches each. The old spelling ``selftest
+    --code`` is cmd_mutants."""
+    if args.code:
+        return cmd_mutants(args)
+    for flag in ("mutant", "checks", "json", "prove_only"):
+        value = getattr(args, flag)
+        if value:
+            raise InputError("--" + flag.replace("_", "-"),
+                             value[0] if isinstance(value, list) else value,
+                             "is an option of cfmpa mutants (or its old spelling selftest "
+                             "--code)")
+    from .runs import run_selftest
+
+    return run_selftest()
+
+
+def cmd_mutants(args: argparse.Namespace) -> int:
+    """Seeded mutations of a copy of the source, and which of prove, the contracts and the
+    tests catch each."""
     from .runs import CODE_CHECKS, run_code_selftest
 
     checks = tuple(c.strip() for c in args.checks.split(",")) if args.checks else CODE_CHECKS
@@ -129,7 +148,8 @@ def cmd_selftest(args: argparse.Namespace) -> int:
 
 
 def cmd_prove(args: argparse.Namespace) -> int:
-    """Discharge every obligation; with --audit, also write the audit report (side by side)."""
+    """Discharge every obligation (--jobs processes, old spelling --workers); with --audit,
+    also write the audit report (side by side)."""
     if args.audit is None:
         from .proofs import run_prove
 
@@ -222,6 +242,16 @@ def _engine(args: argparse.Namespace) -> tuple[int, str | None]:
     return opt.cpus(), None
 
 
+def _build_engine(args: argparse.Namespace) -> Any:
+    """runs.EngineOptions of dr's and plan's --workers, --scheduler and time-outs: D_R built in
+    this process unless --workers K >= 1 or --scheduler is given (both at once refused)."""
+    from .runs import EngineOptions
+
+    workers, scheduler = (0, None) if args.workers is None and args.scheduler is None \
+        else _engine(args)
+    return EngineOptions(workers, scheduler, args.connect_timeout, args.worker_timeout)
+
+
 # --- the parser --------------------------------------------------------------------------------
 
 
@@ -256,7 +286,7 @@ def _command(sub: Any, name: str, summary: str, example: str,
     atop its own help), ``example`` a command line shown under its options."""
     p: argparse.ArgumentParser = sub.add_parser(
         name, help=summary, description=summary[0].upper() + summary[1:] + ".",
-        epilog=f"example:\n  {example}", formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=f"example:\n  {example}", formatter_class=opt.Formatter)
     p.set_defaults(func=func)
     return p
 
@@ -266,8 +296,7 @@ def _parser() -> argparse.ArgumentParser:
     import textwrap
 
     p = argparse.ArgumentParser(prog="cfmpa", description=textwrap.fill(ABOUT, 79),
-                                epilog=FIRST_STEPS,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+                                epilog=FIRST_STEPS, formatter_class=opt.Formatter)
     p.add_argument("--version", action="version", version=f"cfmpa {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     b = opt.budgets()
@@ -279,6 +308,8 @@ def _parser() -> argparse.ArgumentParser:
     opt.out_argument(d, "output folder (dr.npy or dr.zarr is written there)")
     opt.kernel_argument(d)
     opt.store_argument(d)
+    opt.engine_arguments(d, default="0, the build in this process; K >= 1 or --scheduler: "
+                                    "blocks of layers as Dask tasks into dr.zarr")
 
     pl = _command(sub, "plan", "plan the subordinate's path; write dr.npy, plan.json and "
                                "traj.csv",
@@ -294,42 +325,50 @@ def _parser() -> argparse.ArgumentParser:
                help="cells checked by sampled contracts (default: the mode's own)")
     opt.kernel_argument(pl)
     opt.store_argument(pl)
-    pl.add_argument("--witness", default=None, metavar="FILE",
-                    help="also write the search's witness of its answer (npz, docs/model.md "
-                         "§11); plan.json gets its witness_sha256")
-    opt.output(pl, "witness", "--witness", opt.FILE)
+    opt.engine_arguments(pl, default="0, the build in this process; K >= 1 or --scheduler: "
+                                     "blocks of layers as Dask tasks into dr.zarr")
+    opt.alias(pl.add_argument("--witness-out", "--witness", dest="witness", default=None,
+                              metavar="FILE",
+                              help="also write the search's witness of its answer to FILE "
+                                   "(npz, docs/model.md §11); plan.json gets its "
+                                   "witness_sha256"), "--witness")
+    opt.output(pl, "witness", "--witness-out", opt.FILE)
 
-    c = _command(sub, "check", "check another planner's dr.npy and plan.json (or a folder of "
-                               "plan folders with --batch)",
+    c = _command(sub, "check", "check another planner's dr.npy and plan.json",
                  "cfmpa check default --dr plan/dr.npy --plan plan/plan.json", cmd_check)
     c.add_argument("scenario", nargs="?", default=None,
-                   help="scenario the outputs are for: a bundled name or a TOML file (with "
-                        "--batch: optional, else each plan's bundled scenario by its name)")
+                   help="scenario the outputs are for: a bundled name or a TOML file")
     c.add_argument("--dr", default=None, help="dr.npy or dr.zarr (uint8, shape (N + 1, m, n))")
     c.add_argument("--plan", default=None, help="plan.json (docs/model.md §9)")
     c.add_argument("--witness", default=None, metavar="FILE",
-                   help="a witness file (cfmpa plan --witness) to verify for optimality; "
+                   help="a witness file (cfmpa plan --witness-out) to verify for optimality; "
                         "without it the fast search computes one")
-    c.add_argument("--batch", default=None, metavar="DIR",
-                   help="check every folder under DIR holding plan.json and dr.npy (or "
-                        "dr.zarr), one task "
-                        "per plan; summary in DIR/check-batch.json")
-    opt.json_argument(c, "with --batch: write the summary here instead")
-    opt.engine_arguments(c)
+    # The old spelling of cfmpa check-batch (docs/model.md §7.3): accepted, not in the help.
+    c.add_argument("--batch", default=None, metavar="DIR", help=argparse.SUPPRESS)
+    opt.json_argument(c, argparse.SUPPRESS)
+    opt.engine_arguments(c, hidden=True)
+
+    cb = _command(sub, "check-batch", "check every plan folder under DIR, one task per plan",
+                  "cfmpa check-batch plans --workers 2", cmd_check_batch)
+    cb.add_argument("folder", metavar="DIR",
+                    help="a folder of plan folders: each folder under it holding plan.json and "
+                         "dr.npy (or dr.zarr) is checked; summary in DIR/check-batch.json")
+    cb.add_argument("scenario", nargs="?", default=None,
+                    help="the scenario of every plan (default: each plan's bundled scenario by "
+                         "its name)")
+    opt.json_argument(cb, "write the summary here instead of DIR/check-batch.json")
+    opt.engine_arguments(cb)
 
     st = _command(sub, "selftest", "seed faults; show which check catches each",
                   "cfmpa selftest", cmd_selftest)
-    st.add_argument("--code", action="store_true",
-                    help="mutate a copy of the source instead (minutes): which of cfmpa prove, "
-                         "the contracts and the tests catch each mutant; exit 1 unless prove "
-                         "catches every one")
-    st.add_argument("--mutant", action="append", metavar="NAME",
-                    help="with --code: only this mutant (repeatable)")
-    st.add_argument("--checks", metavar="LIST",
-                    help="with --code: comma-separated, of prove,contracts,tests (default all)")
-    st.add_argument("--prove-only", action="append", metavar="ID",
-                    help="with --code: cfmpa prove on these obligations only (as its --only)")
-    opt.json_argument(st, "with --code: the table as JSON")
+    # The old spelling of cfmpa mutants (docs/model.md §7.3): accepted, not in the help.
+    st.add_argument("--code", action="store_true", help=argparse.SUPPRESS)
+    _mutant_arguments(st, hidden=True)
+
+    mu = _command(sub, "mutants", "mutate a copy of the source (minutes); show which of "
+                                  "prove, the contracts and the tests catch each",
+                  "cfmpa mutants --mutant margin_halved --checks prove", cmd_mutants)
+    _mutant_arguments(mu)
 
     pr = _command(sub, "prove", "discharge every obligation (make prove)",
                   "cfmpa prove --only Prop8 --out build/proofs", cmd_prove)
@@ -346,7 +385,8 @@ def _parser() -> argparse.ArgumentParser:
     pr.add_argument("--repin", action="store_true",
                     help="rewrite proofs/obligations.lock with the statements run and print "
                          "what changed (review the diff), instead of failing on a change")
-    opt.number(pr, "--workers", b["prove_workers"], type=int, default=None, metavar="K",
+    opt.number(pr, "--jobs", b["prove_workers"], type=int, default=None, metavar="K",
+               aliases=("--workers",), dest="workers",
                help="processes discharging obligations side by side (default 2 on a machine with "
                  "two cores or more, else 1); the results do not depend on K")
 
@@ -407,14 +447,15 @@ def _parser() -> argparse.ArgumentParser:
                          "the time of the missing ones unobserved (default: exit 2)")
 
     si = _command(sub, "simulate", "write a simulated measured log of a trajectory",
-                  "cfmpa simulate default --traj plan/traj.csv --out log.csv --noise 0.001",
+                  "cfmpa simulate default --traj plan/traj.csv --log-out log.csv --noise 0.001",
                   cmd_simulate)
     opt.trajectory_arguments(si)
-    si.add_argument("--out", required=True, metavar="LOG",
-                    help="the log to write: a ROS 2 bag for a name ending in .mcap or .db3 (that "
-                         "storage file) or for a folder (a new one ending in /, or a bag "
-                         "folder, replaced: metadata.yaml and an mcap file), else CSV")
-    opt.checked(si, "out", "--out", opt.check_log_output)
+    opt.alias(si.add_argument("--log-out", "--out", dest="out", required=True, metavar="LOG",
+                              help="the log to write: a ROS 2 bag for a name ending in .mcap "
+                                   "or .db3 (that storage file) or for a folder (a new one "
+                                   "ending in /, or a bag folder, replaced: metadata.yaml and "
+                                   "an mcap file), else CSV"), "--out")
+    opt.checked(si, "out", "--log-out", opt.check_log_output)
     opt.number(si, "--lag", b["lag"], type=float, default=0.0,
                help="tracking lag in s (default 0)")
     opt.number(si, "--noise", b["noise"], type=float, default=0.0,
@@ -430,6 +471,20 @@ def _parser() -> argparse.ArgumentParser:
                help="keep sampling this many s after the trajectory ends (default 0)")
     opt.bag_arguments(si, read=False)
     return p
+
+
+def _mutant_arguments(p: argparse.ArgumentParser, *, hidden: bool = False) -> None:
+    """cfmpa mutants' options (``hidden``: those of its old spelling, selftest --code)."""
+    def text(t: str) -> str:
+        return argparse.SUPPRESS if hidden else t
+    p.add_argument("--mutant", action="append", metavar="NAME",
+                   help=text("only this mutant (repeatable; default every one)"))
+    p.add_argument("--checks", metavar="LIST",
+                   help=text("comma-separated, of prove,contracts,tests (default all); exit 1 "
+                             "unless prove catches every mutant"))
+    p.add_argument("--prove-only", action="append", metavar="ID",
+                   help=text("cfmpa prove on these obligations only (as its --only)"))
+    opt.json_argument(p, text("the table as JSON"))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -1,70 +1,38 @@
-"""The reference planner: kinematics, swept regions, BuiltDR, searchoptpath (clear first)."""
+"""The reference planner: kinematics, swept regions, BuiltDR, searchoptpath (clear first).
+
+The public names are listed once, below (``cfmpa.lazy``): each is imported on first use, so a
+command loads only the modules it needs (docs/model.md §1.1).
+"""
 
 from typing import TYPE_CHECKING
 
-from ..lazy import lazy_exports
+from ..lazy import lazy_face
 
-if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _EXPORTS
-    from ._builtdr import (ContainmentReport, LeftRegions, RightRegions, build_dr, check_containment,
-                           contained_exactly, containment_slack, left_regions, left_spacing,
-                           right_regions)
-    from ._builtdr_loops import build_dr_loops, builtdr_loop_nest
-    from ._fast_builtdr import build_dr_fast
-    from ._fast_search import search_opt_path_fast
-    from ._kernel_cache import ensure_compiled, load_fast_kernels
-    from ._kernels import KERNELS, kernel_name, kernels
-    from ._kinematics import link_reach, link_rectangles
-    from ._progress import Progress, progress_default, progress_silenced
-    from ._search import search_opt_path
-    from ._threads import kernel_threads, set_kernel_threads
-    from ._regions import SNAP, convex_hull, lattice_range, naive_hull, sweep_margin, swept_region
+if TYPE_CHECKING:     # the public names, one list: the type checker's and __all__ (cfmpa.lazy)
+    # swept regions and BuiltDR (docs/model.md §4)
+    from ._kinematics import link_reach as link_reach, link_rectangles as link_rectangles
+    from ._regions import (SNAP as SNAP, convex_hull as convex_hull, lattice_range as lattice_range,
+                           naive_hull as naive_hull, sweep_margin as sweep_margin,
+                           swept_region as swept_region)
+    from ._builtdr import (LeftRegions as LeftRegions, RightRegions as RightRegions,
+                           build_dr as build_dr, check_containment as check_containment,
+                           contained_exactly as contained_exactly,
+                           containment_slack as containment_slack, left_regions as left_regions,
+                           left_spacing as left_spacing, right_regions as right_regions)
+    from ._builtdr_loops import (build_dr_loops as build_dr_loops,
+                                 builtdr_loop_nest as builtdr_loop_nest)
+    # searchoptpath (docs/model.md §5)
+    from ._search import search_opt_path as search_opt_path
+    # the kernels a run picks by name, the fast ones and their compile cache, threads, progress
+    from ._kernels import KERNELS as KERNELS, kernel_name as kernel_name, kernels as kernels
+    from ._fast_regions import (left_regions_fast as left_regions_fast,
+                                right_regions_fast as right_regions_fast)
+    from ._fast_builtdr import (build_dr_fast as build_dr_fast,
+                                build_from_regions as build_from_regions)
+    from ._fast_search import search_opt_path_fast as search_opt_path_fast
+    from ._kernel_cache import (ensure_compiled as ensure_compiled,
+                                load_fast_kernels as load_fast_kernels)
+    from ._threads import kernel_threads as kernel_threads, set_kernel_threads as set_kernel_threads
+    from ._progress import Progress as Progress, progress_silenced as progress_silenced
 
-#: Each public name -> "module:name", imported on first use (PEP 562, cfmpa.lazy): a
-#: command loads only the modules it needs (docs/model.md §1.1).
-_EXPORTS: dict[str, str] = {
-    "ContainmentReport": "._builtdr:ContainmentReport",
-    "LeftRegions": "._builtdr:LeftRegions",
-    "RightRegions": "._builtdr:RightRegions",
-    "build_dr": "._builtdr:build_dr",
-    "check_containment": "._builtdr:check_containment",
-    "contained_exactly": "._builtdr:contained_exactly",
-    "containment_slack": "._builtdr:containment_slack",
-    "left_regions": "._builtdr:left_regions",
-    "left_spacing": "._builtdr:left_spacing",
-    "right_regions": "._builtdr:right_regions",
-    "build_dr_loops": "._builtdr_loops:build_dr_loops",
-    "builtdr_loop_nest": "._builtdr_loops:builtdr_loop_nest",
-    "build_dr_fast": "._fast_builtdr:build_dr_fast",
-    "search_opt_path_fast": "._fast_search:search_opt_path_fast",
-    "ensure_compiled": "._kernel_cache:ensure_compiled",
-    "load_fast_kernels": "._kernel_cache:load_fast_kernels",
-    "KERNELS": "._kernels:KERNELS",
-    "kernel_name": "._kernels:kernel_name",
-    "kernels": "._kernels:kernels",
-    "link_reach": "._kinematics:link_reach",
-    "link_rectangles": "._kinematics:link_rectangles",
-    "Progress": "._progress:Progress",
-    "progress_default": "._progress:progress_default",
-    "progress_silenced": "._progress:progress_silenced",
-    "search_opt_path": "._search:search_opt_path",
-    "kernel_threads": "._threads:kernel_threads",
-    "set_kernel_threads": "._threads:set_kernel_threads",
-    "SNAP": "._regions:SNAP",
-    "convex_hull": "._regions:convex_hull",
-    "lattice_range": "._regions:lattice_range",
-    "naive_hull": "._regions:naive_hull",
-    "sweep_margin": "._regions:sweep_margin",
-    "swept_region": "._regions:swept_region",
-}
-
-__all__ = [
-    "KERNELS", "SNAP", "ContainmentReport", "LeftRegions", "Progress", "RightRegions", "build_dr",
-    "build_dr_fast", "build_dr_loops", "builtdr_loop_nest", "check_containment", "contained_exactly",
-    "containment_slack", "convex_hull", "ensure_compiled", "kernel_name", "kernel_threads",
-    "kernels", "lattice_range", "left_regions", "left_spacing", "link_reach", "link_rectangles",
-    "load_fast_kernels", "naive_hull", "progress_default",
-    "progress_silenced", "right_regions", "search_opt_path", "search_opt_path_fast", "sweep_margin",
-    "set_kernel_threads", "swept_region",
-]
-
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)
+__getattr__, __dir__, __all__ = lazy_face(__name__, __file__)

@@ -1,30 +1,70 @@
-"""Which BuiltDR and searchoptpath a run uses: the fast kernels or the reference, by name."""
+"""Which BuiltDR and searchoptpath a run uses: a registry of kernels by name (the fast kernels
+and the reference), like the report's sections (docs/model.md §1.1).
+
+A ``Kernel`` names its two functions as ``"module:name"`` of this package, imported when the
+kernel is asked for, not with the registry: every command's parser lists ``KERNELS``, and the
+fast ones load numba (a command imports only what it needs: tests/test_startup.py). Adding a
+kernel is one ``Kernel`` in ``REGISTRY``, its module and its test (bit-identical to the
+reference, as tests/impl/test_fast_builtdr.py checks the fast one).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import importlib
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["KERNELS", "kernel_name", "kernels"]
+__all__ = ["KERNELS", "REGISTRY", "Kernel", "kernel_name", "kernels", "registry"]
 
-#: The kernel names a user can pick; "fast" is bit-identical to "reference" (tested).
-KERNELS: tuple[str, ...] = ("fast", "reference")
+
+@dataclass(frozen=True)
+class Kernel:
+    """A (build, search) pair a run can pick by ``name``: ``build`` is BuiltDR, ``search``
+    searchoptpath, each ``"module:name"`` with the module relative to ``cfmpa.impl``."""
+
+    name: str
+    build: str
+    search: str
+
+    def load(self) -> tuple[Callable[..., Any], Callable[..., Any]]:
+        """(build, search), their modules imported now."""
+        return (_function(self.build), _function(self.search))
+
+
+def _function(where: str) -> Callable[..., Any]:
+    module, attr = where.split(":")
+    return getattr(importlib.import_module(module, __package__), attr)
+
+
+def registry(entries: Iterable[Kernel]) -> dict[str, Kernel]:
+    """name -> kernel, in the order given (the first is the default); ValueError for a name
+    given twice."""
+    out: dict[str, Kernel] = {}
+    for k in entries:
+        if k.name in out:
+            raise ValueError(f"kernel {k.name!r} is registered twice")
+        out[k.name] = k
+    return out
+
+
+#: The kernels a user can pick, the default first; "fast" is bit-identical to "reference"
+#: (tested).
+REGISTRY: Mapping[str, Kernel] = registry((
+    Kernel("fast", "._fast_builtdr:build_dr_fast", "._fast_search:search_opt_path_fast"),
+    Kernel("reference", "._builtdr:build_dr", "._search:search_opt_path"),
+))
+
+#: The kernel names, the default first (the command line's --kernel choices).
+KERNELS: tuple[str, ...] = tuple(REGISTRY)
 
 
 def kernels(name: str = "fast") -> tuple[Callable[..., Any], Callable[..., Any]]:
-    """(build, search) of the kernel called ``name``; ValueError for another name. The kernels
-    are imported here, not with KERNELS: every command's parser lists KERNELS, and the fast
-    ones load numba (a command imports only what it needs: tests/test_startup.py)."""
-    from ._builtdr import build_dr
-    from ._fast_builtdr import build_dr_fast
-    from ._fast_search import search_opt_path_fast
-    from ._search import search_opt_path
-
-    if name == "fast":
-        return build_dr_fast, search_opt_path_fast
-    if name == "reference":
-        return build_dr, search_opt_path
-    raise ValueError(f"kernel={name!r} is not one of {', '.join(KERNELS)}")
+    """(build, search) of the kernel called ``name``; ValueError for another name."""
+    kernel = REGISTRY.get(name)
+    if kernel is None:
+        raise ValueError(f"kernel={name!r} is not one of {', '.join(KERNELS)}")
+    return kernel.load()
 
 
 def kernel_name(build: Callable[..., Any], search: Callable[..., Any]) -> str:

@@ -42,11 +42,12 @@ __all__ = [
 def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path | None = None,
               only: Iterable[str] | None = None, stream: TextIO | None = None,
               repin: bool = False, workers: int | None = None) -> int:
-    """Discharge the obligations (all, or those ``only`` selects), print the summary, write
-    ``out_dir/results.json``; 0 iff every verdict is the pinned one and no id is missing, extra
-    or repeated, 1 otherwise. Raises InputError (exit 2) for a ``--scenarios`` that is not a
-    folder, a folder other than the bundled one with no scenario file, or an ``--only``
-    pattern that selects no expected obligation, or ``workers`` below 1 (``--workers``)."""
+    """Discharge the obligations (all, or those ``only`` selects), print the summary (a line per
+    group on stderr as it ends, before), write ``out_dir/results.json``; 0 iff every verdict
+    is the pinned one and no id is missing, extra or repeated, 1 otherwise. Raises InputError
+    (exit 2) for a ``--scenarios`` that is not a folder, a folder other than the bundled one
+    with no scenario file, or an ``--only`` pattern that selects no expected obligation, or
+    ``workers`` below 1 (``--workers``)."""
     picks = None if only is None else list(only)
     if workers is not None and workers < 1:
         raise InputError("--workers", str(workers), "must be at least 1 (1: one process)")
@@ -68,7 +69,7 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
     run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir),
                           record=run_record(sdir), repin=repin,
                           workers=default_workers() if workers is None else workers,
-                          controls=controls)
+                          controls=controls, progress=sys.stderr)
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
 

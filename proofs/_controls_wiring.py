@@ -14,14 +14,27 @@ which pieces or which label the checker reads, run by every ``cfmpa prove``.
 - witness.raised_start: the optimal path with its genuine witness, the start state's label raised
   from (0, 0) to (0, 1); ``check_witness`` must reject it at witness.start.
 
+- exact.rest_layer_contact: on ``small`` (the modified variant), a path that waits N steps at a
+  cell free in every motion layer, then moves to a neighbour blocked in the rest layer only
+  visited there (its regions meet the principal's at rest at its goal): the exact re-decision
+  (``spec.exact_path_gaps``, in ball arithmetic) must leave that rest-layer cell undecided, and
+  no other. One that stops a layer short never sees it.
+
+- kinds.theorem_moved: the kinds with ``Safety.separation`` moved into the definitional list; the
+  kinds' audit (``definitional_failures``: no obligation a verdict or a run-time checker rests
+  on, ``THEOREM_PREFIXES``, may be definitional) must reject it. Its right input,
+  ``Control.accept.kinds``, is the code's own ``kind_of``: a theorem moved into DEFINITIONAL in
+  the code fails it (the lock's pinned kind fails the run too, but a pin is not what catches).
+
 - loader.spacing_above_bound: the workcell ``small`` with the principal's first joint fast enough
   that omega dt is the double 3.14, just above the lattice spacing the safety proofs assume
   (their G_MAX, 157/50, read from proofs/_obl_safety.py); the loader must refuse it, naming
   that joint's omega. A loader admitting it would build regions outside the proved lemma.
 
 And their right inputs: ``Control.accept.monitor.gap`` (a gap inside one piece, within the tube:
-covered) and ``Control.accept.loader.spacing_at_bound`` (omega dt the largest double <= 157/50:
-loaded) beside the checkers' own positive controls in ``_controls``.
+covered), ``Control.accept.exact`` (the optimal path of ``small``: every cell proved free) and
+``Control.accept.loader.spacing_at_bound`` (omega dt the largest double <= 157/50: loaded)
+beside the checkers' own positive controls in ``_controls``.
 """
 
 from __future__ import annotations
@@ -29,16 +42,20 @@ from __future__ import annotations
 import copy
 import math
 from fractions import Fraction
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
+from .. import spec
 from ..errors import InputError
 from ..scenarios import SELFCHECK_WORKCELLS
 from ..spec import (MOVES, ReferenceSpeeds, Trajectory, Witness, between_samples_bound, certify,
                     check_witness, left_angles, parse_scenario, trajectory_distances)
 from ._controls import Control, ControlNotMade, _case, _rejected, _require
 
-__all__ = ["MARGIN_M", "wiring_controls", "wiring_positive_controls"]
+__all__ = ["MARGIN_M", "THEOREM_PREFIXES", "definitional_failures", "wiring_controls",
+           "wiring_positive_controls"]
 
 #: How far apart the arms are at both grid instants of the moving near-contact (m).
 MARGIN_M = 0.1
@@ -177,6 +194,97 @@ def _raised_start() -> tuple[str, str]:
     return out, f"the start state labelled (0, 1); {detail}"
 
 
+# --- the exact re-decision's rest layer -------------------------------------------------------
+
+
+def _rest_layer_path() -> tuple[list[tuple[int, int]], tuple[int, int]]:
+    """(path, its last cell): N steps at a cell free in every motion layer of the small
+    workcell's D_R, then one move to a neighbour blocked in the rest layer (the first such pair
+    in row-major order); the neighbour is occupied in the rest layer only."""
+    c = _case()
+    dr, N = c.dr, c.grid.N
+    free = ~np.any(dr[:N] != 0, axis=0)
+    for i, j in np.argwhere(dr[N] != 0):
+        for d in MOVES:
+            b = (int(i) + d[0], int(j) + d[1])
+            if d != (0, 0) and 0 <= b[0] < dr.shape[1] and 0 <= b[1] < dr.shape[2] and free[b]:
+                return [b] * N + [(int(i), int(j))], (int(i), int(j))
+    raise ControlNotMade("no cell blocked in the rest layer has a neighbour free in every "
+                         "motion layer")
+
+
+def _exact_verdict(path: list[tuple[int, int]]) -> Any:
+    c = _case()
+    return spec.exact_path_gaps(c.scenario, "modified", c.grid, path)
+
+
+def _rest_layer_contact() -> tuple[str, str]:
+    c = _case()
+    N = c.grid.N
+    path, last = _rest_layer_path()
+    _require(len(path) == N + 1 and path[-2] != last, "the blocked cell is not reached at step N")
+    e = _exact_verdict(path)
+    what = (f"{N} steps at {list(path[0])}, then {list(last)} (blocked in the rest layer {N} "
+            "only there)")
+    if e.ok:
+        return "accepted", f"{what}: every cell proved free ({len(e.cells)} re-decided)"
+    where = [(x.layer, x.cell) for x in e.undecided]
+    if where != [(N, last)]:
+        return "error", f"{what}: undecided at {where}, not only at ({N}, {list(last)})"
+    return "rejected", (f"{what}: layer {N}, cell {list(last)} undecided (gap at least "
+                        f"{e.undecided[0].gap_lower_m:.3g} m)")
+
+
+def _accept_exact() -> tuple[str, str]:
+    c = _case()
+    path = [tuple(x) for x in c.best.path]
+    e = _exact_verdict(path)   # type: ignore[arg-type]
+    what = f"the optimal path of {len(path)} cells, {len(e.cells)} (layer, cell) pairs"
+    return ("accepted", f"{what}, each proved free") if e.ok else (
+        "rejected", f"{what}: {len(e.undecided)} undecided")
+
+
+# --- the kinds -------------------------------------------------------------------------------
+
+#: The obligations a found plan's verdict rests on (the report's rows: Safety., Certificate.,
+#: Tolerance.) and those of the run-time checkers' bounds (Exact., Monitor., Witness.): theorems
+#: about the robot and the code, never definitional (docs/model.md §6.4, §10).
+THEOREM_PREFIXES = ("Safety.", "Certificate.", "Tolerance.", "Exact.", "Monitor.", "Witness.")
+
+
+def definitional_failures(kind_of: Callable[[str], str]) -> list[str]:
+    """The obligations of THEOREM_PREFIXES that ``kind_of`` calls anything but a theorem."""
+    from ._runner import FIXED_IDS
+
+    return [i for i in FIXED_IDS if i.startswith(THEOREM_PREFIXES) and kind_of(i) != "theorem"]
+
+
+def _kinds_verdict(kind_of: Callable[[str], str]) -> tuple[str, str]:
+    from ._runner import FIXED_IDS
+
+    n = sum(1 for i in FIXED_IDS if i.startswith(THEOREM_PREFIXES))
+    bad = definitional_failures(kind_of)
+    if bad:
+        return "rejected", (f"{len(bad)} of the {n} obligations a verdict rests on called "
+                            f"definitional: {', '.join(bad[:3])}")
+    return "accepted", f"the {n} obligations a verdict rests on are theorems"
+
+
+def _theorem_moved() -> tuple[str, str]:
+    from ._runner import FIXED_IDS, kind_of
+
+    moved = "Safety.separation"
+    _require(moved in FIXED_IDS and kind_of(moved) == "theorem",
+             f"{moved} is not a theorem of the run")
+    return _kinds_verdict(lambda i: "definitional" if i == moved else kind_of(i))
+
+
+def _accept_kinds() -> tuple[str, str]:
+    from ._runner import kind_of
+
+    return _kinds_verdict(kind_of)
+
+
 # --- the loader's spacing bound --------------------------------------------------------------
 
 
@@ -233,6 +341,11 @@ def wiring_controls() -> list[Control]:
         Control("Control.witness.raised_start", "witness (spec.check_witness)",
                 "the optimal path with its witness, the start state's label raised to (0, 1)",
                 R, _raised_start),
+        Control("Control.exact.rest_layer_contact", "exact re-decision (spec.exact_path_gaps)",
+                "a path waiting N steps, then moving to a cell blocked in the rest layer, "
+                "visited only there", R, _rest_layer_contact),
+        Control("Control.kinds.theorem_moved", "the kinds (proofs._runner.kind_of)",
+                "Safety.separation moved into the definitional list", R, _theorem_moved),
         Control("Control.loader.spacing_above_bound", "scenario loader (spec.parse_scenario)",
                 "the principal's omega dt the double 3.14, just above the spacing bound the "
                 "safety proofs assume (157/50)", R, _spacing_above_bound),
@@ -240,11 +353,15 @@ def wiring_controls() -> list[Control]:
 
 
 def wiring_positive_controls() -> list[Control]:
-    """The monitor's and the loader's right inputs (the other checkers' are
+    """The monitor's, the exact re-decision's and the loader's right inputs (the others' are
     ``_controls.positive_controls``)."""
     return [Control("Control.accept.monitor.gap",
                     "monitor (spec.between_samples_bound, spec.ReferenceSpeeds.over)",
                     "a gap inside one piece, within the tube", ("accepted",), _accept_gap),
+            Control("Control.accept.exact", "exact re-decision (spec.exact_path_gaps)",
+                    "the optimal path of the small workcell", ("accepted",), _accept_exact),
+            Control("Control.accept.kinds", "the kinds (proofs._runner.kind_of)",
+                    "the kinds as the code gives them", ("accepted",), _accept_kinds),
             Control("Control.accept.loader.spacing_at_bound",
                     "scenario loader (spec.parse_scenario)",
                     "the principal's omega dt the largest double <= 157/50", ("accepted",),

@@ -138,7 +138,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "Scenario.*.margin_side, Lemma.sweep_margin, Scenario.*.containment"),
     Assumption(
         "A11.safety_scope",
-        "The end-to-end theorem (Safety.*) assumes only A2, A3, A4 and A12: that the polygons and "
+        "The end-to-end theorem (Safety.*) assumes only A2, A3, A4 and A12 (and, for a "
+        "workcell with a tool or heights, A13): that the polygons and "
         "distances impl computes in doubles are the construction Safety.region_soundness "
         "proves sound, up to rounding (lattice indices by impl.lattice_range's formula, "
         "rectangles grown by impl.sweep_margin, their hull by impl.convex_hull (or, in "
@@ -181,23 +182,22 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         "A13.tools_and_heights",
         "For a workcell with a tool or height intervals (docs/model.md §2), the end-to-end "
-        "theorem's compositions (Safety.<variant>.composition) are stated for the two link "
-        "rectangles per arm: what covers the tool and the heights is Safety.tool_region (the "
-        "tool inside its region at every configuration of the box), Safety.height_rule (parts "
-        "at disjoint heights share no point), Certificate.height_gap and the tool terms of "
-        "Certificate.lipschitz and Tolerance.tube_factor, each proved on its own, and the "
-        "run-time checks (D_R's postcondition, the certificate, the exact re-decision). Within "
-        "Safety.tool_region three steps are stated, not proved: the polygon grown by the "
-        "square is the hull of the vertices moved by the square's corners ('hull of sums "
-        "stated'); a tool of fewer than 16 vertices is the 16-vertex one with a vertex "
-        "repeated; and the numpy stand-in that runs impl's functions on terms "
-        "(proofs/_obl_tools.py, _Numpy) computes what numpy computes.",
-        "The lemmas are proved for the code as it runs; what joins them into one theorem for a "
-        "workcell with a tool is the compositions' pair list, not yet extended. Until it is, "
-        "such a workcell carries the scope label (spec.theorem_scope) in plan, prove and the "
-        "report, and its verdict reads 'certified', not 'safe'. The stated steps are tested: "
-        "the numpy stand-in against impl's floats on sample tools, the padding by the loader's "
-        "MAX_TOOL_VERTICES, the grown polygon against impl.part_polygons.",
-        "Safety.tool_region, Safety.height_rule, Certificate.height_gap, the verdict rows of "
+        "theorem covers every part: the compositions (Safety.<variant>.composition) range over "
+        "every pair of parts the height rule keeps, the tool's region from Safety.tool_region's "
+        "tool_statement, the pairs it drops by Safety.height_rule. Stated, not proved: (1) the "
+        "polygon grown by the square is the hull of the vertices moved by the square's corners "
+        "('hull of sums stated', Safety.tool_region); (2) a tool of fewer than 16 vertices is "
+        "the 16-vertex one with a vertex repeated; (3) the numpy stand-in that runs impl's "
+        "functions on terms (proofs/_obl_tools.py, _Numpy) computes what numpy computes; (4) "
+        "the pairs BuiltDR tests, spec.pairs_to_test, are the pairs of spec.parts whose "
+        "intervals (spec.part_height) spec.heights_overlap calls overlapping, as the "
+        "compositions read them (an arm's tool present or not, each part's interval or None).",
+        "Each stated step is tested or checked where it is used: the numpy stand-in against "
+        "impl's floats on sample tools, the padding by the loader's MAX_TOOL_VERTICES, the grown "
+        "polygon against impl.part_polygons, and pairs_to_test against heights_overlap on "
+        "sample arms with and without tools and heights every time Safety.height_rule is built "
+        "(a mismatch fails it). heights_overlap itself is read as the code is (run on terms), "
+        "so a wrong comparison is refuted by a proof, not by this check.",
+        "Safety.tool_region, Safety.height_rule, Safety.*.composition, the verdict rows of "
         "workcells with a tool or heights"),
 )

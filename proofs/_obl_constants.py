@@ -589,8 +589,10 @@ def _gap_vc() -> VC:
 
 
 def exact_vcs() -> tuple[VC, ...]:
-    """Exact.gap_formula's VCs, from the spec's functions as they are now."""
-    return (_bounds_vc("A"), _bounds_vc("B"), _gap_vc())
+    """Exact.gap_formula's VCs, from the spec's functions as they are now; a tool's polygon on
+    either side of a pair (proofs/_obl_exact_polygon.py)."""
+    from ._obl_exact_polygon import polygon_gap_vcs
+    return (_bounds_vc("A"), _bounds_vc("B"), _gap_vc(), *polygon_gap_vcs())
 
 
 # --- the obligations ----------------------------------------------------------------------------
@@ -644,7 +646,12 @@ def constants_obligations() -> list[Obligation]:
             "hulls: for any n, spec.projection_bounds gives hi_a >= n.x for every x of hull A "
             "and lo_b <= n.y for every y of hull B (convex combinations of three corners each), "
             "and then |y - x| >= spec.gap_over_norm(hi_a, lo_b, n) = (lo_b - hi_a) / |n| when "
-            "n != 0 (on exact reals, the square root its exact meaning). Named, not checked: a "
+            "n != 0 (on exact reals, the square root its exact meaning). A tool's polygon on "
+            "either side (tool_points, tool_frame, tool_max_A/B, tool_hull_A/B): "
+            "spec._exact._tool_points run on terms makes every vertex of a symbolic tool moved "
+            "by each corner of the square [-grow, grow]^2 in the forearm's frame at the wrist, "
+            "and projection_bounds' end over those points bounds n.x for every point x of the "
+            "tool grown by that square. Named, not checked: a "
             "point of the hull of many corners is a combination of three (Caratheodory, in the "
             "plane); arb's balls contain the exact values, upper() and lower() bound a ball.",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(exact_vcs()),

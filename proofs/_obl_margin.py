@@ -18,6 +18,7 @@ from fractions import Fraction
 import sympy as sp
 import z3
 
+from ..spec import MAX_SPACING
 from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Verdict, Z3Query,
                           check_source)
 from ._sos import Certificate, Square
@@ -26,9 +27,10 @@ __all__ = ["margin_obligations"]
 
 GROUP = "Swept regions (docs/model.md §4)"
 
-#: A rational below pi: the lemma is stated for turns g <= 157/50 (3.14) rad; lattice spacings
-#: are of the order of omega dt, a few hundredths.
-G_MAX = z3.Q(157, 50)
+#: A rational below pi: the lemma is stated for turns g <= the loader's spacing bound
+#: (spec.MAX_SPACING, 157/50 = 3.14 rad, read; below pi: Safety.*.composition's spacing_below_pi);
+#: lattice spacings are of the order of omega dt, a few hundredths.
+G_MAX = z3.Q(MAX_SPACING.numerator, MAX_SPACING.denominator)
 
 Vec = tuple[z3.ArithRef, z3.ArithRef]
 

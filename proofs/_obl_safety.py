@@ -41,7 +41,8 @@ from fractions import Fraction
 import z3
 
 from ..impl import SNAP, lattice_range, link_reach, sweep_margin
-from ..spec import DISTANCE_ERROR_M, EPS, Arm, Variant, cell_box, ptp_angles, ptp_fraction
+from ..spec import (DISTANCE_ERROR_M, EPS, MAX_SPACING, Arm, Variant, cell_box, ptp_angles,
+                    ptp_fraction)
 from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
                             is_path_fixed, member, position, z3_path)
 from ._obl_margin import margin_obligations
@@ -54,7 +55,7 @@ GROUP = "End-to-end safety (docs/model.md §10)"
 VARIANTS = ("original", "modified", "tight")
 
 #: A rational below pi (the lattice spacings' bound, as in Margin.arc_chord).
-G_MAX = z3.Q(157, 50)
+G_MAX = z3.Q(MAX_SPACING.numerator, MAX_SPACING.denominator)
 #: impl.SNAP and spec.EPS as the rationals their decimal literals denote.
 SNAP_Q = z3.RealVal(repr(SNAP))
 EPS_Q = z3.RealVal(repr(EPS))
@@ -1364,13 +1365,14 @@ class Principal:
         return ptp_angles(self.start, self.goal, self.Tf, t)
 
     def tf_def(self) -> Hyp:
-        d = [_abs(self.goal[q] - self.start[q]) / self.omega[q] for q in range(2)]
-        return ("Tf = max_q |goal_q - start_q| / omega_q (spec.exact_tf)",
-                self.Tf == _mx(d[0], d[1]))
+        tf, _ = counts_on_terms(self.start, self.goal, self.omega, self.dt)
+        return ("Tf = max_q |goal_q - start_q| / omega_q (spec.exact_tf)", self.Tf == tf)
 
     def n_def(self) -> Hyp:
-        ceil = -z3.ToInt(-(self.Tf / self.dt))
-        return ("N = max(1, ceil(Tf / dt)) (spec.exact_n)", self.N == z3.If(ceil >= 1, ceil, 1))
+        tf, n = counts_on_terms(self.start, self.goal, self.omega, self.dt)
+        # The code recomputes Tf inside exact_n: it is the named Tf (tf_def, a hypothesis).
+        return ("N = max(1, ceil(Tf / dt)) (spec.exact_n)",
+                self.N == z3.substitute(n, (tf, self.Tf)))
 
     def basics(self) -> tuple[Hyp, ...]:
         return (("dt > 0", self.dt > 0),
@@ -1392,6 +1394,31 @@ class Principal:
             return _flipped(self, z3.ToReal(self.N) - 1)
         return v.rest_box(self.start, self.goal, self.omega, self.dt, self.Tf,
                           z3.ToReal(self.N))
+
+
+def _exact(x: object, reading: str = "binary") -> object:
+    """A reading of a number, on the proofs' symbols: the symbol is the reading's exact value."""
+    return x
+
+
+def counts_on_terms(start: Vec, goal: Vec, omega: Vec, dt: z3.ArithRef,
+                    travel: Callable[..., object] | None = None
+                    ) -> tuple[z3.ArithRef, z3.ArithRef]:
+    """(Tf, N) as spec.exact_tf and spec.exact_n compute them (docs/model.md §2: the counts'
+    one owner), their modules' own code run on the symbols (``module_on_terms``): a number's
+    reading is the symbol itself, ``max`` an If, the exact ceiling ``spec.ceil_of`` (tested equal
+    to the code's on fractions). ``travel`` replaces the travel time's function (the tests'
+    mutant, from a planted copy of its module)."""
+    from types import SimpleNamespace
+
+    from ..spec import ceil_of, exact_tf
+    from ._obl_tools import module_on_terms
+    tt = travel or exact_tf.__globals__["travel_time"]
+    counts = module_on_terms(tt, _read=_exact, ceil_fraction=ceil_of)
+    grid = module_on_terms(exact_tf, travel_time=counts[tt.__name__],
+                           time_steps=counts["time_steps"])
+    s = SimpleNamespace(left=SimpleNamespace(start=start, goal=goal, omega=omega), dt=dt)
+    return grid["exact_tf"](s), grid["exact_n"](s)
 
 
 def _flipped(P: Principal, k: z3.ArithRef) -> tuple[Vec, Vec]:
@@ -1659,6 +1686,118 @@ def _regions(variant: str) -> tuple[Callable[..., z3.ExprRef], Callable[..., z3.
 
 
 LINKS = (0, 1)
+#: Every part of an arm (docs/model.md §2): links 1 and 2 and, if the arm carries one, the tool
+#: (part 3, index 2), each the prism of its planar outline over its height interval.
+TOOL = 2
+PARTS = (0, 1, TOOL)
+#: solid(x, theta1, theta2, p1, p2, z): the point (p, z) of 3-D space lies in the prism of part x
+#: at theta (opaque: its outline and its heights are premises).
+_SOLID_L = z3.Function("solidL", z3.IntSort(), *[_R] * 5, z3.BoolSort())
+_SOLID_R = z3.Function("solidR", z3.IntSort(), *[_R] * 5, z3.BoolSort())
+
+
+@dataclass(frozen=True)
+class Heights:
+    """One arm's tool and heights, symbolic (docs/model.md §2): whether it carries a tool, and
+    for each part whether it has a height interval and the interval."""
+
+    tag: str
+    has_tool: z3.BoolRef
+    has_z: tuple[z3.BoolRef, ...]
+    z: tuple[tuple[z3.ArithRef, z3.ArithRef], ...]
+
+    @classmethod
+    def named(cls, tag: str) -> Heights:
+        return cls(tag, z3.Bool(f"{tag}.has_tool"),
+                   tuple(z3.Bool(f"{tag}.has_z{x + 1}") for x in PARTS),
+                   tuple((z3.Real(f"{tag}.z{x + 1}.lo"), z3.Real(f"{tag}.z{x + 1}.hi"))
+                         for x in PARTS))
+
+    def present(self, x: int) -> z3.BoolRef:
+        return self.has_tool if x == TOOL else z3.BoolVal(True)
+
+    def solid(self, x: int, theta: Vec, p: Vec, z: z3.ArithRef) -> z3.BoolRef:
+        f = _SOLID_L if self.tag == "L" else _SOLID_R
+        return f(x, theta[0], theta[1], p[0], p[1], z)
+
+    def link(self, x: int, theta: Vec, p: Vec) -> z3.BoolRef:
+        return (link_l if self.tag == "L" else link_r)(x, theta, p)
+
+    def outline(self, theta: Vec, p: Vec, z: z3.ArithRef) -> z3.BoolRef:
+        """A point of part x's prism lies over a point of its planar outline; an arm without a
+        tool has no part 3."""
+        return z3.And([z3.Implies(self.solid(x, theta, p, z), z3.And(
+            self.link(x, theta, p), self.present(x))) for x in PARTS])
+
+    def prism(self, theta: Vec, p: Vec, z: z3.ArithRef) -> z3.BoolRef:
+        """Definitional (docs/model.md §2): the prism of part x is its outline over its closed
+        height interval (every height without one)."""
+        return z3.And([z3.Implies(self.solid(x, theta, p, z), z3.And(
+            self.link(x, theta, p), self.present(x),
+            z3.Implies(self.has_z[x], z3.And(self.z[x][0] <= z, z <= self.z[x][1]))))
+            for x in PARTS])
+
+
+def heights_kept(hl: Heights, hr: Heights, x: int, y: int,
+                 overlap: Callable[..., object] | None = None) -> z3.BoolRef:
+    """spec.heights_overlap (or ``overlap``, the tests' mutant) on the two parts' intervals, read
+    off its syntax tree and run on the terms (Safety.height_rule's reading), for each case of
+    "has an interval" (None where not)."""
+    from ._obl_tools import _bool, run_on_terms
+    from ..spec import heights_overlap
+    fn = overlap or heights_overlap
+
+    def ov(a: object, b: object) -> z3.BoolRef:
+        return _bool(run_on_terms(fn, a, b), 0)
+    a, b = hl.z[x], hr.z[y]
+    return z3.If(hl.has_z[x], z3.If(hr.has_z[y], ov(a, b), ov(a, None)),
+                 z3.If(hr.has_z[y], ov(None, b), ov(None, None)))
+
+
+def pair_kept(hl: Heights, hr: Heights, x: int, y: int,
+              overlap: Callable[..., object] | None = None) -> z3.BoolRef:
+    """Whether BuiltDR tests the pair (spec.pairs_to_test: both parts present, their heights
+    overlapping; Safety.height_rule checks pairs_to_test against heights_overlap)."""
+    return z3.And(hl.present(x), hr.present(y), heights_kept(hl, hr, x, y, overlap))
+
+
+HEIGHT_HYP = ("Safety.height_rule at the pairs the height test drops: no point of 3-D space in "
+              "both prisms")
+
+
+def height_hypothesis(at: _At, overlap: Callable[..., object] | None = None) -> z3.BoolRef:
+    """The height rule as the compositions use it, at the instant's configurations and the point
+    (p, z): a pair of parts whose intervals heights_overlap calls disjoint shares no point.
+    ``height_instance_vc`` derives it from the prisms' definition."""
+    hl, hr = Heights.named("L"), Heights.named("R")
+    return z3.And([z3.Implies(z3.Not(heights_kept(hl, hr, x, y, overlap)), z3.Not(z3.And(
+        hl.solid(x, at.theta_l, at.p, at.z), hr.solid(y, at.theta_r, at.p, at.z))))
+        for x in PARTS for y in PARTS])
+
+
+def height_instance_vc(overlap: Callable[..., object] | None = None) -> VC:
+    """The compositions' height hypothesis holds for the prisms (docs/model.md §2: a part is the
+    prism of its outline over its closed height interval), with the pairs read by the code's
+    interval test run on terms: Safety.height_rule at the parts of both arms. ``overlap`` is
+    the tests' mutant (``<`` for ``<=``: refuted at touching ends)."""
+    at = _At.named()
+    hl, hr = Heights.named("L"), Heights.named("R")
+    key = "the prisms (docs/model.md §2): a part's outline over its closed height interval"
+    hyps: list[Hyp] = [
+        (key, z3.And(hl.prism(at.theta_l, at.p, at.z), hr.prism(at.theta_r, at.p, at.z))),
+    ]
+    def at_heights(right: tuple[int, int]) -> tuple[tuple[z3.ExprRef, z3.ExprRef], ...]:
+        """Tools on both arms, the principal's parts at [0, 1], the subordinate's at ``right``."""
+        out: list[tuple[z3.ExprRef, z3.ExprRef]] = []
+        for h, (lo, hi) in ((hl, (0, 1)), (hr, right)):
+            out += [(h.has_tool, z3.BoolVal(True))]
+            for x in PARTS:
+                out += [(h.has_z[x], z3.BoolVal(True)), (h.z[x][0], z3.RealVal(lo)),
+                        (h.z[x][1], z3.RealVal(hi))]
+        return tuple(out)
+    # Vacuity: touching intervals (every pair kept); without the key: [0, 1] and [2, 3] apart.
+    return VC("height_instances", tuple(hyps), height_hypothesis(at, overlap), key_premise=key,
+              witness=at_heights((1, 2)), counter_witness=at_heights((2, 3)))
 
 
 @dataclass(frozen=True)
@@ -1673,13 +1812,15 @@ class _At:
     theta_l: Vec
     theta_r: Vec
     p: Vec
+    z: z3.ArithRef
 
     @classmethod
     def named(cls) -> _At:
         P, S, d = Principal.named(), Subordinate.named(), Z3Dims.named()
         L, k, t = z3_path("L"), z3.Int("kk"), z3.Real("t")
         here, nxt = position(L, k), position(L, k + 1)
-        return cls(P, S, d, k, here, P.theta(t), S.theta(here, nxt, k, t, P.dt), _v("p"))
+        return cls(P, S, d, k, here, P.theta(t), S.theta(here, nxt, k, t, P.dt), _v("p"),
+                   z3.Real("z"))
 
 
 def region_hypotheses(variant: str, at: _At) -> list[Hyp]:
@@ -1706,6 +1847,19 @@ def region_hypotheses(variant: str, at: _At) -> list[Hyp]:
                             z3.Implies(link_r(x, theta_r, p),
                                        member(region_r(here[0], here[1], x), p)))
                  for x in LINKS])),
+        ("(c) Safety.tool_region: the principal's tool at theta_L(t) in layer k's region (its "
+         "box, k < N; at p)",
+         z3.Implies(z3.And(0 <= k, k < at.d.N, in_box(theta_l, box_k), link_l(TOOL, theta_l, p)),
+                    member(region_l(k, TOOL), p))),
+        ("(c) Safety.tool_region: the principal's tool at theta_L(t) in the rest region (its "
+         "box; at p)",
+         z3.Implies(z3.And(in_box(theta_l, P.rest_box(variant)), link_l(TOOL, theta_l, p)),
+                    member(region_rest(TOOL), p))),
+        ("(c) Safety.tool_region: the subordinate's tool at theta_R(t) in the region of its "
+         "cell (its box; at p)",
+         z3.Implies(z3.And(in_grid(at.d, here), in_box(theta_r, at.S.box(here)),
+                           link_r(TOOL, theta_r, p)),
+                    member(region_r(here[0], here[1], TOOL), p))),
     ]
 
 
@@ -1967,10 +2121,65 @@ def region_statement_vc(arm: ArmModel, x: int, kit: Kit | None = None,
               witness=wit, counter_witness=wit)
 
 
+def rectangle_vc(x: int, rectangles: Callable[..., object] | None = None) -> VC:
+    """The rectangle both definitions of region_statement use is impl's: impl.link_rectangles(arm,
+    theta1, theta2, link x, grow) (or ``rectangles``, the tests' mutant), its module's own code
+    run on the terms (numpy's cos and sin as Cos, Sin), for a symbolic arm, configuration and
+    grow >= 0, has the corners of ArmModel's rectangle -r' <= u <= l + r', |v| <= r' (r' = w/2 +
+    grow) in the link's frame, counter-clockwise from (-r', -r'): the link's definition (grow
+    0) and the hull's (grow = sweep_margin) are the code's rectangle."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from ..impl import link_rectangles
+    from ._obl_tools import module_on_terms
+    fn = rectangles or link_rectangles
+    arm = ArmModel.named("rect")
+    r = arm.r1 if x == 0 else arm.r2
+    ell = arm.l1 if x == 0 else arm.l2
+    t1, t2, grow = z3.Reals("rect.theta1 rect.theta2 rect.grow")
+    # Lengths as object arrays and the width as a one-element one, so that numpy, not Z3,
+    # broadcasts a term times an array (as read_tool's arm does).
+    code = SimpleNamespace(base=arm.b, links=(np.asarray(arm.l1, dtype=object),
+                                              np.asarray(arm.l2, dtype=object)),
+                           width=np.asarray([2 * r], dtype=object), tool=None, z=None)
+    got = np.asarray(module_on_terms(fn)[fn.__name__](code, t1, t2, x, grow=grow),
+                     dtype=object).reshape(-1, 2)
+    names = [_v(f"rect.C{i + 1}") for i in range(len(got))]
+    key = (f"C = impl.link_rectangles(arm, theta1, theta2, link {x + 1}, grow), read on terms "
+           "(its corners named C1..C4)")
+    R = r + grow
+    want = [arm.frame_point(x, t1, t1 + t2, (u, v))
+            for u, v in ((-R, -R), (ell + R, -R), (ell + R, R), (-R, R))]
+    hyps = (("the arm: l1, l2 > 0, r = w/2 > 0, grow >= 0",
+             z3.And(arm.l1 > 0, arm.l2 > 0, r > 0, grow >= 0)),
+            (key, z3.And([_veq(n, (z3.simplify(g[0]) if isinstance(g[0], z3.ExprRef) else g[0],
+                                   z3.simplify(g[1]) if isinstance(g[1], z3.ExprRef) else g[1]))
+                          for n, g in zip(names, got)])))
+    goal = z3.And([_veq(w, n) for w, n in zip(want, names)]) if len(names) == 4 else \
+        z3.BoolVal(False)
+    return VC(f"rectangle_link{x + 1}", hyps, goal, key_premise=key)
+
+
 def region_statement_query() -> Z3Query:
     kit = region_kit()
-    return Z3Query(tuple(region_statement_vc(ArmModel.named(t), x, kit)
-                         for t in ("L", "R") for x in LINKS))
+    return Z3Query(tuple(rectangle_vc(x) for x in LINKS)
+                   + tuple(region_statement_vc(ArmModel.named(t), x, kit)
+                           for t in ("L", "R") for x in LINKS))
+
+
+#: How region_instances names the tool's statement (its derivation: Safety.tool_region's
+#: tool_statement_L/R).
+TOOL_STATEMENT = "Safety.tool_region's tool_statement"
+
+
+def tool_statement_closed(tag: str) -> z3.BoolRef:
+    """The tool's region statement for arm ``tag``, universally closed: region_statement's form
+    for part 3 (a point of the tool at a configuration of a box is a member of the region built
+    for the tool and the box), derived in Safety.tool_region (tool_statement_L/R)."""
+    bound, body = region_statement(ArmModel.named(tag), TOOL)
+    return z3.ForAll(bound, body)
 
 
 def region_instance_vc(variant: str) -> VC:
@@ -1993,6 +2202,8 @@ def region_instance_vc(variant: str) -> VC:
         *arm_l.geometry(), *arm_r.geometry(),
         (key, region_statement_closed(arm_l)),
         ("Safety.region_statement for the subordinate's links", region_statement_closed(arm_r)),
+        (TOOL_STATEMENT + " for the principal's tool", tool_statement_closed("L")),
+        (TOOL_STATEMENT + " for the subordinate's tool", tool_statement_closed("R")),
         ("the loader's spacing checks: 0 < omega_q dt <= 157/50, 0 < h_q <= 157/50",
          z3.And(spacing_ok(g_l), spacing_ok(at.S.h))),
         ("layer k's regions are the regions built for its box, anchored at theta_L(k dt), "
@@ -2000,21 +2211,55 @@ def region_instance_vc(variant: str) -> VC:
          z3.Implies(z3.And(0 <= k, k < at.d.N), z3.And([
              region_l(k, x) == _swept(_SWEPT_L, x, P.box(variant, z3.ToReal(k)),
                                       P.theta(z3.ToReal(k) * P.dt), g_l)
-             for x in LINKS]))),
+             for x in PARTS]))),
         ("the rest layer's regions are the regions built for the rest box",
          z3.And([region_rest(x) == _swept(_SWEPT_L, x, P.rest_box(variant), rest_anchor, g_l)
-                 for x in LINKS])),
+                 for x in PARTS])),
         ("a cell's regions are the regions built for its box, anchored at its angles, spacing h",
          z3.Implies(in_grid(at.d, here), z3.And([
              region_r(here[0], here[1], x) == _swept(_SWEPT_R, x, at.S.box(here),
                                                      at.S.angle(here), at.S.h)
-             for x in LINKS]))),
+             for x in PARTS]))),
     ]
     goal = z3.And([h for _, h in region_hypotheses(variant, at)])
     one = z3.IntVal(1)
     pins = ((at.d.N, one), (at.d.m, one), (at.d.n, one))
+    # Without the key, the counter-model at step 0 of unit steps (Z3 took 21 s to find one for
+    # modified with the one-cell pins alone, 0.4 s with these).
+    steps = ((k, z3.IntVal(0)), (P.dt, z3.RealVal(1)))
     return VC(f"region_instances_{variant}", tuple(hyps), goal, key_premise=key, witness=pins,
-              counter_witness=pins)
+              counter_witness=pins + steps)
+
+
+#: A rational below pi (pi = 3.14159265...): what A3's facts on [0, pi] need of G_MAX.
+PI_BELOW = z3.Q(314159, 100000)
+
+
+def spacing_bound_vc(bound: z3.ArithRef | None = None) -> VC:
+    """The loader's spacing bound (spec.MAX_SPACING, read: G_MAX) lies below pi, so A3's facts,
+    stated on [0, G_MAX] where they hold on [0, pi] (cos non-increasing, sin >= 0; cos >= 0 up
+    to G_MAX / 2 < pi / 2), hold there. ``bound`` replaces G_MAX (the tests' mutant)."""
+    pi = z3.Real("pi")
+    key = "pi > 314159/100000"
+    g = G_MAX if bound is None else bound
+    return VC("spacing_below_pi", ((key, pi > PI_BELOW),), g < pi, key_premise=key,
+              witness=((pi, z3.Q(314159265, 100000000)),), counter_witness=())
+
+
+def pair_apart_lemma() -> Lemma:
+    """(d) at one pair of regions, as the compositions use it at each pair BuiltDR tests: with
+    eps = spec.EPS, err = spec.DISTANCE_ERROR_M, A12 at the pair and what a positive distance
+    means, a pair BuiltDR frees (float distance > eps) has no common point."""
+    A, B = z3.Consts("pa.A pa.B", REGION)
+    eps, err = z3.Reals("eps err")
+    p = _v("pa.p")
+    key = "BuiltDR frees the pair: fdist(A, B) > eps"
+    hyps = ((EPS_HYP, eps == EPS_Q), (ERR_HYP, err == ERR_Q),
+            ("A12: |fdist(A, B) - dist(A, B)| <= err", rounding(A, B, err)),
+            ("the distance of compact regions", distance_meaning(A, B)),
+            (key, float_free(A, B, eps)))
+    return lemma("pair_apart", hyps, z3.Not(z3.And(member(A, p), member(B, p))), key,
+                 names=dict(A=A, B=B, p=p))
 
 
 def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
@@ -2040,8 +2285,12 @@ def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
     p = _v("p")
     region_l, region_rest, region_r = _regions(variant)
 
+    hl, hr = Heights.named("L"), Heights.named("R")
+    kept = {(x, y): pair_kept(hl, hr, x, y) for x in PARTS for y in PARTS}
+
     def all_free(left: Callable[[int], z3.ExprRef], i: z3.ArithRef, j: z3.ArithRef) -> z3.BoolRef:
-        return z3.And([float_free(left(x), region_r(i, j, y), eps) for x in LINKS for y in LINKS])
+        return z3.And([z3.Implies(kept[x, y], float_free(left(x), region_r(i, j, y), eps))
+                       for x in PARTS for y in PARTS])
 
     post = blocked_exact(
         DR, d, motion=lambda kk, i, j: z3.Not(all_free(lambda x: region_l(kk, x), i, j)),
@@ -2049,10 +2298,10 @@ def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
     here, nxt = position(L, k), position(L, k + 1)
     theta_l = P.theta(t)
     theta_r = S.theta(here, nxt, k, t, P.dt)
-    pairs = [(A, region_r(here[0], here[1], y)) for x in LINKS
-             for A in (region_l(k, x), region_rest(x)) for y in LINKS]
-    key = ("Theorem 1/3's postcondition: P[k,i,j] = 0 iff every pair of link regions has a "
-           "float distance > eps")
+    pairs = [(A, region_r(here[0], here[1], y)) for x in PARTS
+             for A in (region_l(k, x), region_rest(x)) for y in PARTS]
+    key = ("Theorem 1/3's postcondition: P[k,i,j] = 0 iff every pair of part regions the height "
+           "rule keeps (spec.pairs_to_test) has a float distance > eps")
     hyps: list[Hyp] = [
         *P.basics(), P.n_def(), ("h_q > 0", z3.And(S.h[0] > 0, S.h[1] > 0)),
         ("is_path L (fixed, docs/model.md §5)", is_path_fixed(DR, d, start, goal, L)),
@@ -2060,18 +2309,26 @@ def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
         ("t >= 0", t >= 0),
         ("k = floor(t / dt), the step at t (named)", k == z3.ToInt(t / P.dt)),
         (EPS_HYP, eps == EPS_Q), (ERR_HYP, err == ERR_Q),
-        ("A12 at the eight pairs of regions (layer k and rest, links x links): "
+        ("A12 at the eighteen pairs of regions (layer k and rest, parts x parts): "
          "|fdist - dist| <= err", z3.And([rounding(A, B, err) for A, B in pairs])),
-        ("the distance of compact regions at the eight pairs: dist > 0 -> no common point",
+        ("the distance of compact regions at the eighteen pairs: dist > 0 -> no common point",
          z3.And([distance_meaning(A, B) for A, B in pairs])),
     ]
     hyps += step.at("t", k=k, N=d.N, t=t)
+    pa = pair_apart_lemma()
+    for n, (A, B) in enumerate(pairs):
+        hyps += pa.at(f"pair {n + 1} of regions", A=A, B=B, p=p)
     hyps += motion.at("the step k (a)", k=k, t=t)
     hyps += rest.at("t (a)", t=t)
     hyps += move.at("the step k (b)", c=here, c2=nxt, k=k, t=t)
-    hyps += region_hypotheses(variant, _At.named())
-    target = z3.And([z3.Not(z3.And(link_l(x, theta_l, p), link_r(y, theta_r, p)))
-                     for x in LINKS for y in LINKS])
+    at = _At.named()
+    hyps += region_hypotheses(variant, at)
+    hyps += [("the prisms' outlines (docs/model.md §2): a point of part x's prism lies over a "
+              "point of part x; an arm without a tool has no part 3",
+              z3.And(hl.outline(theta_l, p, at.z), hr.outline(theta_r, p, at.z))),
+             (HEIGHT_HYP, height_hypothesis(at))]
+    target = z3.And([z3.Not(z3.And(hl.solid(x, theta_l, p, at.z), hr.solid(y, theta_r, p, at.z)))
+                     for x in PARTS for y in PARTS])
     one, zero = z3.IntVal(1), z3.IntVal(0)
     # One layer, a one-cell grid, a one-cell path: where Z3 finds the models the vacuity check
     # and the negative controls ask for.
@@ -2113,7 +2370,8 @@ def _separation_query() -> Z3Query:
 
 
 def _composition_query(variant: str) -> Z3Query:
-    return Z3Query((_step_lemma().vc, region_instance_vc(variant), composition_vc(variant)))
+    return Z3Query((_step_lemma().vc, pair_apart_lemma().vc, spacing_bound_vc(),
+                    region_instance_vc(variant), height_instance_vc(), composition_vc(variant)))
 
 
 def safety_obligations() -> list[Obligation]:
@@ -2202,8 +2460,11 @@ def safety_obligations() -> list[Obligation]:
         "quantities (lattice indices, chord weights, points, the displacement) defined as it "
         "defines them. The arm's geometry (l1, l2, r1, r2 > 0, R_base and R_elbow as square "
         "roots) is a premise. Both definitions are definitional (what linkL and the region "
-        "mean); tests check (2)'s generating points against impl.swept_points and (1)'s "
-        "rectangle against the link rectangles impl computes. The compositions' "
+        "mean); rectangle_link1/2 prove the rectangle both use is impl's: impl.link_rectangles, "
+        "run on terms for a symbolic arm, configuration and grow >= 0, has its corners (a "
+        "rectangle not extended past its joint is refuted); tests check (2)'s generating "
+        "points against impl.swept_points and (1)'s rectangle against the link rectangles impl "
+        "computes on floats. The compositions' "
         "region_instances VC takes this statement, universally closed, as its premise.",
         Z, P, region_statement_query))
     out.append(Obligation(
@@ -2223,19 +2484,27 @@ def safety_obligations() -> list[Obligation]:
         out.append(Obligation(
             f"Safety.{v}.composition", GROUP, "docs/model.md §5, §7.2, §10 (e)",
             f"For the {v} variant: if D_R meets Theorem 1/3's postcondition with the "
-            "intersection test read as distance (P[k,i,j] = 0 iff every pair of a principal link "
-            f"region of layer k, the rest layer from N on ({rest}), and a subordinate link region "
-            "of cell (i, j) is more than eps apart) and L is a path under the fixed is_path, "
-            "then at every instant t >= 0 no link of the principal at theta_L(t) shares a point "
-            "with a link of the subordinate at theta_R(t), the linear move from the cell held "
+            "intersection test read as distance (P[k,i,j] = 0 iff every pair of a principal part "
+            f"region of layer k, the rest layer from N on ({rest}), and a subordinate part region "
+            "of cell (i, j) that spec.pairs_to_test keeps -- both parts present, their height "
+            "intervals overlapping by spec.heights_overlap run on the terms -- is more than eps "
+            "apart) and L is a path under the fixed is_path, then at every instant t >= 0 no "
+            "part (link 1, link 2, the tool; each the prism of its outline over its height "
+            "interval) of the principal at theta_L(t) shares a point of 3-D space with a part "
+            "of the subordinate at theta_R(t), the linear move from the cell held "
             "at step k to the one held at k + 1, k = floor(t / dt) (time_step: k dt <= t <= "
             "(k+1) dt, and t >= N dt once k >= N). Composed by substitution from "
             f"Safety.{v}.principal_in_layer_box (motion for k < N, rest from N dt on), "
             "Safety.subordinate_in_cell_box (neighbour_move; the fixed is_path gives the "
             "cells) and the time step; the free test is BuiltDR's own (float distance > eps), "
             "carried to the exact distance by Safety.separation's premises (eps, err, A12 at the "
-            "eight pairs of regions of layer k and of the rest layer, what a positive distance "
-            "means). The regions' soundness enters as hypotheses at theta_L(t), theta_R(t) and "
+            "eighteen pairs of regions of layer k and of the rest layer, what a positive distance "
+            "means), used through pair_apart ((d) at one pair). The pairs the height rule drops: "
+            "the hypothesis that they share no point, which height_instances derives from the "
+            "prisms' definition (Safety.height_rule at the parts); spacing_below_pi: the "
+            "loader's spacing bound (spec.MAX_SPACING, read) is below pi, where A3's facts "
+            "hold. Tf and N are spec.exact_tf and spec.exact_n run on the terms. The regions' "
+            "soundness enters as hypotheses at theta_L(t), theta_R(t) and "
             "the point (a link at a configuration of a region's box lies in the region); the VC "
             "region_instances derives each from Safety.region_statement (proved from "
             "Safety.region_soundness's lemmas and the definitions of a link and a region; here "
@@ -2243,7 +2512,8 @@ def safety_obligations() -> list[Obligation]:
             "read as BuiltDR builds them (layer k's: its box on the lattice anchored at "
             "theta_L(k dt), spacing omega dt; the rest layer's: the rest box, anchored at the "
             "goal for tight, else layer N-1's; a cell's: its box, anchored at its angles, "
-            "spacing h), so a hypothesis stronger than the statement fails. Every "
+            "spacing h), so a hypothesis stronger than the statement fails; the tool's three "
+            "region hypotheses, from Safety.tool_region's tool_statement. Every "
             "hypothesis that is not a proved lemma's instance is needed: cfmpa prove's negative "
             "controls drop each and require the composition without it not proved.",
             Z, P, lambda v=v: _composition_query(v)))

@@ -28,7 +28,7 @@ from pathlib import Path
 from ..spec import (Grid, Scenario, Variant, decimal, link_name, load_scenario, make_grid,
                     spacing_conditions)
 from ..spec import parts as part_indices
-from ..spec import theorem_scope
+from ..spec import MAX_SPACING, theorem_scope
 from ..errors import CfmpaError
 from ._obligation import CheckOutcome, CheckQuery, Method, Obligation, Verdict, check_source
 
@@ -42,8 +42,9 @@ CHECKS = ("time_grid", "cspace_grid", "margin_side", "containment") + TRANSLATIO
 #: other data checks (a default-sized grid takes about 3 s; a user's grid may be much larger).
 TRANSLATION_TIMEOUT_MS = 600_000
 
-#: The margin lemma's bound on a lattice spacing (Margin.arc_chord, Lemma.sweep_margin: g <= 3.14).
-G_MAX = Fraction(157, 50)
+#: The margin lemma's bound on a lattice spacing (Margin.arc_chord, Lemma.sweep_margin: g <= 3.14):
+#: the loader's own (spec.MAX_SPACING, read).
+G_MAX = MAX_SPACING
 
 
 def scenario_files(scenarios_dir: str | Path) -> list[Path]:
@@ -144,7 +145,10 @@ def _containment(s: Scenario) -> CheckOutcome:
 
 def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
     """The fast kernels' D_R and answer, as cfmpa plan computes them, against Theorems 1-4's
-    postconditions, decided by the spec alone: every cell, the path, and the search's witness."""
+    postconditions, decided by the spec alone: every cell, the path, and the search's witness;
+    and a found path's exact re-decision (``spec.exact_path_gaps``, its own loop, the geometry
+    replaced: ``_obl_wiring.exact_cells``) visits every (layer, cell) the fixed is_path reads,
+    the rest layer included (docs/model.md §7.4)."""
     import hashlib
 
     from ..impl import kernels
@@ -163,6 +167,16 @@ def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
         answer = search(dr, start, goal, with_witness=True, progress=False)
         fails = (search_failures(dr, start, goal, answer)
                  or check_witness(dr, start, goal, answer, answer.witness))
+    covered = ""
+    if answer is not None and answer.path and not fails:
+        from types import SimpleNamespace
+
+        from ._obl_wiring import exact_coverage_failures, is_path_reads
+        gaps = exact_coverage_failures(s, variant, g, answer.path)
+        fails = [SimpleNamespace(condition="exact.coverage", message=f"{gaps[0]} ({len(gaps)} "
+                                 "in all)", values=())] if gaps else []
+        covered = (f"; the exact re-decision visits the {len(is_path_reads(answer.path, g.N))} "
+                   "(layer, cell) pairs is_path reads, rest layer included")
     digest = hashlib.sha256(dr.tobytes()).hexdigest()[:16]
     if answer is None:
         said = "not searched"
@@ -171,7 +185,7 @@ def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
     else:
         said = f"no path ({answer.reason}), shown by the reachable set"
     detail = (f"{variant.value}: D_R {list(dr.shape)} sha256 {digest}; {checked} cells checked "
-              f"against the spec's regions; {said}")
+              f"against the spec's regions; {said}{covered}")
     if fails:
         f = fails[0]
         lines = [f"{f.condition}: {f.message}"] + [f"{k} was {v!r}" for k, v in f.values]
@@ -187,8 +201,12 @@ def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
         from ..spec import check_witness, dr_cell_failures, dr_shape_failures, search_failures
         # The checkers' sources (hashed: editing them is a change); the kernels' output is
         # judged by them, and its digest is in the detail.
+        from ..spec import exact_path_gaps, path_violations
+        from ._obl_wiring import exact_cells, exact_coverage_failures, is_path_reads
         src = check_source(_translation, make_grid, kernels, dr_shape_failures, dr_cell_failures,
-                           search_failures, check_witness)
+                           search_failures, check_witness, exact_path_gaps,
+                           exact_path_gaps.__globals__["path_layer_cells"], path_violations,
+                           exact_cells, exact_coverage_failures, is_path_reads)
     else:
         src = check_source(check, Grid.time_readings, Grid.spacing_readings, decimal, make_grid,
                            spacing_conditions)
@@ -269,8 +287,11 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                 "distances), and the fast searchoptpath's answer on it meets Theorem "
                 f"{2 if v is Variant.ORIGINAL else 4}'s (a found path valid under the fixed "
                 "is_path, its costs its own) with a witness that spec.check_witness accepts "
-                "(the path optimal, or no valid path at all). A check of the code that runs, on "
-                "this workcell's data: not a proof for other workcells.",
+                "(the path optimal, or no valid path at all); a found path's exact re-decision "
+                "(spec.exact_path_gaps, its loop run with the geometry replaced) visits every "
+                "(layer, cell) the fixed is_path reads, the rest layer included, and no other. A "
+                "check of the code that runs, on this workcell's data: not a proof for other "
+                "workcells.",
                 D, P, lambda f=f, v=v, what=what: _query(
                     f, lambda s: _translation(s, v), what),
                 label=EVERY_CELL, timeout_ms=TRANSLATION_TIMEOUT_MS))

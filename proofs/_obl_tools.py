@@ -1151,7 +1151,210 @@ def tool_region_query(tk: ToolKit | None = None) -> Z3Query:
         check_tool_reading(reading)
         tk = tool_kit(reading)
     vcs = [L.vc for L in tk.lemmas.values()]
-    return Z3Query(tuple(vcs[:-1]) + (tk.points, vcs[-1]))
+    return Z3Query(tuple(vcs[:-1]) + (tk.points, vcs[-1])
+                   + tuple(tool_statement_vc(tag, tk) for tag in ("L", "R")))
+
+
+# --- the tool's statement: what the compositions read of Safety.tool_region ---------------------
+
+def tool_statement(tag: str) -> tuple[list[z3.ExprRef], z3.BoolRef]:
+    """The tool's region statement for arm ``tag`` (L, R), over its bound names: for every box,
+    lattice anchor and spacing (0 < g_q <= G_MAX), configuration theta in the box and point p, a
+    point of the arm's tool (part 3) at theta is a member of the region built for the tool, the
+    box, the anchor and the spacing: Safety.region_statement's form for part 3."""
+    from ._obl_safety import region_statement, ArmModel
+    return region_statement(ArmModel.named(tag), 2)
+
+
+def tool_statement_closed(tag: str) -> z3.BoolRef:
+    bound, body = tool_statement(tag)
+    return z3.ForAll(bound, body)
+
+
+@dataclass(frozen=True)
+class ToolModel:
+    """One arm's tool as the compositions read it: the arm's base, l1, l2 and V vertices (in
+    the proofs' names for the arm, ``tag``), the opaque "p is a point of part 3 at theta"
+    (linkL/linkR at 2) and its local quantities (the chain's weights and points, the point's
+    coordinates in link 2's frame: functions of theta and p), and the region built for it."""
+
+    tag: str
+    tool: SymTool
+    loc: dict[str, z3.FuncDeclRef]
+
+    @classmethod
+    def named(cls, tag: str) -> ToolModel:
+        args = [z3.RealSort()] * 4
+        loc = {n: z3.Function(f"{tag}.tl.{n}", *args, _R)
+               for n in ["u", "v"] + [f"t{k}" for k in range(2, V + 1)]
+               + [f"c{k}.{a}" for k in range(2, V + 1) for a in "xy"]}
+        return cls(tag, SymTool.named(tag), loc)
+
+    def at(self, name: str, theta: Vec, p: Vec) -> z3.ArithRef:
+        return self.loc[name](theta[0], theta[1], p[0], p[1])
+
+    def definition(self, theta: Vec, p: Vec) -> z3.BoolRef:
+        """Definitional (docs/model.md §2): a point p of the tool at theta is the point of link
+        2's frame (origin at the elbow, x along the forearm) at (u, v) = (l2, 0) + a point of
+        the polygon, a chain of two-point convex combinations of its vertices (weights t_k in
+        [0, 1], points c_k), all functions of theta and p."""
+        from ._obl_safety import link_l, link_r
+        t = self.tool
+        link = link_l if self.tag == "L" else link_r
+
+        def vert(k: int) -> Vec:
+            return (t.l2 + t.verts[k][0], t.verts[k][1])
+
+        def chain(k: int) -> Vec:
+            return vert(0) if k == 0 else (self.at(f"c{k + 1}.x", theta, p),
+                                           self.at(f"c{k + 1}.y", theta, p))
+        conds = []
+        for k in range(1, V):
+            tk = self.at(f"t{k + 1}", theta, p)
+            conds += [0 <= tk, tk <= 1, _veq(chain(k), _comb(chain(k - 1), vert(k), tk))]
+        uv = (self.at("u", theta, p), self.at("v", theta, p))
+        conds += [_veq(uv, chain(V - 1)),
+                  _veq(p, _point2(t.b, t.l1, theta[0], theta[0] + theta[1], uv[0], uv[1]))]
+        return z3.Implies(link(2, theta, p), z3.And(conds))
+
+    def hull_definition(self, reading: ToolReading, box: Any, anchor: Vec, g: Vec,
+                        re: z3.ArithRef) -> tuple[list[z3.ExprRef], z3.BoolRef]:
+        """Definitional (docs/model.md §4.2: the tool's region is the convex hull of the tool
+        grown by impl.sweep_margin at the lattice configurations of impl.lattice_range): a
+        convex combination of points of the grown tools at four lattice configurations, each
+        (l2, 0) + a point of the polygon moved by a point of the square [-Delta, Delta]^2 in
+        that configuration's frame (the grown tool: tool_points), is a member of the region.
+        Stated at the corners the proof combines; returns its bound names and its body."""
+        from ._obl_safety import _SWEPT_L, _SWEPT_R, _swept, lattice_range, member
+        t = self.tool
+        pre = f"{self.tag}.td!"
+        lat = [lattice_range(box[q][0], box[q][1], anchor[q], g[q]) for q in range(2)]
+        moving = (lat[0][1] > lat[0][0], lat[1][1] > lat[1][0])
+        delta = tool_margin(reading, g, re, moving)
+        bound: list[z3.ExprRef] = []
+        conds: list[z3.BoolRef] = []
+        ts = [z3.Real(f"{pre}t{k}") for k in range(2, V + 1)]
+        cs = [_v(f"{pre}c{k}") for k in range(2, V + 1)]
+        u0, v0 = z3.Reals(f"{pre}u {pre}v")
+        bound += ts + [x for c in cs for x in c] + [u0, v0]
+
+        def vert(k: int) -> Vec:
+            return (t.l2 + t.verts[k][0], t.verts[k][1])
+        chain = [vert(0)] + cs
+        for k in range(1, V):
+            conds += [0 <= ts[k - 1], ts[k - 1] <= 1,
+                      _veq(chain[k], _comb(chain[k - 1], vert(k), ts[k - 1]))]
+        conds.append(_veq((u0, v0), chain[V - 1]))
+        pts: list[Vec] = []
+        ws: list[z3.ArithRef] = []
+        for c in range(4):
+            i, j = z3.Int(f"{pre}i{c}"), z3.Int(f"{pre}j{c}")
+            al, be, ph, w = z3.Reals(f"{pre}alpha{c} {pre}beta{c} {pre}phi{c} {pre}w{c}")
+            s = _v(f"{pre}s{c}")
+            bound += [i, j, al, be, ph, w, s[0], s[1]]
+            conds += [lat[0][0] <= i, i <= lat[0][1], al == anchor[0] + z3.ToReal(i) * g[0],
+                      lat[1][0] <= j, j <= lat[1][1], be == anchor[1] + z3.ToReal(j) * g[1],
+                      ph == al + be, w >= 0, in_square(s, delta)]
+            pts.append(_point2(t.b, t.l1, al, ph, u0 + s[0], v0 + s[1]))
+            ws.append(w)
+        q = _v(f"{pre}q")
+        conds += [z3.Sum(ws) == 1, _veq(q, _weighted(ws, pts))]
+        swept = _SWEPT_L if self.tag == "L" else _SWEPT_R
+        body = z3.Implies(z3.And(conds), member(_swept(swept, 2, box, anchor, g), q))
+        return bound + [q[0], q[1]], body
+
+
+#: tool_in_region's hypotheses the statement discharges itself: the arm (the statement's
+#: premise), theta in the box and the spacings (its antecedent), the tool's point (the tool's
+#: definition).
+_TOOL_DERIVED = ("the arm (docs/model.md §2): l1 > 0", "theta in the box",
+                 "lattice spacings 0 < g_q <= 3.14")
+
+
+def tool_statement_vc(tag: str, tk: ToolKit, *, hull: Callable[..., Any] | None = None) -> VC:
+    """The tool's statement for arm ``tag``: its body at its bound names (so its universal
+    closure), from the tool's definition at (theta, p), the hull's definition at the corners
+    tool_in_region exhibits, and tool_in_region (proved in Safety.tool_region) instantiated by
+    substitution at the arm's tool, the box, theta and the point's local quantities. ``hull``
+    replaces ToolModel.hull_definition (the tests' mutants)."""
+    from ._obl_safety import concrete
+    lem = tk["tool_in_region"]
+    reading = tk.reading
+    src, m = reading.tool, ToolModel.named(tag)
+    dst = m.tool
+    bound, goal = tool_statement(tag)
+    lo1, hi1, lo2, hi2, a1, a2, g1, g2, t1, t2, p1, p2 = bound
+    box, anchor, g, theta, p = ((lo1, hi1), (lo2, hi2)), (a1, a2), (g1, g2), (t1, t2), (p1, p2)
+    R = z3.Real
+    # The reading's tool and its named roots and maxes, renamed to the arm's.
+    pairs: list[tuple[z3.ExprRef, z3.ExprRef]] = [
+        (src.b[0], dst.b[0]), (src.b[1], dst.b[1]), (src.l1, dst.l1), (src.l2, dst.l2)]
+    for a, b in zip(src.verts, dst.verts):
+        pairs += [(a[0], b[0]), (a[1], b[1])]
+    for r in reading.root_of:
+        pairs.append((r, R(f"{tag}.{r}")))
+    for n, _ in reading.max_defs:
+        old = n.split(" ")[0]
+        pairs.append((R(old), R(f"{tag}.{old}")))
+    renamed = list(pairs)
+    re = R(f"{tag}.tool.Re")
+    pairs.append((R("tir.Re"), re))
+    pairs += [(R("tir.lo1"), lo1), (R("tir.hi1"), hi1), (R("tir.theta1"), t1), (R("tir.A1"), a1),
+              (R("tir.g1"), g1), (R("tir.lo2"), lo2), (R("tir.hi2"), hi2), (R("tir.theta2"), t2),
+              (R("tir.A2"), a2), (R("tir.g2"), g2),
+              (R("tir.u"), m.at("u", theta, p)), (R("tir.v"), m.at("v", theta, p))]
+    for k in range(2, V + 1):
+        pairs += [(R(f"tir.t{k}"), m.at(f"t{k}", theta, p)),
+                  (R(f"tir.c{k}.x"), m.at(f"c{k}.x", theta, p)),
+                  (R(f"tir.c{k}.y"), m.at(f"c{k}.y", theta, p))]
+    names = {n for n, _ in lem.hyps}
+    missing = [n for n in _TOOL_DERIVED if n not in names]
+    if missing:
+        raise KeyError(f"tool_in_region has no hypotheses {missing}: _TOOL_DERIVED is out of date")
+
+    def sub(f: z3.ExprRef) -> z3.ExprRef:
+        return concrete(z3.substitute(f, *pairs))
+    point = {n for n, _ in ToolPoint.named(reading, "tir").hyps()}
+    defs = [(f"{n} [tool_in_region's named quantity]", sub(h)) for n, h in lem.hyps
+            if n not in _TOOL_DERIVED and n not in point
+            and not n.startswith(("A3 ", "by "))]
+    # The corners, weights and offsets tool_in_region's conclusion names.
+    c1, G1, c2, G2 = R("tir.joint1.c"), R("tir.joint1.G"), R("tir.joint2.c"), R("tir.joint2.G")
+    j1, st1 = z3.Int("tir.joint1.j"), z3.If(z3.Bool("tir.joint1.moving"), 1, 0)
+    j2, st2 = z3.Int("tir.joint2.j"), z3.If(z3.Bool("tir.joint2.moving"), 1, 0)
+    lam, mu, nu = z3.Reals("tir.lam tir.mu tir.nu")
+    D = _v("tir.D")
+    c1e = c1 + G1
+    alphas = (c1, c1, c1e, c1e)
+    betas = (c2, c2 + G2, c2, c2 + G2)
+    phis = (c1 + c2, (c1 + c2) + G2, c1e + c2, (c1e + c2) + G2)
+    i_s = (j1, j1, j1 + st1, j1 + st1)
+    j_s = (j2, j2 + st2, j2, j2 + st2)
+    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
+    hull_bound, hull_body = (hull or m.hull_definition)(reading, box, anchor, g, re)
+    hull_body = z3.substitute(hull_body, *renamed)
+    vals: list[z3.ExprRef] = [m.at(f"t{k}", theta, p) for k in range(2, V + 1)]
+    for k in range(2, V + 1):
+        vals += [m.at(f"c{k}.x", theta, p), m.at(f"c{k}.y", theta, p)]
+    vals += [m.at("u", theta, p), m.at("v", theta, p)]
+    for c in range(4):
+        off = _offset(phis[c], D)
+        vals += [i_s[c], j_s[c], alphas[c], betas[c], phis[c], ws[c], off[0], off[1]]
+    vals += [p1, p2]
+    hull_inst = z3.substitute(hull_body, *zip(hull_bound, [sub(x) for x in vals]))
+    key = f"{tag}: the tool's hull definition at tool_in_region's corners (docs/model.md §4.2)"
+    hyps: list[Hyp] = [
+        (f"{tag}: the arm (docs/model.md §2): l1 > 0", dst.l1 > 0),
+        (f"{tag}: the tool's definition (docs/model.md §2) at (theta, p)",
+         m.definition(theta, p)),
+        (key, concrete(hull_inst)),
+    ]
+    hyps += defs
+    hyps += [(n, concrete(h)) for n, h in lem.use(pairs, f"{tag}, the tool")]
+    wit = tuple((sub(c), v) for c, v in lem.vc.witness)
+    from ._obl_safety import _dedupe
+    return VC(f"tool_statement_{tag}", _dedupe(hyps), goal, key_premise=key, witness=wit,
+              counter_witness=wit)
 
 
 # --- the certificate's and the tube's constants with a tool (docs/model.md §7.2, §12) ---------
@@ -1467,7 +1670,13 @@ def tools_obligations() -> list[Obligation]:
             "that square, so each corner's grown point, a point of the polygon plus a point of the "
             "square, lies in the hull of impl's points there (the sum of two convex polygons is "
             "the hull of their vertices' sums: stated, not proved here), and the tool's point in "
-            "the hull of impl's points over the box's lattice. Faults refuted: a vertex left out "
+            "the hull of impl's points over the box's lattice. tool_statement_L/R: what the "
+            "compositions read, for each arm: a point of the tool at a configuration of a box is "
+            "a member of the region built for the tool and the box, derived from the tool's "
+            "definition (link 2's frame at (l2, 0) plus a chain of convex combinations of the "
+            "vertices), the hull's definition (the grown tool at four lattice configurations, "
+            "each a point of the polygon moved by a point of the square) and tool_in_region by "
+            "substitution. Faults refuted: a vertex left out "
             "of the points (tool_points), the margin from the nearest vertex (far_vertex), the "
             "polygon turned with link 1 (tool_points).",
             Method.Z3, Verdict.PROVED, tool_region_query, label="hull of sums stated"),

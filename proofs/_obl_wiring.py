@@ -44,8 +44,9 @@ from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Verd
                           check_source)
 from ._symexec import Explorer, ExtractionError, Path, SymArray, SymNumpy, obj, rebind
 
-__all__ = ["GROUP_MONITOR", "KEY_GAP", "KEY_ROW", "KEY_SEGMENT", "PIECE_CASES", "grid_motion_vcs",
-           "pieces_failures", "reference_speed_vcs", "trajectory_motion_vcs", "wiring_obligations"]
+__all__ = ["GROUP_MONITOR", "KEY_GAP", "KEY_ROW", "KEY_SEGMENT", "PIECE_CASES", "exact_cells",
+           "exact_coverage_failures", "grid_motion_vcs", "is_path_reads", "pieces_failures",
+           "reference_speed_vcs", "trajectory_motion_vcs", "wiring_obligations"]
 
 GROUP_MONITOR = "Trajectories (docs/model.md §12)"
 
@@ -374,6 +375,60 @@ def _pieces_query() -> CheckQuery:
     content = (check_source(spec.GridMotion.pieces, pieces_failures)
                + f"\ncases: {PIECE_CASES!r}")
     return CheckQuery(_pieces_check, content)
+
+
+# --- the exact re-decision's cells (spec.exact_path_gaps) ----------------------------------
+
+
+class _RecordingDR:
+    """Stands for D_R in ``spec.path_violations``: every entry reads 0 (free) and is recorded
+    as (layer, cell), so the fixed is_path's own loops say which entries a path rests on."""
+
+    def __init__(self, N: int, m: int, n: int) -> None:
+        self.shape = (N + 1, m, n)
+        self.reads: dict[tuple[int, tuple[int, int]], None] = {}
+
+    def __getitem__(self, key: tuple[int, int, int]) -> int:
+        layer, i, j = (int(x) for x in key)
+        self.reads[(layer, (i, j))] = None
+        return 0
+
+
+def is_path_reads(path: Sequence[Sequence[int]], N: int) -> list[tuple[int, tuple[int, int]]]:
+    """The (layer, cell) entries of D_R that the fixed is_path (``spec.path_violations``, run
+    on a recording D_R) reads for ``path`` with N motion layers: the entries a found path's
+    safety rests on, the rest layer N included."""
+    cells = [(int(c[0]), int(c[1])) for c in path]
+    rec = _RecordingDR(N, max(i for i, _ in cells) + 1, max(j for _, j in cells) + 1)
+    spec.path_violations(cells, rec, cells[0], cells[-1])    # type: ignore[arg-type]
+    return list(rec.reads)
+
+
+def exact_cells(s: Any, variant: Any, grid: Any, path: Sequence[Sequence[int]],
+                exact: Any = None) -> list[tuple[int, tuple[int, int]]]:
+    """The (layer, cell) pairs ``exact_path_gaps`` (default ``spec.exact_path_gaps``) decides
+    for ``path``: its own code run with the geometry replaced (each pair's regions by
+    placeholders, one part pair, a gap of 1 m), so its loop, its layer and cell choice and its
+    records are what runs, in milliseconds rather than the seconds of ball arithmetic."""
+    f = spec.exact_path_gaps if exact is None else exact
+    arb = f.__globals__["arb"]
+    cheap = rebind(f, _left_points=lambda *a: [None], _right_points=lambda *a: [None],
+                   pairs_to_test=lambda *a: [(0, 0)], _gap=lambda a, b: arb(1))
+    return [(c.layer, c.cell) for c in cheap(s, variant, grid, path).cells]
+
+
+def exact_coverage_failures(s: Any, variant: Any, grid: Any, path: Sequence[Sequence[int]],
+                            exact: Any = None) -> list[str]:
+    """Where the exact re-decision of ``path`` (``exact_cells``) differs from what the fixed
+    is_path reads (``is_path_reads``): a pair it leaves out (a cell of the path never
+    re-decided; the rest layer's, typically) or one it adds. Empty: it visits every one."""
+    got, want = exact_cells(s, variant, grid, path, exact), is_path_reads(path, grid.N)
+    bad = [f"the exact re-decision leaves out layer {layer}, cell {list(c)}"
+           + (" (the rest layer)" if layer == grid.N else "")
+           for layer, c in want if (layer, c) not in set(got)]
+    bad += [f"the exact re-decision decides layer {layer}, cell {list(c)}, which is_path does "
+            "not read" for layer, c in got if (layer, c) not in set(want)]
+    return bad
 
 
 # --- the obligations ------------------------------------------------------------------------

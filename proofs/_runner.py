@@ -20,7 +20,7 @@ import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import sympy
 import z3
@@ -265,7 +265,8 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                     expected: Sequence[str], *, note: str = "",
                     record: dict[str, Any] | None = None, lock: str | Path | None = None,
                     repin: bool = False, workers: int = 1,
-                    controls: Sequence[Control] = ()) -> ProveRun:
+                    controls: Sequence[Control] = (),
+                    progress: TextIO | None = None) -> ProveRun:
     """Discharge each obligation (in ``workers`` forked processes side by side; the results do
     not depend on how many), save its query and the results, compare with the last run;
     every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``,
@@ -273,9 +274,9 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
     ``repin`` rewrites first (for the obligations run; after a whole run, dropping the rest).
     cvc5 replays each VC in the background while Z3 goes on (``_cvc5.Cvc5Pool``). Then the
     negative ``controls`` run (side by side too); the run is OK only if each ends as it
-    expects. ``repin`` never touches what a control expects."""
-    from ._cvc5 import Cvc5Pool
-
+    expects. ``repin`` never touches what a control expects. ``progress``: a line per group of
+    obligations as its last one ends, and one for the controls (``GroupProgress``); the results
+    do not depend on it."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     previous = _load_previous(out / "results.json")
@@ -283,14 +284,15 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
     # cvc5 replays the statements it decided when they were pinned (--repin: every one).
     skip = {} if repin else cvc5_skips(load_lock(lock_path))
     t0 = time.perf_counter()
+    told = GroupProgress(obligations, progress)
     if workers > 1 and len(obligations) > 1:
         cost = {i: float(o.get("seconds") or 0.0) for i, o in previous.items()}
-        proofs = _discharge_side_by_side(obligations, skip, workers, cost)
+        proofs = _discharge_side_by_side(obligations, skip, workers, cost, told)
     else:
-        with Cvc5Pool() as pool:
-            pending = [discharge_pending(o, pool, skip) for o in obligations]
-            proofs = tuple(p.settle() for p in pending)
+        proofs = _discharge_in_turn(obligations, skip, told)
     checked = _controls_side_by_side(controls, workers)
+    if controls:
+        told.line("negative controls", len(checked), sum(c.seconds for c in checked))
     seconds = time.perf_counter() - t0
     repinned = None
     if repin:
@@ -333,6 +335,61 @@ def default_workers() -> int:
     return 2 if (os.cpu_count() or 1) >= 2 else 1
 
 
+class GroupProgress:
+    """A line per group of obligations on ``stream`` as the last of the group ends: the group,
+    how many, their own time (summed: side by side it exceeds the wall clock) and the time since
+    the run began; in the order the groups end, which the results do not depend on. None:
+    silent."""
+
+    def __init__(self, obligations: Sequence[Obligation], stream: TextIO | None) -> None:
+        self.stream = stream
+        self.start = time.perf_counter()
+        self.left: dict[str, int] = {}
+        for o in obligations:
+            self.left[o.group] = self.left.get(o.group, 0) + 1
+        self.count = dict(self.left)
+        self.work = dict.fromkeys(self.left, 0.0)
+
+    def done(self, ob: Obligation, p: Proof) -> None:
+        """``ob`` has ended with ``p``: the line of its group if it was the group's last."""
+        self.work[ob.group] += p.seconds
+        self.left[ob.group] -= 1
+        if self.left[ob.group] == 0:
+            self.line(ob.group, self.count[ob.group], self.work[ob.group])
+
+    def line(self, what: str, n: int, work: float) -> None:
+        if self.stream is not None:
+            self.stream.write(f"prove: {what}: {n} done, {work:.1f} s of work, at "
+                              f"{time.perf_counter() - self.start:.1f} s\n")
+            self.stream.flush()
+
+
+def _discharge_in_turn(obligations: Sequence[Obligation], skip: dict[str, str],
+                       told: GroupProgress) -> tuple[Proof, ...]:
+    """Each obligation discharged in this process, one after another, cvc5 replaying behind Z3;
+    each settled (``_Pending.settle``, the same Proof whenever it is called) as soon as its
+    replays are done, so that a group's line comes when the group is, not at the end."""
+    from ._cvc5 import Cvc5Pool
+
+    out: list[Proof | None] = [None] * len(obligations)
+    pending: dict[int, Any] = {}
+
+    def settle(i: int) -> None:
+        out[i] = pending.pop(i).settle()
+        told.done(obligations[i], out[i])
+
+    with Cvc5Pool() as pool:
+        for i, o in enumerate(obligations):
+            pending[i] = discharge_pending(o, pool, skip)
+            for j in [j for j, p in pending.items()
+                      if all(f is None or f.done() for f in p.futures)]:
+                settle(j)
+        for j in sorted(pending):
+            settle(j)
+    assert all(p is not None for p in out)
+    return tuple(out)  # type: ignore[arg-type]
+
+
 # What a worker process of _discharge_side_by_side works on: set before the pool forks, so the
 # obligations (closures) are inherited, never pickled; only an index goes out, a Proof back.
 _SHARED: dict[str, Any] = {}
@@ -356,12 +413,14 @@ def _worker_discharge(index: int) -> Proof:
 
 
 def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, str], jobs: int,
-                            cost: dict[str, float]) -> tuple[Proof, ...]:
+                            cost: dict[str, float], told: GroupProgress | None = None
+                            ) -> tuple[Proof, ...]:
     """Each obligation discharged in one of ``jobs`` forked processes, the longest (by the last
     run's seconds) first so that the two finish together; returned in the given order. An
-    obligation whose process dies is FAILED with that reason, never lost or waited for."""
+    obligation whose process dies is FAILED with that reason, never lost or waited for. Each is
+    told to ``told`` as it ends."""
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures import ProcessPoolExecutor, as_completed
 
     order = sorted(range(len(obligations)), key=lambda i: -cost.get(obligations[i].id, 0.0))
     _SHARED.update(obligations=obligations, skip=skip)
@@ -370,13 +429,16 @@ def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, s
         with ProcessPoolExecutor(max_workers=min(jobs, len(obligations)),
                                  mp_context=multiprocessing.get_context("fork"),
                                  initializer=_worker_start) as ex:
-            futures = {i: ex.submit(_worker_discharge, i) for i in order}
-            for i in order:
+            futures = {ex.submit(_worker_discharge, i): i for i in order}
+            for fut in as_completed(futures):
+                i = futures[fut]
                 try:
-                    out[i] = futures[i].result()
+                    out[i] = fut.result()
                 except Exception as exc:  # noqa: BLE001 - a dead worker is a verdict, not a crash
                     why = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
                     out[i] = failed_proof(obligations[i], f"its worker process ended ({why})")
+                if told is not None:
+                    told.done(obligations[i], out[i])  # type: ignore[arg-type]
     finally:
         _SHARED.clear()
     assert all(p is not None for p in out)      # every future ended in a Proof, above

@@ -45,9 +45,9 @@ _IN_BOX = ("The principal arm's straight joint-space motion stays, within each t
 _COMPOSED = ("The safety theorem ({variant} variant): if D_R is as Theorems 1/3 say and the path is "
              "valid, the two arms share no point at any instant of the executed motion, in "
              "continuous time, not only at the grid's instants.")
-_TRANSLATION = ("{workcell}, {variant}: the D_R and the path that the fast compiled code computes "
-                "for this workcell meet Theorem {dr}'s and {search}'s postconditions at every "
-                "cell; the search's answer (a least-cost path, or none) is checked by its witness.")
+_TRANSLATION = ("{workcell}, {variant}: the fast code's D_R and path meet Theorem {dr}'s and "
+                "{search}'s postconditions at every cell; the search's answer is checked by its "
+                "witness; the exact re-decision visits every cell of the path.")
 
 #: Obligation id (or pattern) -> its plain summary.
 SUMMARIES: dict[str, str] = {
@@ -158,7 +158,8 @@ SUMMARIES: dict[str, str] = {
         "no link point moves more than the constant times the tolerance."),
     "Exact.gap_formula": (
         "The gap the exact re-check computes along a separating direction, divided by that "
-        "direction's length, never exceeds the true distance between the two regions."),
+        "direction's length, never exceeds the true distance between the two regions, a "
+        "tool's polygon included."),
     "Tolerance.tube": "A robot that tracks a plan proved clear by c to within delta in every "
                       "joint cannot collide while c > 2 L delta, L the largest reach of a link "
                       "about its two joints (metres per radian).",

@@ -201,11 +201,18 @@ def build_audit(scenarios: Sequence[str] | None, *, argv: Sequence[str] | None =
                    argv=argv, compare_n=compare_n, compare_seed=compare_seed,
                    recorded=recorded, campaign=campaign, proofs_json=proofs_json,
                    expected_ids=expected_ids, stages=stages, plans=_Plans(contracts, stages))
-    for sec in compute_order(chosen):
-        parts = sec.compute(ctx)
-        if set(parts) != set(sec.keys):
-            raise ValueError(f"section {sec.key!r} computed {sorted(parts)}, not {list(sec.keys)}")
-        ctx.doc.update(parts)
+    if any(sec.deferred for sec in chosen):
+        ctx.start_proofs()              # discharged side by side with the other sections
+    try:
+        for sec in compute_order(chosen):
+            parts = sec.compute(ctx)
+            if set(parts) != set(sec.keys):
+                raise ValueError(f"section {sec.key!r} computed {sorted(parts)}, "
+                                 f"not {list(sec.keys)}")
+            ctx.doc.update(parts)
+    finally:
+        if ctx.background is not None:  # not taken (an error): the run is ended, not left
+            ctx.background.close()
     for sec in chosen:
         if sec.finish is not None:
             sec.finish(ctx.doc)
@@ -237,6 +244,7 @@ class _Context:
     figures: dict[str, F.Figure] = dataclasses.field(default_factory=dict)
     doc: dict[str, Any] = dataclasses.field(default_factory=dict)
     _proofs: ProofData | None = None
+    background: _FreshProofs | None = None   # the fresh run, started early (``start_proofs``)
 
     def proofs(self) -> ProofData:
         """The obligation data; the user's workcells are the ones to prove: given files bring
@@ -245,10 +253,134 @@ class _Context:
             source = self.proofs_json
             with self.stages.stage("proofs (" + ("discharged afresh" if source is None else
                                                 "read from the prove run") + ")"):
-                self._proofs = load_proofs(source() if callable(source) else source, self.sdir,
-                                           self.expected_ids,
-                                           files=self.paths if self.given else None)
+                got, self.background = (self.background.result() if self.background else None,
+                                        None)
+                self._proofs = got if got is not None else self._load(
+                    source() if callable(source) else source, self.stages.stream)
         return self._proofs
+
+    def _load(self, source: str | None, progress: TextIO | None) -> ProofData:
+        return load_proofs(source, self.sdir, self.expected_ids,
+                           files=self.paths if self.given else None, progress=progress)
+
+    def start_proofs(self) -> None:
+        """A fresh run of the obligations begun now, in a forked process, while this one
+        computes the other sections (``_FreshProofs``); ``proofs`` takes its data."""
+        if self.proofs_json is None and self._proofs is None and self.background is None:
+            self.background = _FreshProofs(lambda told: self._load(None, told),
+                                           self.stages.stream)
+
+
+class _FreshProofs:
+    """``run`` (the fresh prove run: its own worker processes, docs/model.md §8) in a forked
+    process begun at once; ``result`` waits for its ProofData, which comes back pickled, the
+    same data as run here. Its line per group goes straight to ``stream`` when that is a file
+    (the terminal: as each group ends), else back with the data. An exception raised there is
+    raised by ``result``; a process that ends without an answer gives None (the caller then
+    runs the obligations itself). ``close`` ends a run whose result is not wanted."""
+
+    def __init__(self, run: Callable[[TextIO | None], ProofData], stream: TextIO | None) -> None:
+        import multiprocessing
+        import sys
+
+        mp = multiprocessing.get_context("fork")
+        self.stream = stream
+        self._recv, send = mp.Pipe(duplex=False)
+        direct = _file_stream(stream)
+        for f in (sys.stdout, sys.stderr, stream):
+            if f is not None:
+                f.flush()
+        self._proc = mp.Process(target=_fresh_child, args=(run, send, direct, stream is None),
+                                name="cfmpa-audit-proofs")
+        self._proc.start()
+        send.close()
+        _own_group(self._proc.pid)
+
+    def result(self) -> ProofData | None:
+        try:
+            while True:
+                try:
+                    kind, value = self._recv.recv()
+                except Exception:  # noqa: BLE001 - ended, died, or an answer that won't unpickle
+                    return None
+                if kind != "line":
+                    break
+                if self.stream is not None:
+                    self.stream.write(value)
+                    self.stream.flush()
+        finally:
+            self._proc.join(timeout=10)        # it ends once its answer is sent
+            self.close()
+        if kind == "raised" and isinstance(value, BaseException):
+            raise value
+        return value if isinstance(value, ProofData) else None
+
+    def close(self) -> None:
+        """End the run (its process group: its workers and cvc5 too) unless it has ended."""
+        import os
+        import signal
+
+        if self._proc.is_alive():
+            try:
+                os.killpg(self._proc.pid, signal.SIGTERM)
+            except OSError:
+                self._proc.terminate()
+        self._proc.join()
+        self._recv.close()
+
+
+def _own_group(pid: int | None) -> None:
+    """Make ``pid`` the leader of a process group of its own (called in both processes, so it
+    holds whichever runs first): ``_FreshProofs.close`` ends it with all its processes."""
+    import os
+
+    try:
+        os.setpgid(pid or 0, pid or 0)
+    except OSError:                    # it has ended already, or no such call here
+        pass
+
+
+class _Lines(io.TextIOBase):
+    """A stream whose lines go back to the parent through ``send`` (the child's progress)."""
+
+    def __init__(self, send: Any) -> None:
+        self._send = send
+
+    def write(self, text: str) -> int:
+        self._send.send(("line", text))
+        return len(text)
+
+
+def _file_stream(stream: TextIO | None) -> TextIO | None:
+    """``stream`` if a forked process can write to it (it has a file descriptor), else None."""
+    try:
+        stream.fileno()  # type: ignore[union-attr]
+    except (AttributeError, OSError, ValueError):
+        return None
+    return stream
+
+
+def _fresh_child(run: Callable[[TextIO | None], ProofData], send: Any,
+                 direct: TextIO | None, silent: bool) -> None:
+    import os
+
+    from ..impl import set_kernel_threads
+
+    _own_group(None)
+    set_kernel_threads(1)          # beside this audit's own process
+    code = 0
+    try:
+        told = None if silent else (direct if direct is not None else _Lines(send))
+        send.send(("done", run(told)))
+    except BaseException as exc:   # noqa: BLE001 - handed to the parent, raised there
+        try:
+            send.send(("raised", exc))
+        except Exception:          # noqa: BLE001 - unpicklable: the parent runs it itself
+            code = 1
+    finally:
+        if direct is not None:
+            direct.flush()
+    os._exit(code)
 
 
 def _template_source(name: str) -> str:
@@ -382,6 +514,11 @@ ROW_OBLIGATION_PREFIXES = ("Safety.", "Certificate.", "Tolerance.")
 _VARIANTS = tuple(v.value for v in Variant)
 
 
+def _tools_or_heights(s: Scenario) -> bool:
+    """Whether a workcell has a tool or a height interval: its safety rests on ledger A13 too."""
+    return any(arm.tool is not None or arm.z is not None for arm in (s.left, s.right))
+
+
 def row_requirements(stem: str, variant: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(obligation ids, control ids) a found plan's row of workcell ``stem`` (its file's stem)
     and ``variant`` rests on: ROW_OBLIGATION_PREFIXES' ids of the prove machinery, of this
@@ -477,7 +614,8 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
     ``tolerance_farthest_point_mm``, also under its former name ``tolerance_tip_mm`` for format
     version 1), the ledger ids it rests on, its verdict and why, ``missing``: the obligations
     and controls it rests on that are not in this run, and ``scope``: ``spec.theorem_scope``,
-    what the safety theorem does not yet cover of the workcell (a tool, heights), or None.
+    what the safety theorem does not cover of the workcell, or None (every workcell today: tools
+    and heights are covered; such a row rests on ledger A13 too).
 
     A found plan's verdict rests on what ran (``row_requirements``): ``ok`` is True ("safe")
     for a plan certified clear with no contract violation whose every required obligation and
@@ -509,7 +647,8 @@ def workcell_summary(loaded: Sequence[Scenario], doc: Mapping[str, Any]) -> list
             needs: tuple[str, ...] = ()
             missing: tuple[str, ...] = ()
             if v["status"] == "found" and cl and cl["clear"] and not violations:
-                needs = _SAFETY_ASSUMPTIONS + (() if translated else ("A5",))
+                needs = _SAFETY_ASSUMPTIONS + (() if translated else ("A5",)) + (
+                    ("A13",) if _tools_or_heights(s) else ())
                 why = ["certified clear in continuous time",
                        f"contracts held ({(v['contracts'] or {}).get('mode', 'not recorded')})"]
                 missing = standing.missing

@@ -409,7 +409,7 @@ def variants_figure(fid: str, s: Scenario, g: Grid, drs: Mapping[Variant, npt.ND
     # Above the axes, not over the curves (they rise to the top right in every scenario).
     a.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=3, frameon=False,
              fontsize=8)
-    order = [v for v in (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT) if v in regions]
+    order = [v for v in Variant if v in regions]
     polys = [p for v in order for p in regions[v]]
     for col, v in enumerate(order):
         b = fig.add_subplot(grid[1, col])
@@ -627,7 +627,7 @@ def inconsistency_figure(fid: str, d: InconsistencyData) -> Figure:
     t = np.linspace(0, d.grid.Tf, 200)
     th = left_angles(s, t)
     a.plot(th[:, 0], th[:, 1], color=LEFT_COLOR, lw=1, label="principal's planned motion")
-    for v in (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT):
+    for v in Variant:
         (x0, x1), (y0, y1) = d.boxes[v]
         if x1 - x0 < 1e-9 and y1 - y0 < 1e-9:
             a.plot([x0], [y0], marker="P", ms=9, color=VARIANT_COLORS[v], ls="",
@@ -648,7 +648,7 @@ def inconsistency_figure(fid: str, d: InconsistencyData) -> Figure:
     a.set_ylabel("θ2 of the principal (rad)")
     a.set_title(f"joint boxes at the last layer k = {d.layer}")
     a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), fontsize=7)
-    order = (Variant.ORIGINAL, Variant.MODIFIED, Variant.TIGHT)
+    order = tuple(Variant)
     for ax in (b, c):
         for v in order:
             for idx, p in enumerate(d.regions[v]):

@@ -23,7 +23,7 @@ import json
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from ..errors import InputError
 
@@ -194,13 +194,15 @@ class ProofData:
 
 def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
                 expected: Sequence[str] | None = None,
-                files: Sequence[str | Path] | None = None) -> ProofData:
+                files: Sequence[str | Path] | None = None,
+                progress: TextIO | None = None) -> ProofData:
     """Obligations and ledger from ``proofs_json``, else from a fresh run (module docstring).
 
     ``expected``: the ids the data must hold (None: ``audited_ids(files)`` when ``files`` is
     given, else ``expected_ids(scenarios_dir)``, every obligation; a prove run restricted with
     ``--only`` is then reported with ids missing). ``files``: the workcells the report is about,
     whose per-scenario obligations are then the ones shown (a given ``expected`` overrides).
+    ``progress``: a fresh run's line per group of obligations as it ends (``run_obligations``).
     """
     from ..proofs import FIXED_IDS, collect_obligations, expected_ids, scenario_obligations
 
@@ -208,13 +210,13 @@ def load_proofs(proofs_json: str | None, scenarios_dir: str | Path,
         want = tuple(expected) if expected is not None else expected_ids(Path(scenarios_dir))
         if proofs_json is not None:
             return _from_file(Path(proofs_json), want)
-        return _fresh(list(collect_obligations(scenarios_dir)), want)
+        return _fresh(list(collect_obligations(scenarios_dir)), want, progress)
     paths = [Path(f) for f in files]
     want = audited_ids(paths)
     if proofs_json is not None:
         return _from_file(Path(proofs_json), want, keep={p.stem for p in paths})
     fixed = [o for o in collect_obligations(scenarios_dir) if o.id in FIXED_IDS]
-    return _fresh(fixed + scenario_obligations(paths), want)
+    return _fresh(fixed + scenario_obligations(paths), want, progress)
 
 
 def audited_ids(files: Sequence[str | Path]) -> tuple[str, ...]:
@@ -486,7 +488,8 @@ def _z3_only(vcs: Any) -> tuple[str, ...]:
 
 # --- a fresh run --------------------------------------------------------------------------------
 
-def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
+def _fresh(obligations: Sequence[Any], expected: Sequence[str],
+           progress: TextIO | None = None) -> ProofData:
     import tempfile
 
     from ..proofs import (ASSUMPTIONS, DEFINITIONAL, FIXED_IDS, collect_controls,
@@ -503,7 +506,7 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str]) -> ProofData:
     controls = collect_controls() if whole else ()
     with tempfile.TemporaryDirectory(prefix="cfmpa-audit-proofs-") as tmp:
         run = run_obligations(obligations, tmp, [o.id for o in obligations], workers=workers,
-                              controls=controls)
+                              controls=controls, progress=progress)
     by_id = {p.id: p for p in run.proofs}
     rows = []
     for ob in obligations:

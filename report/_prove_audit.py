@@ -34,8 +34,10 @@ def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
     the fork (a stream of this process's memory would not reach the terminal from there).
     ``progress``: the report process writes a line per stage with its time on its sys.stderr,
     as `cfmpa audit` does (the proofs' stage last: it waits for this run's results.json)."""
-    # Through the packages, not their modules: the names a caller (or a test's stand-in) sees.
+    # Through the packages, not their modules: the names a caller (or a test's stand-in) sees;
+    # the report's read now, so the forked process starts with its modules imported.
     from .. import proofs, report
+    run_audit = report.run_audit
 
     so = sys.stdout if stdout is None else stdout
     if only:
@@ -51,11 +53,9 @@ def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
         return results
 
     def write_audit() -> int:
-        return int(report.run_audit(None, str(audit), argv=list(argv or ["cfmpa"]),
-                                    proofs_json=proofs_ready,
-                                    progress=sys.stderr if progress else None,
-                                    scenarios_dir=None if scenarios_dir is None
-                                    else str(scenarios_dir)))
+        return int(run_audit(None, str(audit), argv=list(argv or ["cfmpa"]),
+                             proofs_json=proofs_ready, progress=sys.stderr if progress else None,
+                             scenarios_dir=None if scenarios_dir is None else str(scenarios_dir)))
 
     def child() -> None:
         set_kernel_threads(1)          # beside the prove run's processes

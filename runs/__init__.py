@@ -42,6 +42,7 @@ if TYPE_CHECKING:     # the names as the type checker sees them; at run time, _E
     from ._check import CheckReport, check_outputs, read_dr, read_plan, run_check
     from ._drstore import (DR_FILES, DR_STORES, ZARR_ABOVE_CELLS, default_store, dr_sha256_of,
                            find_dr, load_dr, open_dr_layers, write_dr)
+    from ._drdask import BuiltStore, EngineOptions, build_store
     from ._engine import (CONNECT_TIMEOUT_S, RETRIES, WORKER_TIMEOUT_S, Engine, ProgressBar,
                           TaskLost, check_scheduler_address, error_message)
     from ._contracts import (DEFAULT_SAMPLE, Mode, Settings, TripleRun, contracts_json,
@@ -105,6 +106,9 @@ _EXPORTS: dict[str, str] = {
     "load_dr": "._drstore:load_dr",
     "open_dr_layers": "._drstore:open_dr_layers",
     "write_dr": "._drstore:write_dr",
+    "BuiltStore": "._drdask:BuiltStore",
+    "EngineOptions": "._drdask:EngineOptions",
+    "build_store": "._drdask:build_store",
     "CONNECT_TIMEOUT_S": "._engine:CONNECT_TIMEOUT_S",
     "RETRIES": "._engine:RETRIES",
     "WORKER_TIMEOUT_S": "._engine:WORKER_TIMEOUT_S",
@@ -197,6 +201,8 @@ __all__ = [
     # D_R on disk: dr.npy or the chunked dr.zarr (docs/model.md §9)
     "DR_FILES", "DR_STORES", "ZARR_ABOVE_CELLS", "default_store", "dr_sha256_of", "find_dr",
     "load_dr", "open_dr_layers", "write_dr",
+    # D_R built on Dask, blocks of layers into dr.zarr (docs/model.md §9)
+    "BuiltStore", "EngineOptions", "build_store",
     "BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch",
     "CONNECT_TIMEOUT_S", "Engine", "ProgressBar", "RETRIES", "TaskLost", "WORKER_TIMEOUT_S",
     "check_scheduler_address", "error_message",

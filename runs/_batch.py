@@ -1,4 +1,4 @@
-"""`cfmpa check --batch DIR [SCENARIO]`: every plan folder under DIR checked, one task per plan.
+"""`cfmpa check-batch DIR [SCENARIO]`: every plan folder under DIR checked, one task per plan.
 
 A plan folder is any folder under DIR (DIR itself included) holding a plan.json; its D_R is
 expected beside it: the store plan.json's ``dr_store`` names, else dr.npy, else dr.zarr
@@ -85,14 +85,18 @@ def run_batch(root: str | Path, scenario: str | Path | None = None, *,
               json_out: str | Path | None = None, workers: int = 0,
               scheduler: str | None = None, connect_timeout: float = CONNECT_TIMEOUT_S,
               worker_timeout: float = WORKER_TIMEOUT_S, progress: bool | None = None,
-              stream: TextIO | None = None) -> int:
-    """Check every plan folder under ``root``; print the table, write the JSON summary; return
-    the exit code (0 all pass, 1 any fails or errs; InputError for a bad batch; WorkersLost,
-    naming the command to run again, when the cluster had no worker for ``worker_timeout`` s)."""
-    out = sys.stdout if stream is None else stream
+              stdout: TextIO | None = None, stderr: TextIO | None = None,
+              folder_option: str = "DIR") -> int:
+    """`cfmpa check-batch`: check every plan folder under ``root``; print the table and the
+    engine's notes on ``stdout`` (default sys.stdout at call time; errors are raised), write
+    the JSON summary; return the exit code (0 all pass, 1 any fails or errs; InputError for a
+    bad batch; WorkersLost, naming the command to run again, when the cluster had no worker
+    for ``worker_timeout`` s). ``folder_option``: how a message names ``root`` (DIR, or the old
+    spelling's --batch)."""
+    out = sys.stdout if stdout is None else stdout
     top = Path(root)
     if not top.is_dir():
-        raise InputError("--batch", str(root), "must be a folder of plan folders")
+        raise InputError(folder_option, str(root), "must be a folder of plan folders")
     engine = Engine(workers, scheduler, connect_timeout=connect_timeout,
                     worker_timeout=worker_timeout, stream=out)
     scen = None
@@ -101,7 +105,8 @@ def run_batch(root: str | Path, scenario: str | Path | None = None, *,
         load_scenario(scen)              # unreadable: exit 2 before any task
     folders = find_plan_folders(top)
     if not folders:
-        raise InputError("--batch", str(root), "holds no plan folder (a folder with plan.json)")
+        raise InputError(folder_option, str(root), "holds no plan folder (a folder with "
+                         "plan.json)")
     rels = [_rel(f, top) for f in folders]
     rows: list[dict[str, Any] | None] = [None] * len(folders)
 
@@ -121,7 +126,7 @@ def run_batch(root: str | Path, scenario: str | Path | None = None, *,
                        on_done, name="check-plan", progress=bar)
     except WorkersLost as exc:
         checked = sum(r is not None for r in rows)
-        command = ["cfmpa", "check", "--batch", str(root), *([scen] if scen is not None else []),
+        command = ["cfmpa", "check-batch", str(root), *([scen] if scen is not None else []),
                    *(["--json", str(json_out)] if json_out is not None else []),
                    *engine.options()]
         raise WorkersLost(f"{exc}. {checked} of {len(rows)} plans were checked; no summary is "

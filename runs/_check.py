@@ -101,10 +101,12 @@ class CheckReport:
 
 
 def run_check(scenario_path: str | Path, dr_path: str | Path, plan_path: str | Path,
-              witness_path: str | Path | None = None, *, stdout: TextIO | None = None) -> int:
+              witness_path: str | Path | None = None, *, stdout: TextIO | None = None,
+              stderr: TextIO | None = None) -> int:
     """Check the outputs, print the listing on ``stdout``; 0 all hold, 1 some failed; unreadable
     input raises InputError (exit 2) before anything is printed. ``witness_path``: a witness
-    file (`cfmpa plan --witness`) to verify instead of computing one."""
+    file (`cfmpa plan --witness-out`) to verify instead of computing one; ``stderr`` is for
+    errors only, which are raised."""
     so = sys.stdout if stdout is None else stdout
     s = load_scenario(scenario_path)
     # A dr.npy or a dr.zarr (checked against the grid before a chunk is read), and dr_sha256.

@@ -162,18 +162,39 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "as rejected (Control.harness.error_is_not_a_pass)", "proofs/_controls.py",
                (("        outcome, detail = \"error\", f\"{type(exc).__name__}: {exc}\"\n",
                  "        outcome, detail = \"rejected\", f\"{type(exc).__name__}: {exc}\"\n"),)),
-    CodeMutant("theorem_made_definitional", "a theorem moved into the definitional list (its "
-               "kind, pinned in obligations.lock, is not what --repin may change)",
+    CodeMutant("theorem_made_definitional", "a theorem moved into the definitional list "
+               "(Control.accept.kinds rejected, Control.kinds.theorem_moved not made; its kind, "
+               "pinned in obligations.lock, is not what --repin may change either)",
                "proofs/_runner.py",
                (("    \"Def1.segment\": \"the definition's weights named\",\n}\n",
                  "    \"Def1.segment\": \"the definition's weights named\",\n"
                  "    \"Safety.separation\": \"a definition restated\",\n}\n"),)),
+    CodeMutant("exact_rest_layer_skipped", "the exact re-decision stops a step short, the path's "
+               "rest-layer cell never re-decided (Control.exact.rest_layer_contact proved free; "
+               "Scenario.*.translation_*'s exact.coverage)", "spec/_exact.py",
+               (("    for k in range(max(len(cells) - 1, N) + 1):\n",
+                 "    for k in range(max(len(cells) - 1, N)):\n"),)),
+    CodeMutant("exact_tool_square_corner_dropped", "the exact re-decision grows a tool's vertices "
+               "by three corners of the square, not four (Exact.gap_formula's tool_points "
+               "refuted)", "spec/_exact.py",
+               (("    steps = [(-grow, -grow), (grow, -grow), (grow, grow), (-grow, grow)]\n",
+                 "    steps = [(-grow, -grow), (grow, -grow), (grow, grow)]\n"),)),
     CodeMutant("loader_spacing_bound_raised", "the loader's exact spacing bound raised above the "
                "157/50 the safety proofs assume (Control.loader.spacing_above_bound loaded)",
                "spec/_scenario.py",
                (("\n_G_MAX = MAX_SPACING\n", "\n_G_MAX = MAX_SPACING + Fraction(1, 100)\n"),)),
     # --- tools and heights under proof (docs/model.md §7.3, §10; proofs/_obl_tools.py: each
     # caught by its obligation under --repin) ---
+    CodeMutant("travel_time_min", "the travel time Tf from the quickest joint (max made min): "
+               "the principal's slower joint overshoots its boxes (Safety.*.principal_in_layer_box's "
+               "travel refuted, the compositions' Tf read from spec.exact_tf on terms)",
+               "spec/_counts.py",
+               (("    return max(abs(_read(goal[q], reading) - _read(start[q], reading))",
+                 "    return min(abs(_read(goal[q], reading) - _read(start[q], reading))"),)),
+    CodeMutant("spacing_bound_above_pi", "the spacing bound the loader and the proofs read "
+               "raised to 16/5 rad, past pi where A3's facts fail (Safety.*.composition's "
+               "spacing_below_pi refuted)", "spec/_counts.py",
+               (("MAX_SPACING = Fraction(157, 50)\n", "MAX_SPACING = Fraction(16, 5)\n"),)),
     CodeMutant("heights_compared_strictly", "the height test compares with < where <= is meant "
                "(touching intervals called disjoint: Safety.height_rule refuted)",
                "spec/_kinematics.py",

@@ -179,35 +179,82 @@ def write_zarr_atomic(target: str | Path, dr: npt.NDArray[np.uint8], *,
                       layers_per_chunk: int | None = None) -> tuple[Path, str]:
     """``dr`` as a Zarr v3 store at ``target`` (see the module's docstring), built under a
     temporary name beside it, flushed and renamed into place; the path and dr_sha256."""
-    import zarr
-    from zarr.codecs import ZstdCodec
-
     target = Path(target)
     if dr.ndim != 3 or dr.dtype != np.uint8:
         raise ValueError(f"D_R must be uint8 of shape (N + 1, m, n), got {dr.dtype} {dr.shape}")
     K, m, n = (int(x) for x in dr.shape)
     L = layers_per_chunk or chunk_layers(m, n, K)
+    tmp = temporary_store(target)
+    try:
+        h = hashlib.sha256(npy_header(dr.shape))
+        z = create_store(tmp, (K, m, n), L)
+        for k0 in range(0, K, L):
+            block = np.ascontiguousarray(dr[k0:k0 + L])
+            h.update(block.data)
+            _write_block(z, k0, block)
+        _sync_tree(tmp)
+        publish_store(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return target, h.hexdigest()
+
+
+def temporary_store(target: str | Path) -> Path:
+    """A new empty folder beside ``target`` (``.dr.zarr.XXXX.tmp``), where a store is made
+    before ``publish_store`` renames it into place (the caller removes it on failure)."""
+    target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
+    os.chmod(tmp, 0o755)
+    return tmp
+
+
+def create_store(root: Path, shape: tuple[int, int, int], layers_per_chunk: int) -> Any:
+    """The Zarr v3 array of D_R at ``root`` (zarr.json only; the module docstring's layout),
+    opened for writing with every chunk written, an all-free one too."""
+    import zarr
+    from zarr.codecs import ZstdCodec
+
+    K, m, n = shape
+    return zarr.create_array(store=str(root), shape=(K, m, n), chunks=(layers_per_chunk, m, n),
+                             dtype="uint8", fill_value=0, zarr_format=3,
+                             compressors=ZstdCodec(level=ZSTD_LEVEL, checksum=True),
+                             config={"write_empty_chunks": True},
+                             attributes={"cfmpa": {
+                                 "format": _FORMAT,
+                                 "layout": "D_R, uint8 (N + 1, m, n), 1 = blocked, the rest "
+                                           "layer at index N (docs/model.md §4.3, §9)",
+                                 "dr_sha256": "sha256 of the array's .npy bytes (format 1.0 "
+                                              "header, C order)"}})
+
+
+def encode_chunk(layers: npt.NDArray[np.uint8], layers_per_chunk: int) -> bytes:
+    """One chunk's file as ``create_store``'s array writes it: the layers padded with the fill
+    value (0) to ``layers_per_chunk`` (the last chunk of the array), C-order bytes, zstd at
+    ZSTD_LEVEL with its content checksum (zarr's ``bytes`` and ``zstd`` codecs)."""
+    raw = np.zeros((layers_per_chunk, *layers.shape[1:]), dtype=np.uint8)
+    raw[:layers.shape[0]] = layers
+    return bytes(_zstd(level=ZSTD_LEVEL, checksum=True).encode(raw.tobytes()))
+
+
+def _zstd(**config: Any) -> Any:
+    """numcodecs' Zstd codec (zarr's zstd) with ``config``, imported when first needed."""
+    from numcodecs.zstd import Zstd  # type: ignore[import-untyped]  # no py.typed
+
+    return Zstd(**config)
+
+
+def chunk_file(root: Path, c: int) -> Path:
+    """Chunk c's file in a store ``create_store`` made (the default key encoding, "/")."""
+    return Path(root) / "c" / str(c) / "0" / "0"
+
+
+def publish_store(tmp: Path, target: Path) -> None:
+    """Rename the finished, flushed store ``tmp`` to ``target``: an earlier store there is
+    moved aside first and removed after, or put back if the rename fails."""
     old: Path | None = None
     try:
-        os.chmod(tmp, 0o755)
-        h = hashlib.sha256(npy_header(dr.shape))
-        with zarr.config.set({"array.write_empty_chunks": True}):
-            z = zarr.create_array(store=str(tmp), shape=(K, m, n), chunks=(L, m, n),
-                                  dtype="uint8", fill_value=0, zarr_format=3,
-                                  compressors=ZstdCodec(level=ZSTD_LEVEL, checksum=True),
-                                  attributes={"cfmpa": {
-                                      "format": _FORMAT,
-                                      "layout": "D_R, uint8 (N + 1, m, n), 1 = blocked, the "
-                                                "rest layer at index N (docs/model.md §4.3, §9)",
-                                      "dr_sha256": "sha256 of the array's .npy bytes (format "
-                                                   "1.0 header, C order)"}})
-            for k0 in range(0, K, L):
-                block = np.ascontiguousarray(dr[k0:k0 + L])
-                h.update(block.data)
-                _write_block(z, k0, block)
-        _sync_tree(tmp)
         if target.exists() or target.is_symlink():
             old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old",
                                         dir=target.parent))
@@ -215,7 +262,6 @@ def write_zarr_atomic(target: str | Path, dr: npt.NDArray[np.uint8], *,
         os.rename(tmp, target)
         _sync_dir(target.parent)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
         if old is not None and (old / "store").exists() and not target.exists():
             os.rename(old / "store", target)      # put the earlier store back
         if old is not None:
@@ -223,7 +269,6 @@ def write_zarr_atomic(target: str | Path, dr: npt.NDArray[np.uint8], *,
         raise
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
-    return target, h.hexdigest()
 
 
 def _write_block(z: Any, k0: int, block: npt.NDArray[np.uint8]) -> None:
@@ -310,8 +355,6 @@ class ZarrDr:
         except OSError as exc:
             raise self._bad(f"chunk {c} cannot be read ({exc.strerror or exc})", path) from None
         if self.compressed:
-            from numcodecs.zstd import Zstd  # type: ignore[import-untyped]  # no py.typed
-
             out = np.empty(raw, dtype=np.uint8)
             try:
                 # Into a buffer of exactly the chunk's size: a frame that claims or holds more
@@ -320,7 +363,7 @@ class ZarrDr:
                 claimed = _zstd_content_size(data)
                 if claimed is not None and claimed != raw:
                     raise ValueError(f"the frame holds {claimed:,} bytes")
-                Zstd().decode(data, out=out)
+                _zstd().decode(data, out=out)
             except Exception as exc:   # numcodecs raises RuntimeError / ValueError
                 raise self._bad(f"chunk {c} does not decode to {raw:,} bytes "
                                 f"({cause_text(exc)}): the store is corrupt", path) from None

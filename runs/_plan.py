@@ -37,6 +37,7 @@ from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_b
 
 if TYPE_CHECKING:     # the exact re-decision loads python-flint: only plan() needs it
     from ..spec import ExactGaps
+    from ._drdask import BuiltStore, EngineOptions
 
 R = TypeVar("R")
 
@@ -285,7 +286,8 @@ TRAJ_CSV = "traj.csv"
 
 
 def write_plan(p: PlanResult, out: str | Path, *, witness: str | Path | None = None,
-               store: str | None = None) -> tuple[Path, Path]:
+               store: str | None = None, built: BuiltStore | None = None
+               ) -> tuple[Path, Path]:
     """Write DIR/dr.npy (or with ``store="zarr"`` DIR/dr.zarr; by default the one
     ``default_store`` picks for the grid's cells, docs/model.md §9) and DIR/plan.json, each
     atomically (temporary name, then rename); plan.json's dr_sha256 is the hash of the very
@@ -297,7 +299,9 @@ def write_plan(p: PlanResult, out: str | Path, *, witness: str | Path | None = N
     plan.json as ``witness_sha256``.
 
     dr.npy and the witness are streamed to their files (the witness layer by layer,
-    ``spec.save_npz``) and hashed by reading the files back, so neither is held as bytes."""
+    ``spec.save_npz``) and hashed by reading the files back, so neither is held as bytes.
+    ``built``: D_R is that store, built on Dask (runs/_drdask.py) and read back into ``p.dr``;
+    it is renamed into place as DIR/dr.zarr (``store`` is then zarr) instead of written."""
     out = Path(out)
     witness_sha = None
     if witness is not None:
@@ -305,10 +309,14 @@ def write_plan(p: PlanResult, out: str | Path, *, witness: str | Path | None = N
             raise ValueError("write_plan(witness=...) needs a plan made with witness=True")
         members = p.search.witness.npz_members()
         _, witness_sha = _write_streamed(witness, lambda fh: save_npz(fh, members))
-    from ._drstore import default_store, write_dr
+    from ._drstore import _remove_other, default_store, write_dr
 
-    store = default_store(int(p.dr.size)) if store is None else store
-    dr_path, dr_sha = write_dr(out, p.dr, store)
+    if built is not None:
+        store, dr_path, dr_sha = "zarr", built.publish(), built.sha256
+        _remove_other(out, store)
+    else:
+        store = default_store(int(p.dr.size)) if store is None else store
+        dr_path, dr_sha = write_dr(out, p.dr, store)
     if p.search.status is SearchStatus.FOUND:
         traj = executed_trajectory(p.scenario, p.grid, p.search.path)
         write_bytes_atomic(out / TRAJ_CSV, trajectory_csv(traj).encode())
@@ -324,32 +332,54 @@ def write_plan(p: PlanResult, out: str | Path, *, witness: str | Path | None = N
 
 def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *,
            kernel: str = "fast", name: str | None = None, stdout: TextIO | None = None,
-           store: str | None = None) -> int:
+           store: str | None = None, engine: EngineOptions | None = None) -> int:
     """`cfmpa dr`: build D_R of the scenario file for ``variant`` with the ``kernel`` pair
     (``impl.KERNELS``), write ``out``/dr.npy or dr.zarr (``store``, by default by the grid's
     cells: ``default_store``) atomically and print the grid and the free fraction; 0 (bad input
-    raises InputError). ``name``: the scenario as the user gave it."""
+    raises InputError). ``name``: the scenario as the user gave it. ``engine`` (--workers K >= 1
+    or --scheduler): D_R built on Dask a block of layers a task into dr.zarr
+    (runs/_drdask.py); the cluster losing its workers is WorkersLost naming the command that
+    runs it again."""
     from ..impl import kernels
-    from ._drstore import default_store, write_dr
+    from ._drstore import _remove_other, default_store, write_dr
     from ..spec import load_scenario
 
     so = sys.stdout if stdout is None else stdout
     v = Variant(variant)
     s = load_scenario(scenario_path)
     g = make_grid(s)
-    store = default_store((g.N + 1) * g.m * g.n) if store is None else store
-    build, _ = kernels(kernel)
-    t0 = time.perf_counter()
-    dr = build(s, v.value, g)
-    seconds = time.perf_counter() - t0
-    path, _ = write_dr(out, dr, store)
-    free = 1.0 - float(dr.mean())
+    shape = (g.N + 1, g.m, g.n)
+    if engine is not None and engine.on_dask:
+        engine.check(kernel, store)
+        from ._drdask import build_store
+
+        t0 = time.perf_counter()
+        with engine.rerun_on_lost(["dr", str(scenario_path if name is None else name),
+                                   "--variant", v.value, "--out", str(out)]):
+            built = build_store(s, v, Path(out) / "dr.zarr", stream=so, **engine.kwargs())
+        try:
+            path = built.publish()
+        finally:
+            built.discard()
+        _remove_other(out, "zarr")
+        seconds, free = time.perf_counter() - t0, built.free_fraction
+        parts = "  ".join(f"{key} {x:.3f} s" for key, x in built.timings_s.items()
+                          if key != "dr_store")
+    else:
+        store = default_store((g.N + 1) * g.m * g.n) if store is None else store
+        build, _ = kernels(kernel)
+        t0 = time.perf_counter()
+        dr = build(s, v.value, g)
+        seconds = time.perf_counter() - t0
+        path, _ = write_dr(out, dr, store)
+        free = 1.0 - float(dr.mean())
+        parts = ""
     print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)
     print(f"variant   {v.value} ({kernel} kernel)", file=so)
     print(f"grid      N={g.N} m={g.m} n={g.n} dt={g.dt} h=({g.h[0]:.6g}, {g.h[1]:.6g}) rad"
-          f"  shape={tuple(dr.shape)}", file=so)
+          f"  shape={shape}", file=so)
     print(f"free      {free:.4%} of cells", file=so)
-    print(f"time      {seconds:.3f} s", file=so)
+    print(f"time      {seconds:.3f} s" + (f" ({parts})" if parts else ""), file=so)
     print(f"wrote     {path}", file=so)
     return 0
 
@@ -358,10 +388,12 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
              contracts: Mode | str = "full", seed: int = 0, sample: int | None = None,
              kernel: str = "fast", witness: str | Path | None = None, name: str | None = None,
              stdout: TextIO | None = None, stderr: TextIO | None = None,
-             store: str | None = None) -> int:
+             store: str | None = None, engine: EngineOptions | None = None) -> int:
     """`cfmpa plan`: ``plan`` with the ``kernel`` pair, not stopping at a violation, then
     ``write_plan`` into ``out`` (D_R as ``store``, by default by the grid's cells; and the
-    witness file); print the summary.
+    witness file); print the summary. ``engine`` (--workers K >= 1 or --scheduler): D_R built
+    on Dask into dr.zarr as `cfmpa dr` does (runs/_drdask.py), read back, then checked and
+    searched here as the one-process build's array would be.
 
     0 when nothing was violated; 1 when a contract failed or the certificate is not clear (a
     contact or an undecided interval is a violation in every contracts mode, off included); the
@@ -378,9 +410,36 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
     s = load_scenario(scenario_path)
     zarr_threshold()                  # a bad CFMPA_ZARR_CELLS is exit 2 before any work
     build, search = kernels(kernel)
-    p = plan(s, variant, contracts=contracts, seed=seed, sample=sample, stop=False, build=build,
-             search=search, kernel=kernel, witness=witness is not None)
-    dr_path, plan_path = write_plan(p, out, witness=witness, store=store)
+    if engine is None or not engine.on_dask:
+        p = plan(s, variant, contracts=contracts, seed=seed, sample=sample, stop=False,
+                 build=build, search=search, kernel=kernel, witness=witness is not None)
+        dr_path, plan_path = write_plan(p, out, witness=witness, store=store)
+    else:
+        engine.check(kernel, store)
+        from ._drdask import build_store
+
+        built: list[BuiltStore] = []
+
+        def on_dask(s: Scenario, v: Variant, g: Grid) -> npt.NDArray[np.uint8]:
+            b = build_store(s, v, Path(out) / "dr.zarr", keep_array=True, stream=so,
+                            **engine.kwargs())
+            built.append(b)
+            assert b.array is not None
+            return b.array
+
+        command = ["plan", str(scenario_path if name is None else name), "--variant",
+                   Variant(variant).value, "--out", str(out), "--contracts", str(contracts),
+                   *(["--witness", str(witness)] if witness is not None else [])]
+        try:
+            with engine.rerun_on_lost(command):
+                p = plan(s, variant, contracts=contracts, seed=seed, sample=sample, stop=False,
+                         build=on_dask, search=search, kernel=kernel,
+                         witness=witness is not None)
+            p.timings_s.update(built[0].timings_s)
+            dr_path, plan_path = write_plan(p, out, witness=witness, built=built[0])
+        finally:
+            for b in built:
+                b.discard()
     violations = p.violations
     g, r, t = p.grid, p.search, p.timings_s
     print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)

@@ -8,10 +8,12 @@ joints taken by name (``--joints``, the ROS names of left1, left2, right1, right
 among the message's names; other joints are ignored.
 
 A bag is streamed: one message at a time, handed on in blocks of rows, so a log of any length
-is read in bounded memory (a trajectory, which the certificate needs whole, is bounded like a
-CSV one). A sample's ``line`` is the one it has in the CSV of the same samples (message k on the
-topic, 1-based, is line k + 1 under the header), so the JSON of `cfmpa monitor` is the same for
-a bag and for its CSV; messages to the user say "message k".
+is read in bounded memory, and so is a trajectory `cfmpa certify` and `cfmpa monitor` read
+(``bag_trajectory_rows``: at most TRAJECTORY_ROWS messages); one held whole
+(``load_bag_trajectory``, `cfmpa simulate`) is bounded like a CSV one. A sample's ``line`` is
+the one it has in the CSV of the same samples (message k on the topic, 1-based, is line k + 1
+under the header), so the JSON of `cfmpa monitor` is the same for a bag and for its CSV;
+messages to the user say "message k".
 
 The count read is checked against the count the bag declares on the topic (its metadata.yaml,
 or a bare file's mcap summary): a storage file can lose a message silently (rosbags skips a
@@ -27,7 +29,7 @@ import os
 import shutil
 import struct
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
@@ -41,8 +43,8 @@ from ..files import LIMITS, cause_text, echo
 from ..spec import TRAJECTORY_COLUMNS, Scenario, Trajectory, parse_trajectory_csv
 
 __all__ = ["BagOptions", "BagReading", "DEFAULT_TOPIC", "JOINT_STATE", "LOG_KINDS", "bag_rows",
-           "bag_sha256", "is_bag", "load_bag_trajectory", "log_output_kind", "parse_joints",
-           "write_bag"]
+           "bag_row_name", "bag_sha256", "bag_trajectory_rows", "is_bag", "load_bag_trajectory",
+           "log_output_kind", "parse_joints", "write_bag"]
 
 #: The message type read and written.
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -378,6 +380,20 @@ def bag_rows(path: str | os.PathLike[str], opts: BagOptions, *, block_rows: int,
         yield first, np.stack(block)
 
 
+def bag_trajectory_rows(path: str | os.PathLike[str], opts: BagOptions
+                        ) -> Iterator[tuple[int, FloatArray]]:
+    """A trajectory bag's rows one at a time, streamed, as ``spec.certify_trajectory_rows``
+    takes them: (line, row (5,) in COLUMNS order), message k standing at line k + 1 of the CSV
+    of the same samples; every message the bag declares must be read (``_samples``)."""
+    for k, row in _samples(path, opts, "--traj"):
+        yield k + 1, row
+
+
+def bag_row_name(opts: BagOptions) -> Callable[[int], str]:
+    """How a failed check names a trajectory bag's row k (1-based): its message."""
+    return lambda k: f"message {k} on {opts.topic}"
+
+
 def load_bag_trajectory(path: str | os.PathLike[str], s: Scenario, opts: BagOptions, *,
                         allow_speed: bool = False) -> Trajectory:
     """A trajectory from a bag, read and validated as the CSV of the same samples is
@@ -397,7 +413,7 @@ def load_bag_trajectory(path: str | os.PathLike[str], s: Scenario, opts: BagOpti
             yield ",".join(repr(float(x)) for x in row)     # repr: the same doubles back
 
     return parse_trajectory_csv(lines(), s, source=str(path), allow_speed=allow_speed,
-                                name_row=lambda k: f"message {k} on {opts.topic}")
+                                name_row=bag_row_name(opts))
 
 
 def bag_sha256(path: str | os.PathLike[str]) -> str:

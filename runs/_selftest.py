@@ -341,9 +341,10 @@ def selftest_table(rows: tuple[SelftestRow, ...], *, sample: int = SAMPLE, seed:
     return "\n".join(out)
 
 
-def run_selftest(*, stdout: TextIO | None = None) -> int:
-    """`cfmpa selftest`: seed every fault, print the table on ``stdout`` (default sys.stdout);
-    0 iff full mode caught every one."""
+def run_selftest(*, stdout: TextIO | None = None, stderr: TextIO | None = None) -> int:
+    """`cfmpa selftest`: seed every fault, print the table and the verdict on ``stdout``
+    (default sys.stdout at call time; ``stderr`` is for errors only, which are raised); 0 iff
+    full mode caught every one."""
     import sys
 
     so = sys.stdout if stdout is None else stdout

@@ -10,6 +10,7 @@ JSON outputs are byte-identical for the same inputs apart from ``timings_s``.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import math
@@ -19,7 +20,7 @@ import warnings
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, TextIO
 
 import numpy as np
 import numpy.typing as npt
@@ -27,20 +28,22 @@ import numpy.typing as npt
 from ..errors import MISSING, InputError
 from ..files import angle_text, bounded_lines, dumps_json, echo, write_bytes_atomic
 from ._limits import MAX_LOG_SAMPLES
-from ._rosbag import (BagOptions, BagReading, bag_rows, bag_sha256, is_bag, load_bag_trajectory,
-                      log_output_kind, write_bag)
-from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario, Trajectory,
-                    TrajectorySummary, between_samples_bound, certify_trajectory,
-                    certify_trajectory_file, closest_links, contact_links_text, contact_parts,
-                    csv_column_order,
-                    load_scenario, load_trajectory, log_end_bound, tolerance_rad,
-                    trajectory_distances, tube_lipschitz)
+from ._rosbag import (BagOptions, BagReading, bag_row_name, bag_rows, bag_sha256,
+                      bag_trajectory_rows, is_bag, load_bag_trajectory, log_output_kind,
+                      write_bag)
+from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario,
+                    StreamedReference, Trajectory, TrajectorySummary, WholeReference,
+                    between_samples_bound, certify_trajectory_file, certify_trajectory_rows,
+                    closest_links, contact_links_text, contact_parts, csv_column_order,
+                    load_scenario, load_trajectory, log_end_bound, row_blocks, tolerance_rad,
+                    trajectory_distances, trajectory_file_blocks, tube_lipschitz)
 
 __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
            "LISTED_UNOBSERVED", "MISSING_MESSAGES",
            "MonitorResult", "Unobserved",
            "certify_json", "log_csv", "monitor_json", "monitor_log", "monitor_rows",
-           "parse_excursion", "parse_max_speed", "run_certify", "run_monitor", "run_simulate", "simulate_log"]
+           "parse_excursion", "parse_max_speed", "run_certify", "run_monitor", "run_simulate",
+           "simulate_log"]
 
 
 #: Log rows parsed per numpy block by the monitor ...
@@ -49,6 +52,8 @@ BLOCK_ROWS = 16_384
 #: make a block of 1 GiB).
 BLOCK_CHARS = 8 * 1024 * 1024
 FloatArray = npt.NDArray[np.float64]
+#: The trajectory as the monitor reads it: held whole, or streamed a second time.
+Reference = WholeReference | StreamedReference
 
 
 def _scenario(s: Scenario | str | Path) -> Scenario:
@@ -123,51 +128,53 @@ def certify_json(s: Scenario, traj: Trajectory | TrajectorySummary, cert: Certif
 
 def run_certify(scenario: Scenario | str | Path, traj_path: str | Path, *,
                 json_out: str | Path | None = None, allow_speed: bool = False,
-                bag: BagOptions | None = None) -> int:
-    """Certify the trajectory file, read and certified in one pass (memory independent of its
-    rows: ``spec.certify_trajectory_file``), or a ROS 2 bag (read with ``bag``, whole, within
-    the trajectory's row limit); print the summary; 0 clear, 1 not clear (bad input raises
-    InputError, exit 2, nothing written)."""
+                bag: BagOptions | None = None, stdout: TextIO | None = None,
+                stderr: TextIO | None = None) -> int:
+    """Certify the trajectory file or ROS 2 bag (read with ``bag``), read and certified in one
+    pass, memory independent of its rows (``spec.certify_trajectory_file``,
+    ``spec.certify_trajectory_rows``: at most TRAJECTORY_ROWS rows); print the summary, the
+    verdict and its details on ``stdout`` (default sys.stdout at call time; ``stderr`` is
+    for errors only, which are raised: InputError, exit 2, nothing written); 0 clear, 1 not
+    clear."""
+    so = sys.stdout if stdout is None else stdout
     s = _scenario(scenario)
     opts = _bag_options(bag, traj_path)
     timings: dict[str, float] = {}
     if is_bag(traj_path):
-        t0 = time.perf_counter()
-        traj = _trajectory(traj_path, s, allow_speed, opts)
-        t1 = time.perf_counter()
-        cert = certify_trajectory(s, traj)
-        timings = {"load": t1 - t0, "certificate": time.perf_counter() - t1}
-        rows, t_start, t_end = traj.rows, float(traj.t[0]), float(traj.t[-1])
-        doc = certify_json(s, traj, cert, timings, _sha256(traj_path))
+        info, cert = certify_trajectory_rows(
+            bag_trajectory_rows(traj_path, opts), s, source=str(traj_path),
+            allow_speed=allow_speed, name_row=bag_row_name(opts), timings=timings)
+        rows, t_start, t_end = info.rows, info.t_start_s, info.t_end_s
+        doc = certify_json(s, info, cert, timings, _sha256(traj_path))
     else:
         info, cert, sha = certify_trajectory_file(traj_path, s, allow_speed=allow_speed,
                                                   timings=timings)
         rows, t_start, t_end = info.rows, info.t_start_s, info.t_end_s
         doc = certify_json(s, info, cert, timings, sha)
     print(f"trajectory {traj_path}: {rows} rows, t {t_start:.6g}..{t_end:.6g} s "
-          f"(scenario {s.name})")
+          f"(scenario {s.name})", file=so)
     sampled = (f"sampled minimum {cert.min_clearance_m * 1000:.6g} mm at t={cert.t_min_s:.6g} s "
                f"({cert.intervals} intervals)")
     if cert.clear:
         print(f"clearance clear: proved >= {cert.lower_bound_m * 1000:.6g} mm at every instant; "
-              f"{sampled}")
+              f"{sampled}", file=so)
         print(f"tolerance {doc['tolerance_rad']:.6f} rad ({doc['tolerance_deg']:.4g} deg) in "
               f"every joint (max norm), moving the farthest point of either arm by at most "
               f"{doc['tolerance_farthest_point_mm']:.3g} mm (L = "
-              f"{doc['tube_lipschitz_m_per_rad']:.6g} m/rad)")
+              f"{doc['tube_lipschitz_m_per_rad']:.6g} m/rad)", file=so)
     elif doc["contact"] is not None:
         c = doc["contact"]
         where = "" if c["line"] is None else f" (line {c['line']})"
         print(f"clearance NOT CLEAR: contact at t={c['t_s']:.9g} s, {c['links_text']}, "
               f"{c['segment']}{where}; left angles "
               f"{', '.join(angle_text(a) for a in c['left_angles_rad'])}; right angles "
-              f"{', '.join(angle_text(a) for a in c['right_angles_rad'])}", file=sys.stderr)
+              f"{', '.join(angle_text(a) for a in c['right_angles_rad'])}", file=so)
     else:
         print(f"clearance NOT CLEAR: {len(cert.undecided)} interval(s) neither proved clear nor "
-              f"in contact, first {cert.undecided[0]} s; {sampled}", file=sys.stderr)
+              f"in contact, first {cert.undecided[0]} s; {sampled}", file=so)
     if json_out is not None:
         write_bytes_atomic(json_out, dumps_json(doc).encode())
-        print(f"wrote     {json_out}")
+        print(f"wrote     {json_out}", file=so)
     return 0 if cert.clear else 1
 
 
@@ -333,13 +340,22 @@ def _blocks(lines: Iterator[str], rows: int) -> Iterator[list[str]]:
         yield block
 
 
-def parse_max_speed(text: str | None, s: Scenario, traj: Trajectory) -> FloatArray:
+def _default_max_speed(s: Scenario, top: FloatArray) -> FloatArray:
+    """The scenario's omega, raised to the trajectory's top speed ``top`` where that is faster."""
+    return np.maximum(np.array([*s.left.omega, *s.right.omega], dtype=float), top)
+
+
+def parse_max_speed(text: str | None, s: Scenario,
+                    traj: Trajectory | TrajectorySummary | Reference) -> FloatArray:
     """The robot's joint speed bound (4,) in JOINTS order, rad/s: ``--max-speed`` as one value
     for all joints or four comma-separated ones; without it the scenario's omega, raised to the
-    trajectory's own top speed on a joint where that is faster (a robot tracking it is)."""
+    trajectory's own top speed on a joint where that is faster (a robot tracking it is): of the
+    trajectory held whole, or as its first reading found it (``TrajectorySummary``)."""
     if text is None:
-        omega = np.array([*s.left.omega, *s.right.omega], dtype=float)
-        return np.maximum(omega, ReferenceSpeeds.of(traj).top())
+        top = (ReferenceSpeeds.of(traj).top() if isinstance(traj, Trajectory) else
+               np.asarray(traj.top_speed_rad_s, dtype=float)
+               if isinstance(traj, TrajectorySummary) else traj.top())
+        return _default_max_speed(s, top)
     parts = str(text).split(",")
     try:
         vals = [float(x) for x in parts]
@@ -384,7 +400,7 @@ def _csv_blocks(stream: Iterable[str], block_rows: int, source: str
                          line=no)
 
 
-def monitor_log(s: Scenario, traj: Trajectory, tol: float, stream: Iterable[str], *,
+def monitor_log(s: Scenario, traj: Trajectory | Reference, tol: float, stream: Iterable[str], *,
                 source: str = "<log>", block_rows: int = BLOCK_ROWS,
                 max_speed: npt.ArrayLike | None = None) -> MonitorResult:
     """``monitor_rows`` of a CSV log's lines (``stream``): its header, then ``block_rows``
@@ -414,7 +430,7 @@ def _end_reach(d: FloatArray, h: float, w_robot: FloatArray, w_ref: FloatArray,
     return 0.0
 
 
-def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
+def monitor_rows(s: Scenario, traj: Trajectory | Reference, tol: float,
                  blocks: Iterable[tuple[int, FloatArray]], *, source: str = "<log>",
                  max_speed: npt.ArrayLike | None = None,
                  reading: BagReading | None = None) -> MonitorResult:
@@ -432,14 +448,16 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
     (``monitor_log``) or a bag's (``bag_rows``); times must strictly increase. One block at a
     time (constant memory; the last sample is carried into the next block's first gap).
     ``reading``: a bag's, read with allow_gaps: where a declared message was not read, the
-    time around it is unobserved, whatever the bounds (MISSING_MESSAGES).
+    time around it is unobserved, whatever the bounds (MISSING_MESSAGES). ``traj``: the
+    trajectory held whole, or read a second time beside the log (``spec.StreamedReference``,
+    the same numbers: `cfmpa monitor` holds neither file whole).
     """
     res = MonitorResult()
-    w_robot = (parse_max_speed(None, s, traj) if max_speed is None else
+    ref = WholeReference(traj) if isinstance(traj, Trajectory) else traj
+    w_robot = (_default_max_speed(s, ref.top()) if max_speed is None else
                np.broadcast_to(np.asarray(max_speed, dtype=float), (4,)).copy())
     res.max_speed_rad_s = tuple(float(x) for x in w_robot)
-    ref = ReferenceSpeeds.of(traj)
-    span0, span1 = float(traj.t[0]), float(traj.t[-1])
+    span0, span1 = ref.span
     span_seen = False                                  # the instant span0 (a zero span)
     run: _Open | None = None
 
@@ -466,15 +484,18 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
                              f"{before!r} (times strictly increase)", source=source,
                              line=start + k)
         res.t_last_s = float(t[-1])
-        dev = np.abs(arr[:, 1:] - traj.at(t))
+        # The trajectory at the samples, and its speeds on the gaps from the previous sample
+        # (from the trajectory's start, or the first sample, before the first block).
+        first = prev_dev is None
+        at, speeds = ref.block(min(span0, float(t[0])) if first else prev_t, t)
+        dev = np.abs(arr[:, 1:] - at)
         if res.t_first_s is None:
             res.t_first_s = t1 = float(t[0])
             if reading is not None and reading.missing_first and t1 > span0:
                 extend(span0, t1, None, MISSING_MESSAGES)
             elif t1 > span0:
                 # Covered back from the first sample as far as the one-sided bound holds.
-                reach = _end_reach(dev[0], t1 - span0, w_robot,
-                                   ref.over(np.array([span0]), np.array([t1]))[0], tol)
+                reach = _end_reach(dev[0], t1 - span0, w_robot, speeds[0], tol)
                 cut = t1 - reach
                 if cut > span0:
                     extend(span0, cut, None, BEFORE_LOG)
@@ -496,7 +517,7 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
             h = b - a
             res.max_gap_s = max(res.max_gap_s, float(h.max()))
             bound = between_samples_bound(gd[:-1], gd[1:], h[:, None], w_robot[None, :],
-                                          ref.over(a, b))
+                                          speeds[1:] if first else speeds)
             ok = np.all(bound <= tol, axis=1)
             # A gap a declared message was lost from (--allow-gaps) is not vouched for.
             lost = (np.isin(gl[1:], list(reading.gaps_before)) if reading is not None
@@ -535,7 +556,7 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
     elif prev_t < span1 and prev_dev is not None:
         # Covered on from the last sample as far as the one-sided bound holds.
         reach = _end_reach(prev_dev, span1 - prev_t, w_robot,
-                           ref.over(np.array([prev_t]), np.array([span1]))[0], tol)
+                           ref.block(prev_t, np.array([span1]))[1][0], tol)
         cut = prev_t + reach
         if cut < span1:
             extend(max(cut, prev_t), span1, prev_line, AFTER_LOG)
@@ -559,7 +580,7 @@ def monitor_rows(s: Scenario, traj: Trajectory, tol: float,
     return res
 
 
-def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
+def monitor_json(s: Scenario, traj: Trajectory | Reference, tol: float, res: MonitorResult,
                  log: str) -> dict[str, Any]:
     f = res.first
     return {
@@ -597,14 +618,17 @@ def monitor_json(s: Scenario, traj: Trajectory, tol: float, res: MonitorResult,
 def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str | Path, *,
                 json_out: str | Path | None = None, allow_speed: bool = False,
                 stdin: IO[str] | None = None, max_speed: str | None = None,
-                bag: BagOptions | None = None, allow_gaps: bool = False) -> int:
+                bag: BagOptions | None = None, allow_gaps: bool = False,
+                stdout: TextIO | None = None, stderr: TextIO | None = None) -> int:
     """Monitor a measured log (a file, or ``-`` for standard input) against the certified tube
     at every instant: 0 inside, 1 some sample outside or some time unobserved (or the trajectory
     is not certified clear: no JSON then), 2 bad input (InputError). ``max_speed``: the
     robot's joint speed bound as ``--max-speed`` gives it (``parse_max_speed``). The log (and
     the trajectory) may be a ROS 2 bag, read with ``bag`` (``runs._rosbag``); a log bag with
     fewer messages than it declares is bad input unless ``allow_gaps`` (their time is then
-    unobserved). The verdict and its details are printed on standard output, one line each."""
+    unobserved). The verdict and its details are printed on ``stdout`` (default sys.stdout at
+    call time), one line each; ``stderr`` is for errors only, which are raised (InputError)."""
+    so = sys.stdout if stdout is None else stdout
     s = _scenario(scenario)
     opts = _bag_options(bag, traj_path, log)
     in_bag = str(log) != "-" and is_bag(log)
@@ -612,35 +636,35 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
         raise InputError("--allow-gaps", MISSING, f"applies to a ROS 2 bag log only, and --log "
                          f"{log} is none")
     t0 = time.perf_counter()
-    traj = _trajectory(traj_path, s, allow_speed, opts)
-    w_robot = parse_max_speed(max_speed, s, traj)
-    cert = certify_trajectory(s, traj)
+    # The trajectory is read twice, streamed (docs/model.md §12): certified first (its tube),
+    # then beside the log; neither reading holds it whole. A pipe cannot be read twice.
+    traj_p = Path(traj_path)
+    if traj_p.exists() and not (traj_p.is_file() or is_bag(traj_p)):
+        raise InputError("--traj", str(traj_path), "must be a regular file or a ROS 2 bag: the "
+                         "monitor reads the trajectory twice (a pipe or a device can be read "
+                         "once)")
+    if is_bag(traj_path):
+        info, cert = certify_trajectory_rows(
+            bag_trajectory_rows(traj_path, opts), s, source=str(traj_path),
+            allow_speed=allow_speed, name_row=bag_row_name(opts))
+    else:
+        info, cert, _ = certify_trajectory_file(traj_path, s, allow_speed=allow_speed)
+    w_robot = parse_max_speed(max_speed, s, info)
     t1 = time.perf_counter()
     c1 = time.process_time()
     if not cert.clear:
         print(f"monitor   {traj_path} is not certified clear (run cfmpa certify): there is no "
-              "tube to monitor", file=sys.stderr)
+              "tube to monitor", file=so)
         return 1
     tol = tolerance_rad(s, cert)
+    with contextlib.ExitStack() as stack:
+        blocks = (row_blocks(bag_trajectory_rows(traj_path, opts)) if is_bag(traj_path) else
+                  stack.enter_context(trajectory_file_blocks(traj_path, s)))
+        ref = StreamedReference(blocks, info)
+        res, reading = _monitor_stream(s, ref, tol, log, opts, in_bag, w_robot, stdin,
+                                       allow_gaps)
+        ref.finish()
     source = "<stdin>" if str(log) == "-" else str(log)
-    # Lines within LIMITS["line"] (docs/model.md §12): /dev/zero ends at its first line's limit.
-    reading = BagReading()
-    if in_bag:
-        res = monitor_rows(s, traj, tol, bag_rows(log, opts, block_rows=BLOCK_ROWS,
-                                                  reading=reading, allow_gaps=allow_gaps),
-                           source=source, max_speed=w_robot, reading=reading)
-    elif str(log) == "-":
-        res = monitor_log(s, traj, tol, bounded_lines(stdin if stdin is not None else sys.stdin,
-                                                      source), source=source, max_speed=w_robot)
-    else:
-        try:
-            fh = open(log, "rb")
-        except OSError as exc:
-            raise InputError("log", MISSING, f"cannot be read ({exc.strerror or exc})",
-                             source=source) from None
-        with fh:
-            res = monitor_log(s, traj, tol, bounded_lines(fh, source), source=source,
-                              max_speed=w_robot)
     t2 = time.perf_counter()
     # monitor: wall-clock seconds of the stream; monitor_cpu: this process's CPU seconds in it.
     res.timings_s = {"certificate": t1 - t0, "monitor": t2 - t1,
@@ -653,7 +677,47 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
     print(f"monitor   {res.samples} samples of {source} against {traj_path} "
           f"(tolerance {angle_text(tol)}): {verdict}; largest gap {res.max_gap_s:.6g} s, "
           f"{100 * res.covered_fraction:.4g}% of the trajectory's time covered "
-          f"({rate:,.0f} samples/s)")
+          f"({rate:,.0f} samples/s)", file=so)
+    _report(res, ref, tol, in_bag, opts, reading, log=source, out=so)
+    doc = monitor_json(s, ref, tol, res, source)
+    if json_out is not None:
+        write_bytes_atomic(json_out, dumps_json(doc).encode())
+        print(f"wrote     {json_out}", file=so)
+    return 0 if res.status == "inside" else 1
+
+
+def _monitor_stream(s: Scenario, ref: Reference, tol: float, log: str | Path, opts: BagOptions,
+                    in_bag: bool, w_robot: FloatArray, stdin: IO[str] | None,
+                    allow_gaps: bool) -> tuple[MonitorResult, BagReading]:
+    """``monitor_rows`` of the log (a bag, standard input or a CSV file) against ``ref``."""
+    source = "<stdin>" if str(log) == "-" else str(log)
+    # Lines within LIMITS["line"] (docs/model.md §12): /dev/zero ends at its first line's limit.
+    reading = BagReading()
+    if in_bag:
+        res = monitor_rows(s, ref, tol, bag_rows(log, opts, block_rows=BLOCK_ROWS,
+                                                  reading=reading, allow_gaps=allow_gaps),
+                           source=source, max_speed=w_robot, reading=reading)
+    elif str(log) == "-":
+        res = monitor_log(s, ref, tol, bounded_lines(stdin if stdin is not None else sys.stdin,
+                                                      source), source=source, max_speed=w_robot)
+    else:
+        try:
+            fh = open(log, "rb")
+        except OSError as exc:
+            raise InputError("log", MISSING, f"cannot be read ({exc.strerror or exc})",
+                             source=source) from None
+        with fh:
+            res = monitor_log(s, ref, tol, bounded_lines(fh, source), source=source,
+                              max_speed=w_robot)
+    return res, reading
+
+
+def _report(res: MonitorResult, ref: Reference, tol: float, in_bag: bool, opts: BagOptions,
+            reading: BagReading, log: str, out: TextIO) -> None:
+    """The monitor's detail lines, after its verdict: the first sample outside, the first time
+    no sample vouches for, what a bag lacked, the --t0 hint."""
+    intervals = (f"{res.unobserved_count} interval(s), {res.unobserved_s:.6g} s in all")
+
     # A bag's sample k stands at line k + 1 (its CSV's line); the user is told its message.
     def at(line: int) -> str:
         return f"message {line - 1} on {opts.topic}" if in_bag else f"line {line}"
@@ -665,23 +729,18 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
         kind = (f"IN CONTACT ({f['links_text']})" if f["in_contact"] else
                 "not in contact, outside the certified tube")
         print(f"first     outside at t={f['t_s']!r} s ({at(f['line'])}): {f['joint']} off by "
-              f"{angle_text(f['deviation_rad'])}; {kind}")
+              f"{angle_text(f['deviation_rad'])}; {kind}", file=out)
     if res.unobserved_count:
         u = res.unobserved[0]
         where = "" if u.line is None else f" ({at(u.line)})"
         print(f"first     unobserved from t={u.t_s!r} s for {u.length_s:.6g} s{where}: {u.why}"
-              + ("" if res.status == "unobserved" else f" ({intervals})"))
+              + ("" if res.status == "unobserved" else f" ({intervals})"), file=out)
     if in_bag and res.missing_messages:
         print(f"missing   {res.missing_messages} message(s) the bag declares on {opts.topic} "
-              f"were not read (--allow-gaps): their time is unobserved")
-    hint = _t0_hint(res, reading, traj) if in_bag else None
+              f"were not read (--allow-gaps): their time is unobserved", file=out)
+    hint = _t0_hint(res, reading, ref.span[0]) if in_bag else None
     if hint is not None:
-        print(f"hint      {hint}")
-    doc = monitor_json(s, traj, tol, res, source)
-    if json_out is not None:
-        write_bytes_atomic(json_out, dumps_json(doc).encode())
-        print(f"wrote     {json_out}")
-    return 0 if res.status == "inside" else 1
+        print(f"hint      {hint}", file=out)
 
 
 #: How far past the trajectory's start (s) a bag's first stamp must be, beyond the largest gap
@@ -689,18 +748,18 @@ def run_monitor(scenario: Scenario | str | Path, traj_path: str | Path, log: str
 T0_HINT_S = 1e-3
 
 
-def _t0_hint(res: MonitorResult, reading: BagReading, traj: Trajectory) -> str | None:
+def _t0_hint(res: MonitorResult, reading: BagReading, start: float) -> str | None:
     """When every sample of a bag is outside and t counted from its first stamp (no --t0),
     which is well past the trajectory's start: the suggestion of --t0; else None."""
     if (res.samples == 0 or res.outside < res.samples or reading.t0_given
             or reading.first_ns is None):
         return None
     first = reading.first_ns / 1e9
-    past = first - float(traj.t[0])
+    past = first - start
     if past <= T0_HINT_S + res.max_gap_s:
         return None
     return (f"every sample is outside, and t counts from the bag's first stamp, {first:.9g} s, "
-            f"{past:.6g} s past the trajectory's start at {float(traj.t[0]):.6g} s: if the log "
+            f"{past:.6g} s past the trajectory's start at {start:.6g} s: if the log "
             "began after the trajectory did, give --t0 the stamp at its start (--t0 0 when "
             "the stamps are on the trajectory's clock)")
 
@@ -798,15 +857,18 @@ def run_simulate(scenario: Scenario | str | Path, traj_path: str | Path, out: st
                  lag: float = 0.0, noise: float = 0.0, seed: int = 0,
                  excursions: Sequence[Excursion] = (), period: float | None = None,
                  samples: int | None = None, tail: float = 0.0,
-                 allow_speed: bool = False, bag: BagOptions | None = None) -> int:
+                 allow_speed: bool = False, bag: BagOptions | None = None,
+                 stdout: TextIO | None = None, stderr: TextIO | None = None) -> int:
     """Write a simulated measured log of the trajectory to ``out`` (atomically): a ROS 2 bag
     (JointState on ``bag``'s topic and joint names, header.stamp = t to the nearest ns) when
     ``out`` ends in .mcap or .db3 (that storage file) or names a folder (``runs._rosbag.
-    log_output_kind``: the rosbag2 layout), CSV otherwise; 0 on success."""
+    log_output_kind``: the rosbag2 layout), CSV otherwise; what was written on ``stdout``
+    (default sys.stdout at call time; errors are raised, InputError); 0 on success."""
+    so = sys.stdout if stdout is None else stdout
     s = _scenario(scenario)
     kind = log_output_kind(out)
     if bag is not None and kind == "csv":
-        raise InputError("--topic/--joints", MISSING, f"apply to a bag only: --out {out} is "
+        raise InputError("--topic/--joints", MISSING, f"apply to a bag only: --log-out {out} is "
                          "written as CSV (a bag is a name ending in .mcap or .db3, or a folder "
                          "ending in /)")
     traj = _trajectory(traj_path, s, allow_speed, BagOptions() if bag is None else bag)
@@ -819,6 +881,6 @@ def run_simulate(scenario: Scenario | str | Path, traj_path: str | Path, out: st
     what = {"csv": "CSV", "mcap": "ROS 2 bag, mcap", "db3": "ROS 2 bag, sqlite3",
             "folder": "ROS 2 bag folder, mcap"}[kind]
     print(f"simulate  {len(t)} samples of {traj_path} (lag {lag:g} s, noise {noise:g} rad, seed "
-          f"{seed}, {len(excursions)} excursion(s))")
-    print(f"wrote     {out} ({what})")
+          f"{seed}, {len(excursions)} excursion(s))", file=so)
+    print(f"wrote     {out} ({what})", file=so)
     return 0

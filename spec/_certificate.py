@@ -497,6 +497,10 @@ class _Motion:
         return part_distances(s, polygon_distances(left[:, :, None], right[:, None, :]))
 
 
+#: The grid path's motion under its public name (read on Z3 terms by the wiring obligations).
+GridMotion = _Motion
+
+
 def _merge(parts: list[tuple[FloatArray, FloatArray]]) -> tuple[tuple[float, float], ...]:
     """Sorted, with touching or overlapping intervals merged."""
     if not parts:

@@ -112,7 +112,10 @@ def _vertex_edge_sq(p: FloatArray, q: FloatArray) -> FloatArray:
     return np.min(np.sum(gap * gap, axis=-1), axis=(-2, -1))
 
 
-def _distances(a: FloatArray, b: FloatArray) -> FloatArray:
+def _distances_reference(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The method of the module docstring on arrays (..., vertices, 2) as they come: the
+    statement ``_distances`` computes, number for number, batch last (tests/spec/test_polygon.py
+    checks the two agree bit for bit)."""
     lead = np.broadcast_shapes(a.shape[:-2], b.shape[:-2])
     a = np.broadcast_to(a, lead + a.shape[-2:])
     b = np.broadcast_to(b, lead + b.shape[-2:])
@@ -122,3 +125,86 @@ def _distances(a: FloatArray, b: FloatArray) -> FloatArray:
             | _inside(side_ba, _orientation(b)))
     gap_sq = np.minimum(_vertex_edge_sq(a, b), _vertex_edge_sq(b, a))
     return np.where(meet, 0.0, np.sqrt(gap_sq))
+
+
+# --- the same, batch last ---------------------------------------------------------------------
+# ``_distances`` lays each coordinate out as (vertices, N), the N pairs of the batch last and
+# contiguous, so every step is one elementwise operation over whole rows and every reduction over
+# vertices is elementwise across rows, where ``_distances_reference`` reduces tiny trailing axes
+# (2 coordinates, a few vertices) pair by pair. Each value is the same IEEE operation on the same
+# operands in the same order (a sum of two terms is x0 + x1 in both; orientations are computed
+# by ``_orientation`` itself), so the distances are bit-identical.
+
+
+def _soa(p: FloatArray, lead: tuple[int, ...]) -> tuple[FloatArray, FloatArray]:
+    """(x, y) of polygons (..., V, 2) broadcast to ``lead``: each (V, N), contiguous."""
+    flat = np.broadcast_to(p, lead + p.shape[-2:]).reshape(-1, p.shape[-2], 2)
+    return np.ascontiguousarray(flat[:, :, 0].T), np.ascontiguousarray(flat[:, :, 1].T)
+
+
+def _next_minus(x: FloatArray) -> FloatArray:
+    """x[i + 1] - x[i] along the first axis, cyclically: ``np.roll(x, -1, axis=0) - x``."""
+    out = np.empty_like(x)
+    np.subtract(x[1:], x[:-1], out=out[:-1])
+    np.subtract(x[0], x[-1], out=out[-1])
+    return out
+
+
+def _half(px: FloatArray, py: FloatArray, qx: FloatArray, qy: FloatArray
+          ) -> tuple[FloatArray, FloatArray]:
+    """(side, least squared vertex-to-edge distance) of q's vertices against p's edges: side
+    (np, nq, N) is ``_side``'s, the distance (N,) ``_vertex_edge_sq``'s (in place where a
+    temporary is done with: the same operations on the same operands)."""
+    ex, ey = _next_minus(px), _next_minus(py)            # (np, N): p_{i+1} - p_i
+    relx = qx[None, :, :] - px[:, None, :]               # (np, nq, N)
+    rely = qy[None, :, :] - py[:, None, :]
+    exb, eyb = ex[:, None, :], ey[:, None, :]
+    side = exb * rely
+    side -= eyb * relx                                   # cross(e, rel)
+    ee = (ex * ex + ey * ey)[:, None, :]                 # (np, 1, N)
+    t = relx * exb
+    t += rely * eyb                                      # dot(rel, e)
+    pos = ee > 0
+    if np.all(pos):                                      # no zero-length edge: t = 0 nowhere
+        t /= ee
+        np.clip(t, 0.0, 1.0, out=t)
+    else:
+        t = np.where(pos, np.clip(t / np.where(pos, ee, 1.0), 0.0, 1.0), 0.0)
+    gx = t * exb
+    np.subtract(relx, gx, out=gx)
+    gy = t * eyb
+    np.subtract(rely, gy, out=gy)
+    gx *= gx
+    gy *= gy
+    gx += gy
+    return side, np.min(gx.reshape(gx.shape[0] * gx.shape[1], gx.shape[2]), axis=0)
+
+
+def _straddles(side: FloatArray) -> npt.NDArray[np.bool_]:
+    """side[i, j] and side[i, j + 1] (cyclically) strictly of opposite signs: ``_crossing``'s
+    sign(x) * sign(y) < 0."""
+    neg, pos = side < 0, side > 0
+    out = np.empty_like(neg)
+    out[:, :-1] = (neg[:, :-1] & pos[:, 1:]) | (pos[:, :-1] & neg[:, 1:])
+    out[:, -1] = (neg[:, -1] & pos[:, 0]) | (pos[:, -1] & neg[:, 0])
+    return out
+
+
+def _contains(side: FloatArray, orient: FloatArray) -> npt.NDArray[np.bool_]:
+    """``_inside`` of (np, nq, N) sides and (N,) orientations."""
+    inner = orient * side >= 0
+    return (orient != 0) & np.any(np.all(inner, axis=0), axis=0)
+
+
+def _distances(a: FloatArray, b: FloatArray) -> FloatArray:
+    lead = np.broadcast_shapes(a.shape[:-2], b.shape[:-2])
+    ax, ay = _soa(a, lead)
+    bx, by = _soa(b, lead)
+    orient_a = np.broadcast_to(_orientation(a), lead).reshape(-1)
+    orient_b = np.broadcast_to(_orientation(b), lead).reshape(-1)
+    side_ab, gap_ab = _half(ax, ay, bx, by)
+    side_ba, gap_ba = _half(bx, by, ax, ay)
+    meet = (np.any(_straddles(side_ab) & np.swapaxes(_straddles(side_ba), 0, 1), axis=(0, 1))
+            | _contains(side_ab, orient_a) | _contains(side_ba, orient_b))
+    out = np.where(meet, 0.0, np.sqrt(np.minimum(gap_ab, gap_ba)))
+    return out.reshape(lead)

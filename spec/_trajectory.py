@@ -32,9 +32,11 @@ import hashlib
 import itertools
 import json
 import math
+import os
+import stat
 import time
 from array import array
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, cast
@@ -58,10 +60,14 @@ __all__ = ["COLUMNS", "JOINTS", "Trajectory", "csv_column_order", "load_trajecto
            "executed_trajectory", "trajectory_csv", "tube_lipschitz", "tolerance_rad",
            "TOLERANCE_STEP_RAD", "SPEED_TOLERANCE", "trajectory_distances", "validate",
            "between_samples_bound", "ReferenceSpeeds", "CHUNK_ROWS", "TrajectorySummary",
-           "certify_trajectory_file", "log_end_bound"]
+           "certify_trajectory_file", "log_end_bound", "RowLimit", "TRAJECTORY_ROWS",
+           "certify_trajectory_rows", "check_trajectory_size", "WholeReference",
+           "StreamedReference", "row_blocks", "trajectory_file_blocks", "rows_digest"]
 
 #: The file columns, in the order of ``Trajectory.angles`` after t.
 COLUMNS = ("t", "left1", "left2", "right1", "right2")
+#: The same, under the public name it has in ``cfmpa.spec``.
+TRAJECTORY_COLUMNS = COLUMNS
 JOINTS = COLUMNS[1:]
 #: tolerance_rad is rounded down to a multiple of this.
 TOLERANCE_STEP_RAD = 1e-6
@@ -77,6 +83,41 @@ CHUNK_ROWS = 65_536
 DISTANCE_BATCH = 1_024
 
 FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class RowLimit:
+    """A row budget of a streamed reader (docs/model.md §12): ``default`` rows unless the
+    environment variable ``env`` sets it (a positive integer). A streamed reader holds a part at
+    a time, so the budget bounds the time a run takes, not its memory."""
+
+    env: str
+    default: int
+    what: str
+
+    def value(self) -> int:
+        raw = os.environ.get(self.env)
+        if raw is None:
+            return self.default
+        try:
+            v = int(raw)
+        except ValueError:
+            v = 0
+        if v < 1:
+            raise InputError(self.env, echo(raw), "must be a positive integer (rows)")
+        return v
+
+    def refusal(self, cap: int, source: str | None, line: int | None,
+                field: str = "trajectory") -> InputError:
+        """The one-line refusal of the row after the ``cap``-th: the limit and how to raise it."""
+        return InputError(field, MISSING, f"has more than {cap:,} rows, the limit for {self.what} "
+                          f"(set the environment variable {self.env} higher to read a longer "
+                          "one)", source=source, line=line)
+
+
+#: The rows a streamed trajectory reader takes (`cfmpa certify`, `cfmpa monitor --traj`; CSV or
+#: bag): 10^8 rows are a 6.6 GB CSV and about half an hour of certify on one core.
+TRAJECTORY_ROWS = RowLimit("CFMPA_MAX_TRAJECTORY_ROWS", 100_000_000, "a streamed trajectory")
 
 
 @dataclass(frozen=True)
@@ -144,21 +185,84 @@ def _csv_rows(lines: Iterator[str], source: str | None) -> Iterator[tuple[int, l
             continue
         if blank is not None:                       # trailing blank lines are no rows; others
             raise _fail("row", "", "is blank (rows must follow one another)", source, blank)
-        fields = line.rstrip("\r\n").split(",")
-        if len(fields) != len(COLUMNS):
-            raise _fail("row", echo(line.strip()), f"must have {len(COLUMNS)} values, has "
-                        f"{len(fields)}", source, no)
-        vals = []
-        for name, i in zip(COLUMNS, order):
+        yield no, _csv_values(line, order, source, no)
+
+
+def _csv_values(line: str, order: list[int], source: str | None, no: int) -> list[float]:
+    """The five values of a CSV row (file line ``no``) in COLUMNS order; InputError naming the
+    first that is missing, no number or not finite."""
+    fields = line.rstrip("\r\n").split(",")
+    if len(fields) != len(COLUMNS):
+        raise _fail("row", echo(line.strip()), f"must have {len(COLUMNS)} values, has "
+                    f"{len(fields)}", source, no)
+    vals = []
+    for name, i in zip(COLUMNS, order):
+        try:
+            v = float(fields[i])
+        except ValueError:
+            raise _fail(name, echo(fields[i].strip()), "must be a number", source,
+                        no) from None
+        if not math.isfinite(v):
+            raise _fail(name, v, "must be finite", source, no)
+        vals.append(v)
+    return vals
+
+
+#: CSV lines parsed at a time by ``_csv_row_blocks``.
+PARSE_LINES = 1_024
+#: A block of rows: their file lines and their values in COLUMNS order, (rows, 5).
+RowBlock = tuple[Sequence[int], FloatArray]
+
+
+def _csv_row_blocks(lines: Iterator[str], source: str | None, block: int = PARSE_LINES
+                    ) -> Iterator[RowBlock]:
+    """``_csv_rows``' rows, ``block`` lines at a time: (their file lines, their values (m, 5)).
+    A block of rows alone (no blank line in it or pending) is parsed at once: one ``float``
+    per field, the same conversion; any other block, or one whose parse fails, line by line as
+    ``_csv_rows`` does, its good rows given before its error is raised, so that the same error
+    comes out after the same rows (a row budget counts them first)."""
+    order = csv_column_order(next(lines, ""), source)
+    blank: int | None = None
+    no = 1
+    width = len(COLUMNS)
+    while True:
+        batch = list(itertools.islice(lines, block))
+        if not batch:
+            return
+        if blank is None and all(map(str.strip, batch)):
+            text = "".join(batch).replace("\n", ",")
+            fields = text[:-1].split(",") if text.endswith(",") else text.split(",")
+            if len(fields) == width * len(batch) and list(map(str.count, batch, itertools.repeat(
+                    ","))).count(width - 1) == len(batch):
+                try:
+                    arr = np.array(list(map(float, fields)), dtype=float).reshape(-1, width)
+                except ValueError:
+                    arr = None
+                if arr is not None and np.all(np.isfinite(arr)):
+                    yield range(no + 1, no + 1 + len(batch)), arr[:, order]
+                    no += len(batch)
+                    continue
+        rows: list[list[float]] = []
+        nos: list[int] = []
+        error: InputError | None = None
+        for line in batch:
+            no += 1
+            if not line.strip():
+                blank = no if blank is None else blank
+                continue
             try:
-                v = float(fields[i])
-            except ValueError:
-                raise _fail(name, echo(fields[i].strip()), "must be a number", source,
-                            no) from None
-            if not math.isfinite(v):
-                raise _fail(name, v, "must be finite", source, no)
-            vals.append(v)
-        yield no, vals
+                if blank is not None:
+                    raise _fail("row", "", "is blank (rows must follow one another)", source,
+                                blank)
+                rows.append(_csv_values(line, order, source, no))
+            except InputError as exc:
+                error = exc
+                break
+            nos.append(no)
+        if nos:
+            yield nos, np.array(rows, dtype=float).reshape(-1, width)
+        if error is not None:
+            raise error
 
 
 def parse_trajectory_csv(text: str | Iterable[str], s: Scenario, *, source: str | None = None,
@@ -219,16 +323,36 @@ def parse_trajectory_json(doc: Any, s: Scenario, *, source: str | None = None,
 
 
 def load_trajectory(path: str | Path, s: Scenario, *, allow_speed: bool = False) -> Trajectory:
-    """A trajectory file: JSON if it ends in .json (or its first line starts with ``{``), else
-    CSV. Bounded (docs/model.md §12): CSV is streamed line by line, each line within
-    LIMITS["line"], the file within LIMITS["trajectory"]; JSON, read whole, within the latter."""
+    """A trajectory file, held whole: JSON if it ends in .json (or its first line starts with
+    ``{``), else CSV. Bounded (docs/model.md §12): a regular file larger than
+    LIMITS["trajectory"] is refused by its size before its first line is read; CSV is read line
+    by line, each line within LIMITS["line"] (and, from a pipe or device, the bytes read within
+    LIMITS["trajectory"]); JSON is read whole, within the latter. The streamed readers
+    (``certify_trajectory_file``, ``certify_trajectory_rows``) have no byte limit."""
     p = Path(path)
     source = str(p)
-    with _csv_lines(p, source) as csv:
+    check_trajectory_size(p, source)
+    with _csv_lines(p, source, whole=True) as csv:
         if csv is not None:
             return parse_trajectory_csv(csv.lines, s, source=source, allow_speed=allow_speed)
     data = read_bounded(p, LIMITS["trajectory"], source, lines=False, field="trajectory")
     return _parse_json_bytes(data, s, source, allow_speed)
+
+
+def check_trajectory_size(p: Path, source: str) -> None:
+    """Refuse a regular file larger than LIMITS["trajectory"] by its size, nothing read (what
+    a reader holding the trajectory whole, or JSON, applies first); a pipe or a device has no
+    size to check (its reader counts the bytes), and a file that cannot be read is left to the
+    reader, which names why."""
+    try:
+        st = os.stat(p)
+    except OSError:
+        return
+    lim = LIMITS["trajectory"]
+    cap = lim.value()
+    if stat.S_ISREG(st.st_mode) and st.st_size > cap:
+        raise _fail("file", MISSING, f"is larger than {lim.words(cap)}, and a trajectory read "
+                    "whole (JSON, or `cfmpa simulate`'s) is held in memory", source, None)
 
 
 @dataclass(frozen=True)
@@ -241,10 +365,12 @@ class _CsvFile:
 
 
 @contextlib.contextmanager
-def _csv_lines(p: Path, source: str, *, hashing: bool = False) -> Iterator[_CsvFile | None]:
-    """The trajectory file open as CSV, streamed line by line within LIMITS["line"] and, in
-    all, LIMITS["trajectory"]; None when it is JSON (it ends in .json, or its first line starts
-    with ``{``), which the caller reads whole after the ``with``. An unreadable file raises
+def _csv_lines(p: Path, source: str, *, hashing: bool = False,
+               whole: bool = False) -> Iterator[_CsvFile | None]:
+    """The trajectory file open as CSV, streamed line by line within LIMITS["line"] and, when
+    read ``whole`` (held in memory), in all LIMITS["trajectory"]; None when it is JSON (it ends
+    in .json, or its first line starts with ``{``), which the caller reads whole after the
+    ``with`` (its size checked first: ``check_trajectory_size``). An unreadable file raises
     InputError naming it. Both readers (``load_trajectory``, ``certify_trajectory_file``) open
     and bound their file here, so they take a file for the same format and refuse it alike."""
     if p.suffix.lower() == ".json":
@@ -259,7 +385,7 @@ def _csv_lines(p: Path, source: str, *, hashing: bool = False) -> Iterator[_CsvF
         reader = _HashingReader(fh) if hashing else None
         # cast: bounded_lines reads only readline(size) of a binary stream
         stream = cast(IO[bytes], reader) if reader is not None else fh
-        lines = bounded_lines(stream, source, total=LIMITS["trajectory"])
+        lines = bounded_lines(stream, source, total=LIMITS["trajectory"] if whole else None)
         first = next(lines, "")
         yield (None if first.lstrip().startswith("{")
                else _CsvFile(itertools.chain([first], lines), reader))
@@ -466,6 +592,195 @@ class ReferenceSpeeds:
         return out
 
 
+class WholeReference:
+    """A trajectory held whole as the monitor reads it (``block``): the reference that
+    ``StreamedReference`` must equal, bit for bit."""
+
+    def __init__(self, traj: Trajectory) -> None:
+        self.traj, self.speeds = traj, ReferenceSpeeds.of(traj)
+        self.source = traj.source
+        self.span = (float(traj.t[0]), float(traj.t[-1]))
+
+    def top(self) -> FloatArray:
+        return self.speeds.top()
+
+    def block(self, lo: float, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(the trajectory at times ``t`` (K,), sorted, (K, 4); each joint's largest speed
+        (K, 4) on the K intervals between consecutive points of ``lo``, t_0, ..., t_K-1), with
+        ``lo`` <= t_0 (``Trajectory.at``, ``ReferenceSpeeds.over``). Successive calls ask
+        from no earlier than the last point of the previous one."""
+        pts = np.concatenate([[lo], t])
+        return self.traj.at(t), self.speeds.over(pts[:-1], pts[1:])
+
+    def finish(self) -> None:
+        """Nothing to check: the rows are the ones certified."""
+
+
+class StreamedReference:
+    """``WholeReference``'s ``block`` over a trajectory read a second time, in order, in blocks
+    (t (m,), angles (m, 4)), holding a window of about ``window_rows`` rows whatever the
+    trajectory's length (docs/model.md §12): the rows from the one before the earliest time
+    still asked for on. Where one interval between two points asked for spans more rows than
+    the window, the largest speed over its rows read so far is carried (a maximum, so the same
+    number) and those rows are dropped. ``summary``: the first pass's (``certify_trajectory_rows``):
+    the span, the top speeds, and the rows' count and digest, which ``finish`` checks this pass
+    read again (InputError otherwise: the file changed between the passes)."""
+
+    def __init__(self, blocks: Iterable[tuple[FloatArray, FloatArray]],
+                 summary: TrajectorySummary, window_rows: int = 2 * CHUNK_ROWS) -> None:
+        if window_rows < 4:
+            raise ValueError("window_rows must be at least 4")
+        self.blocks = iter(blocks)
+        self.summary, self.window = summary, window_rows
+        self.source = summary.source
+        self.span = (summary.t_start_s, summary.t_end_s)
+        self.wt: FloatArray = np.zeros(0)
+        self.wa: FloatArray = np.zeros((0, 4))
+        self.base = 0                                   # the window's first row in the whole
+        self.eof = False
+        self.read = 0
+        self.digest = hashlib.sha256()
+        self.peak_rows = 0                              # the largest window held (tests)
+
+    def top(self) -> FloatArray:
+        return np.asarray(self.summary.top_speed_rad_s, dtype=float)
+
+    def _load(self) -> None:
+        got = next(self.blocks, None)
+        if got is None:
+            self.eof = True
+            return
+        t, a = got
+        rows_digest(t, a, self.digest)
+        self.read += len(t)
+        self.wt = np.concatenate([self.wt, t])
+        self.wa = np.concatenate([self.wa, a])
+        self.peak_rows = max(self.peak_rows, len(self.wt))
+
+    def _drop(self, r: int) -> None:
+        """Drop the window's rows before its row ``r``."""
+        if r > 0:
+            self.wt, self.wa = self.wt[r:], self.wa[r:]
+            self.base += r
+
+    def _window(self) -> tuple[Trajectory, ReferenceSpeeds]:
+        """The window as a trajectory of its own, and its speeds (``ReferenceSpeeds.of``: piece
+        j between its rows j - 1 and j, the whole's piece base + j; its pieces 0 and n, at rest,
+        are the whole's only when the window starts at row 0, or ends at the last row)."""
+        window = Trajectory(self.wt, self.wa)
+        return window, ReferenceSpeeds.of(window)
+
+    def block(self, lo: float, t: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """As ``WholeReference.block``, the same numbers."""
+        t = np.asarray(t, dtype=float)
+        k_all = len(t)
+        pts = np.concatenate([[lo], t])
+        at = np.empty((k_all, 4))
+        over = np.empty((k_all, 4))
+        if not len(self.wt) and not self.eof:
+            self._load()
+        # The rows before the one at or before lo are asked for no more.
+        n = len(self.wt)
+        self._drop(max(min(int(np.searchsorted(self.wt, lo, side="right")) - 1, n - 2), 0))
+        carry: FloatArray | None = None     # the largest speed on dropped pieces of the open gap
+        i = 0                               # pts[i] answered (lo first); pts[i + 1:] pending
+        while i < k_all:
+            while not self.eof and len(self.wt) < self.window and (
+                    len(self.wt) < 2 or self.wt[-1] <= pts[-1]):
+                self._load()
+            if not len(self.wt):            # the second reading gave no rows at all
+                self.finish()
+            if self.eof and self.base + len(self.wt) == 1:      # one row: at rest there
+                at[i:] = self.wa[0]
+                over[i:] = 0.0
+                return at, over
+            end = math.inf if self.eof else float(self.wt[-1])
+            j = i + 1 + int(np.searchsorted(pts[i + 1:], end, side="left"))
+            if j > i + 1:                   # pts[i + 1 .. j - 1] lie before the window's end
+                self._answer(pts[i:j], carry, at[i:j - 1], over[i:j - 1])
+                carry, i = None, j - 1
+                continue
+            carry = self._reduce(float(pts[i]), carry)
+        return at, over
+
+    def _answer(self, pts: FloatArray, carry: FloatArray | None, at: FloatArray,
+                over: FloatArray) -> None:
+        """The trajectory at ``pts[1:]`` and the speeds between consecutive ``pts``, all within
+        the window, by the code that answers for the whole (``Trajectory.at``,
+        ``ReferenceSpeeds.over``) run on the window: each point lies before the window's last
+        row (or the window ends at the whole's), and after its first (or it starts at row 0),
+        so the window's row and pieces are the whole's. ``carry``: the speeds of the dropped
+        pieces of the first interval, whose pieces in the window start at its first row."""
+        window, speeds = self._window()
+        at[:] = window.at(pts[1:])
+        a = pts[:-1].copy()
+        if carry is not None:
+            a[0] = self.wt[0]
+        over[:] = speeds.over(a, pts[1:])
+        if carry is not None:
+            over[0] = np.maximum(over[0], carry)
+
+    def _reduce(self, a: float, carry: FloatArray | None) -> FloatArray | None:
+        """The window is full and the next point lies past it: keep its last two rows, and carry
+        the largest speed of the pieces dropped from the interval starting at ``a``."""
+        n = len(self.wt)
+        keep = n - 2
+        lo = 1 if carry is not None else int(np.searchsorted(self.wt, a, side="right"))
+        if lo <= keep:
+            seg = self._window()[1].per_piece[lo:keep + 1].max(axis=0)
+            carry = seg if carry is None else np.maximum(carry, seg)
+        self._drop(keep)            # else the interval starts on the last piece: nothing dropped
+        return carry
+
+    def finish(self) -> None:
+        """Read the rest, and check the rows read again are the ones certified."""
+        while not self.eof:
+            self._drop(len(self.wt))
+            self._load()
+        if (self.read != self.summary.rows
+                or self.digest.hexdigest() != self.summary.rows_sha256):
+            raise _fail("trajectory", MISSING, f"changed while it was read: its second reading "
+                        f"({self.read:,} rows) differs from the rows certified "
+                        f"({self.summary.rows:,})", self.source, None)
+
+
+def row_blocks(rows: Iterable[tuple[int, Iterable[float]]], block_rows: int = CHUNK_ROWS
+               ) -> Iterator[tuple[FloatArray, FloatArray]]:
+    """Rows given one at a time (as ``certify_trajectory_rows`` takes them) in blocks of
+    ``block_rows``: (t (m,), angles (m, 4))."""
+    vals: array[float] = array("d")
+    n = 0
+    for _, row in rows:
+        vals.extend(row)
+        n += 1
+        if n >= block_rows:
+            arr = np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
+            yield arr[:, 0].copy(), arr[:, 1:].copy()
+            vals, n = array("d"), 0
+    if n:
+        arr = np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
+        yield arr[:, 0].copy(), arr[:, 1:].copy()
+
+
+@contextlib.contextmanager
+def trajectory_file_blocks(path: str | Path, s: Scenario, *, block_rows: int = CHUNK_ROWS
+                           ) -> Iterator[Iterator[tuple[FloatArray, FloatArray]]]:
+    """The rows of a trajectory file (``certify_trajectory_file``'s) read again, in blocks for
+    ``StreamedReference``: a CSV streamed (no byte limit, each line bounded), a JSON read
+    whole (its size within LIMITS["trajectory"]). Not validated again: ``finish`` checks they
+    are the rows certified."""
+    p = Path(path)
+    source = str(p)
+    with _csv_lines(p, source) as csv:
+        if csv is not None:
+            yield row_blocks(_csv_rows(csv.lines, source), block_rows)
+            return
+    check_trajectory_size(p, source)
+    data = read_bounded(p, LIMITS["trajectory"], source, lines=False, field="trajectory")
+    traj = _parse_json_bytes(data, s, source, allow_speed=True)
+    yield iter([(traj.t, traj.angles)])
+
+
 def trajectory_distances(s: Scenario, angles: FloatArray) -> FloatArray:
     """d[k, a, b]: distance (3-D, with the heights) between left part a and right part b at
     configurations (K, 4)
@@ -564,17 +879,25 @@ def _split(traj: Trajectory, chunk_rows: int) -> Iterator[tuple[Trajectory, int]
         yield Trajectory(traj.t[lo:hi], traj.angles[lo:hi], traj.source, lines), lo
 
 
+#: A trajectory's motion under its public name (read on Z3 terms by the wiring obligations).
+TrajectoryMotion = _TrajectoryMotion
+
+
 @dataclass(frozen=True)
 class TrajectorySummary:
     """What `cfmpa certify` reports of a trajectory it no longer holds: its file, row count and
     time span, and for a contact on the piece between rows k and k + 1 the (time, file line) of
-    both rows (line None for JSON)."""
+    both rows (line None for JSON); and what `cfmpa monitor` needs before its second pass: each
+    joint's top speed (``ReferenceSpeeds.top``, 0.0 for one row) and ``rows_sha256``, the
+    SHA-256 of the rows' doubles in order (``rows_digest``), which that pass must read again."""
 
     source: str | None
     rows: int
     t_start_s: float
     t_end_s: float
     contact_rows: tuple[tuple[float, int | None], tuple[float, int | None]] | None = None
+    top_speed_rad_s: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)
+    rows_sha256: str | None = None
 
     @staticmethod
     def of(traj: Trajectory, cert: Certificate) -> TrajectorySummary:
@@ -582,8 +905,17 @@ class TrajectorySummary:
         k = None if d is None else d.step
         rows = None if k is None else ((float(traj.t[k]), traj.line(k)),
                                        (float(traj.t[k + 1]), traj.line(k + 1)))
+        top = tuple(float(x) for x in ReferenceSpeeds.of(traj).top())
         return TrajectorySummary(traj.source, traj.rows, float(traj.t[0]), float(traj.t[-1]),
-                                 rows)
+                                 rows, top, rows_digest(traj.t, traj.angles).hexdigest())
+
+
+def rows_digest(t: FloatArray, angles: FloatArray, h: Any = None) -> Any:
+    """``h`` (a new SHA-256 when None) updated with rows (t, angles) as doubles, row by row in
+    COLUMNS order: the same digest however the rows are split into blocks."""
+    h = hashlib.sha256() if h is None else h
+    h.update(np.ascontiguousarray(np.column_stack([t, angles]), dtype=np.float64).tobytes())
+    return h
 
 
 class _Certifier:
@@ -595,8 +927,13 @@ class _Certifier:
         self.prover = Prover(first_contact=True, **caps)
         self.rows, self.t_start, self.t_end = 0, math.nan, math.nan
         self.contact_rows: tuple[tuple[float, int | None], tuple[float, int | None]] | None = None
+        self.top = np.zeros(4)
+        self.digest = hashlib.sha256()
 
     def add(self, part: Trajectory, offset: int) -> None:
+        if part.rows > 1:           # ReferenceSpeeds.of's speeds, the same numbers
+            self.top = np.maximum(self.top, (np.abs(np.diff(part.angles, axis=0))
+                                             / np.diff(part.t)[:, None]).max(axis=0))
         if self.prover.add(_TrajectoryMotion(self.s, part, offset)):
             d = self.prover.detail
             k = None if d is None else d.step
@@ -607,7 +944,8 @@ class _Certifier:
 
     def summary(self) -> TrajectorySummary:
         return TrajectorySummary(self.source, self.rows, self.t_start, self.t_end,
-                                 self.contact_rows)
+                                 self.contact_rows, tuple(float(x) for x in self.top),
+                                 self.digest.hexdigest())
 
 
 def certify_trajectory(s: Scenario, traj: Trajectory, *, max_depth: int = DEFAULT_MAX_DEPTH,
@@ -641,14 +979,43 @@ class _HashingReader:
         return raw
 
 
-def _csv_parts(lines: Iterator[str], s: Scenario, source: str, allow_speed: bool,
-               chunk_rows: int, c: _Certifier) -> Iterator[tuple[Trajectory, int]]:
-    """The CSV trajectory's validated parts as ``_split`` makes them, read ``chunk_rows`` rows
-    at a time. The first failure of a row (parse, blank line) raises at once, as
-    ``parse_trajectory_csv`` would; a validation failure stops the parts and is raised once the
-    whole file is read (a later row's parse failure, or an earlier check, would win in
-    ``validate``'s order); counts rows and the time span into ``c``."""
-    checks = _Checks(s, source, allow_speed)
+def _blocks_of(rows: Iterable[tuple[int, Iterable[float]]], block: int = PARSE_LINES
+               ) -> Iterator[RowBlock]:
+    """Rows given one at a time as (file line, the five values in COLUMNS order) in blocks of
+    ``block`` rows; a failure of ``rows`` is raised after the block of the rows before it."""
+    it = iter(rows)
+    while True:
+        vals: array[float] = array("d")
+        nos: list[int] = []
+        error: Exception | None = None
+        try:
+            for no, row in itertools.islice(it, block):
+                vals.extend(row)
+                nos.append(no)
+        except Exception as exc:        # the reader's own failure, raised below in its turn
+            error = exc
+        if nos:
+            yield nos, np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
+        if error is not None:
+            raise error
+        if len(nos) < block:
+            return
+
+
+def _row_parts(blocks: Iterable[RowBlock], s: Scenario, source: str,
+               allow_speed: bool, chunk_rows: int, c: _Certifier,
+               name_row: Callable[[int], str] | None = None,
+               ) -> Iterator[tuple[Trajectory, int]]:
+    """The trajectory's validated parts as ``_split`` makes them, from its rows given in blocks
+    of (file lines, the five values in COLUMNS order), ``chunk_rows`` rows at a time. A
+    failure of the reader (a CSV row's parse, a blank line; a bag's message) raises at once, as
+    the whole-file loader would; a validation failure stops the parts and is raised once every
+    row is read (a later row's parse failure, or an earlier check, would win in ``validate``'s
+    order); a row past the budget (TRAJECTORY_ROWS) raises at once, naming its line (or, with
+    ``name_row``, how a failure names the row: a bag's "message k on TOPIC"). Counts rows and
+    the time span into ``c``."""
+    checks = _Checks(s, source, allow_speed, name_row)
+    cap = TRAJECTORY_ROWS.value()
     prev: tuple[float, FloatArray, int] | None = None
     vals: array[float] = array("d")
     where: list[int] = []
@@ -656,6 +1023,7 @@ def _csv_parts(lines: Iterator[str], s: Scenario, source: str, allow_speed: bool
     def flush() -> Iterator[tuple[Trajectory, int]]:
         nonlocal prev, vals, where
         arr = np.frombuffer(vals, dtype=float).reshape(-1, len(COLUMNS))
+        c.digest.update(arr.tobytes())
         t, a = arr[:, 0].copy(), arr[:, 1:].copy()
         offset, lines_here = c.rows, where
         vals, where = array("d"), []
@@ -675,11 +1043,19 @@ def _csv_parts(lines: Iterator[str], s: Scenario, source: str, allow_speed: bool
                                   (prev[2], *lines_here)), offset - 1)
         prev = last
 
-    for no, row in _csv_rows(lines, source):
-        vals.extend(row)
-        where.append(no)
-        if len(where) >= chunk_rows:
-            yield from flush()
+    for nos, block in blocks:
+        i, m = 0, len(nos)
+        while i < m:                                # row nos[i] is the next
+            if c.rows + len(where) >= cap:
+                raise TRAJECTORY_ROWS.refusal(cap, source,
+                                              None if name_row is not None else nos[i])
+            # the rows up to the budget (at least the one just admitted) and the part's end
+            take = max(1, min(m - i, chunk_rows - len(where), cap - c.rows - len(where)))
+            vals.frombytes(np.ascontiguousarray(block[i:i + take], dtype=float).tobytes())
+            where.extend(nos[i:i + take])
+            i += take
+            if len(where) >= chunk_rows:
+                yield from flush()
     if where:
         yield from flush()
     if not c.rows:
@@ -687,38 +1063,74 @@ def _csv_parts(lines: Iterator[str], s: Scenario, source: str, allow_speed: bool
     checks.raise_first()
 
 
+def certify_trajectory_rows(rows: Iterable[tuple[int, Iterable[float]]], s: Scenario, *,
+                            source: str, allow_speed: bool = False,
+                            chunk_rows: int = CHUNK_ROWS,
+                            name_row: Callable[[int], str] | None = None,
+                            timings: dict[str, float] | None = None,
+                            ) -> tuple[TrajectorySummary, Certificate]:
+    """(summary, certificate) of a trajectory given row by row as (line, the five values in
+    COLUMNS order), read, validated and certified ``chunk_rows`` rows at a time in one pass
+    (docs/model.md §12): what is held does not grow with the rows; at most TRAJECTORY_ROWS of
+    them. The certificate is ``certify_trajectory``'s of the same rows loaded whole, and the
+    errors are the whole loader's, in the same order (``name_row`` as in
+    ``parse_trajectory_csv``). ``timings`` gets the seconds spent reading (``load``, the rows'
+    source included) and certifying (``certificate``)."""
+    return _certify_blocks(_blocks_of(rows), s, source=source, allow_speed=allow_speed,
+                           chunk_rows=chunk_rows, name_row=name_row, timings=timings)
+
+
+def _certify_blocks(blocks: Iterable[RowBlock], s: Scenario, *, source: str,
+                    allow_speed: bool = False, chunk_rows: int = CHUNK_ROWS,
+                    name_row: Callable[[int], str] | None = None,
+                    timings: dict[str, float] | None = None,
+                    ) -> tuple[TrajectorySummary, Certificate]:
+    """``certify_trajectory_rows`` of rows given in blocks (``_blocks_of``,
+    ``_csv_row_blocks``)."""
+    if chunk_rows < 2:
+        raise ValueError("chunk_rows must be at least 2")
+    tim = {"load": 0.0, "certificate": 0.0}
+    c = _Certifier(s, source)
+    parts = _row_parts(blocks, s, source, allow_speed, chunk_rows, c, name_row)
+    t0 = time.perf_counter()
+    while True:
+        part = next(parts, None)
+        t1 = time.perf_counter()
+        tim["load"] += t1 - t0
+        if part is None:
+            break
+        c.add(*part)
+        t0 = time.perf_counter()
+        tim["certificate"] += t0 - t1
+    if timings is not None:
+        timings.update(tim)
+    return c.summary(), c.prover.certificate()
+
+
 def certify_trajectory_file(path: str | Path, s: Scenario, *, allow_speed: bool = False,
                             chunk_rows: int = CHUNK_ROWS,
                             timings: dict[str, float] | None = None,
                             ) -> tuple[TrajectorySummary, Certificate, str]:
     """(summary, certificate, SHA-256 of the file's bytes) of a trajectory file, read and
-    certified in one pass: a CSV ``chunk_rows`` rows at a time, so what is held does not grow
-    with the file (docs/model.md §12); a JSON file is read whole (within LIMITS["trajectory"])
-    and certified in the same parts. Errors are those of ``load_trajectory``, in the same
-    order; the certificate is ``certify_trajectory``'s of the loaded trajectory. ``timings``
-    gets the seconds spent reading (``load``) and certifying (``certificate``)."""
+    certified in one pass: a CSV ``chunk_rows`` rows at a time (``certify_trajectory_rows``),
+    so what is held does not grow with the file, with no byte limit: each line within
+    LIMITS["line"], at most TRAJECTORY_ROWS rows (docs/model.md §12); a JSON file is read whole
+    (its size within LIMITS["trajectory"], checked before it is read) and certified in the same
+    parts. Errors are those of ``load_trajectory``, in the same order (but for the limits); the
+    certificate is ``certify_trajectory``'s of the loaded trajectory. ``timings`` gets the
+    seconds spent reading (``load``) and certifying (``certificate``)."""
     if chunk_rows < 2:
         raise ValueError("chunk_rows must be at least 2")
     p = Path(path)
     source = str(p)
-    tim = {"load": 0.0, "certificate": 0.0}
-    c = _Certifier(s, source)
     t0 = time.perf_counter()
     with _csv_lines(p, source, hashing=True) as csv:
         if csv is not None and csv.hashing is not None:
-            parts = _csv_parts(csv.lines, s, source, allow_speed, chunk_rows, c)
-            while True:
-                part = next(parts, None)
-                t1 = time.perf_counter()
-                tim["load"] += t1 - t0
-                if part is None:
-                    break
-                c.add(*part)
-                t0 = time.perf_counter()
-                tim["certificate"] += t0 - t1
-            if timings is not None:
-                timings.update(tim)
-            return c.summary(), c.prover.certificate(), csv.hashing.hash.hexdigest()
+            summary, cert = _certify_blocks(
+                _csv_row_blocks(csv.lines, source), s, source=source, allow_speed=allow_speed,
+                chunk_rows=chunk_rows, timings=timings)
+            return summary, cert, csv.hashing.hash.hexdigest()
+    check_trajectory_size(p, source)
     data = read_bounded(p, LIMITS["trajectory"], source, lines=False, field="trajectory")
     traj = _parse_json_bytes(data, s, source, allow_speed)
     t1 = time.perf_counter()

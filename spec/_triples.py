@@ -157,7 +157,7 @@ _REGION = {
 
 def _builtdr(name: str, variant: Variant, reference: str, note: str) -> Triple:
     region = _REGION[variant]
-    rest = ("the principal at rest at its goal" if variant is Variant.TIGHT else "layer N-1")
+    rest = "the principal at rest at its goal" if variant.rest_at_goal else "layer N-1"
     return Triple(
         name=name, title=f"BuiltDR, {variant.value}", reference=reference,
         command=Command.BUILT_DR, variant=variant,

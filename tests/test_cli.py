@@ -294,21 +294,25 @@ def _no_work(monkeypatch):
 OUTPUTS = [
     (["dr", "default", "--out", "{bad}"], "--out"),
     (["plan", "default", "--out", "{bad}"], "--out"),
-    (["plan", "default", "--out", "{ok}", "--witness", "{bad}"], "--witness"),
-    (["check", "--batch", "{ok}", "--json", "{bad}"], "--json"),
-    (["selftest", "--code", "--json", "{bad}"], "--json"),
+    (["plan", "default", "--out", "{ok}", "--witness-out", "{bad}"], "--witness-out"),
+    (["plan", "default", "--out", "{ok}", "--witness", "{bad}"], "--witness-out"),   # old
+    (["check-batch", "{ok}", "--json", "{bad}"], "--json"),
+    (["check", "--batch", "{ok}", "--json", "{bad}"], "--json"),                     # old
+    (["mutants", "--json", "{bad}"], "--json"),
+    (["selftest", "--code", "--json", "{bad}"], "--json"),                           # old
     (["prove", "--out", "{bad}"], "--out"),
     (["prove", "--out", "{ok}", "--audit", "{bad}"], "--audit"),
     (["audit", "--out", "{bad}"], "--out"),
     (["compare", "--out", "{bad}"], "--out"),
     (["certify", "default", "--traj", "t.csv", "--json", "{bad}"], "--json"),
     (["monitor", "default", "--traj", "t.csv", "--log", "l.csv", "--json", "{bad}"], "--json"),
-    (["simulate", "default", "--traj", "t.csv", "--out", "{bad}"], "--out"),
+    (["simulate", "default", "--traj", "t.csv", "--log-out", "{bad}"], "--log-out"),
+    (["simulate", "default", "--traj", "t.csv", "--out", "{bad}"], "--log-out"),      # old
 ]
 
 
 def _is_file_option(argv, option):
-    return option in ("--json", "--witness") or argv[0] == "simulate"
+    return option in ("--json", "--witness-out") or argv[0] == "simulate"
 
 
 @pytest.mark.parametrize("argv, option", OUTPUTS, ids=lambda x: " ".join(x)
@@ -495,7 +499,8 @@ def test_the_campaign_refuses_too_many_workcells_before_its_store(tmp_path):
     (["plan", "default", "--out", "{tmp}", "--sample", str(2**60)], "--sample must be at most"),
     (["plan", "default", "--out", "{tmp}", "--seed", str(2**64)], "--seed must be at most"),
     (["check", "--batch", "{tmp}", "--workers", "100000"], "--workers must be at most"),
-    (["prove", "--out", "{tmp}", "--workers", "100000"], "--workers must be at most"),
+    (["prove", "--out", "{tmp}", "--jobs", "100000"], "--jobs must be at most"),
+    (["prove", "--out", "{tmp}", "--workers", "100000"], "--jobs must be at most"),   # old
     (["audit", "--out", "{tmp}", "--compare-n", str(10**9)], "--compare-n must be at most"),
 ])
 def test_every_other_numeric_option_has_a_budget(tmp_path, monkeypatch, capsys, argv, said):
@@ -619,3 +624,145 @@ def test_the_commands_runs_print_on_the_streams_they_are_given(tiny_file, tmp_pa
     assert run_compare(n=1, dt=0.5, workers=0, progress=False, stdout=out) == 0
     assert "workcell(s) planned in" in out.getvalue()
     assert capsys.readouterr() == ("", "")        # nothing went to the process's own streams
+
+
+#: A trajectory of the bundled default workcell that holds still (clear), and one that sweeps
+#: the subordinate's upper arm into the principal's (in contact at t ~ 1.25 s).
+STILL = "t,left1,left2,right1,right2\n0,0.3,0.8,3.3,0.5\n2,0.3,0.8,3.3,0.5\n"
+SWEEP = "t,left1,left2,right1,right2\n0,0.3,0.8,3.3,0.5\n12,0.3,0.8,1.2,0.5\n"
+
+
+def test_certify_monitor_simulate_print_verdict_and_details_on_the_stdout_given(tmp_path,
+                                                                               capsys):
+    """docs/model.md §7: each run_* takes its streams and returns the exit code; a verdict and
+    its details go to the stdout it is given (stderr is for errors proper, which are raised)."""
+    import io
+
+    from cfmpa.runs import Excursion, run_certify, run_monitor, run_simulate
+    from cfmpa.scenarios import resolve
+
+    scen = resolve("default")
+    still, sweep = tmp_path / "still.csv", tmp_path / "sweep.csv"
+    still.write_text(STILL)
+    sweep.write_text(SWEEP)
+
+    def run(f, *a, **kw):
+        out, err = io.StringIO(), io.StringIO()
+        return f(*a, stdout=out, stderr=err, **kw), out.getvalue(), err.getvalue()
+
+    code, out, err = run(run_certify, scen, still)
+    assert code == 0 and "clearance clear: proved >=" in out and err == ""
+    code, out, err = run(run_certify, scen, sweep)
+    assert code == 1 and "clearance NOT CLEAR: contact at t=1.25" in out and err == ""
+    code, out, err = run(run_simulate, scen, still, tmp_path / "log.csv", period=0.01)
+    assert code == 0 and f"wrote     {tmp_path / 'log.csv'} (CSV)" in out and err == ""
+    code, out, err = run(run_monitor, scen, still, tmp_path / "log.csv")
+    assert code == 0 and "inside;" in out and err == ""
+    code, out, err = run(run_simulate, scen, still, tmp_path / "bad.csv", period=0.01,
+                         excursions=[Excursion(1.0, "right1", 0.2)])
+    assert code == 0 and err == ""
+    code, out, err = run(run_monitor, scen, still, tmp_path / "bad.csv")
+    assert code == 1 and err == ""
+    verdict, first = out.splitlines()[:2]
+    assert "outside (" in verdict and first.startswith("first     outside at t=1")
+    code, out, err = run(run_monitor, scen, sweep, tmp_path / "log.csv")
+    assert code == 1 and "is not certified clear" in out and err == ""
+    assert capsys.readouterr() == ("", "")        # nothing went to the process's own streams
+
+
+# --- one name, one meaning; old spellings still work (docs/model.md §7) -------------------------
+
+def _calls(monkeypatch, module, name):
+    """Record the keyword arguments (and positional ones as "args") of ``module.name``'s
+    calls, instead of running it."""
+    seen: list[dict] = []
+    monkeypatch.setattr(module, name, lambda *a, **kw: seen.append({"args": a, **kw}) or 0)
+    return seen
+
+
+@pytest.mark.parametrize("new, old, where, key", [
+    (["plan", "default", "--out", "{d}", "--witness-out", "{d}/w.npz"],
+     ["plan", "default", "--out", "{d}", "--witness", "{d}/w.npz"], "run_plan", "witness"),
+    (["simulate", "default", "--traj", "t.csv", "--log-out", "{d}/log.csv"],
+     ["simulate", "default", "--traj", "t.csv", "--out", "{d}/log.csv"], "run_simulate",
+     "args"),
+    (["prove", "--out", "{d}", "--jobs", "1"], ["prove", "--out", "{d}", "--workers", "1"],
+     "run_prove", "workers"),
+    (["check-batch", "{d}", "--workers", "0", "--json", "{d}/s.json"],
+     ["check", "--batch", "{d}", "--workers", "0", "--json", "{d}/s.json"], "run_batch",
+     "args"),
+    (["mutants", "--mutant", "margin_halved", "--checks", "prove", "--json", "{d}/m.json"],
+     ["selftest", "--code", "--mutant", "margin_halved", "--checks", "prove", "--json",
+      "{d}/m.json"], "run_code_selftest", "args"),
+], ids=["plan --witness", "simulate --out", "prove --workers", "check --batch",
+        "selftest --code"])
+def test_an_old_spelling_makes_the_same_call_as_the_new(tmp_path, monkeypatch, new, old,
+                                                        where, key):
+    import cfmpa.proofs
+    import cfmpa.runs
+
+    module = cfmpa.proofs if where == "run_prove" else cfmpa.runs
+    seen = _calls(monkeypatch, module, where)
+    d = str(tmp_path)
+    assert main([a.format(d=d) for a in new]) == 0
+    assert main([a.format(d=d) for a in old]) == 0
+    for call in seen:            # a message names the folder as the user spelled it
+        call.pop("folder_option", None)
+    assert len(seen) == 2 and seen[0] == seen[1] and seen[0][key], seen
+    if key == "args" and where == "run_simulate":
+        assert str(seen[0]["args"][2]) == f"{d}/log.csv"
+
+
+def test_the_help_shows_the_new_names_and_hides_the_old_spellings(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    top = capsys.readouterr().out
+    assert "check-batch" in top and "mutants" in top
+    for argv, shown, hidden in [
+        (["plan"], "--witness-out FILE", "--witness "),
+        (["simulate"], "--log-out LOG", "--out "),
+        (["prove"], "--jobs K", "--workers"),
+        (["check"], "--witness FILE", "--batch"),
+        (["selftest"], "cfmpa selftest", "--code"),
+        (["check-batch"], "--workers K", "--batch"),
+        (["mutants"], "--prove-only ID", "--code"),
+    ]:
+        with pytest.raises(SystemExit):
+            main([*argv, "--help"])
+        text = capsys.readouterr().out
+        assert shown in text and hidden not in text, (argv, text)
+
+
+def _shared_names(parser):
+    """The options that name a file or folder written (``_arguments.output`` or ``checked``,
+    not a number's Budget) in one command and an input in another."""
+    import argparse
+
+    from cfmpa._arguments import Budget, visible_options
+
+    outputs, inputs = set(), set()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                written = {option for _, option, check in sub.get_default("_checks") or ()
+                           if not isinstance(check, Budget)}
+                for a in sub._actions:
+                    for o in visible_options(a):
+                        (outputs if o in written else inputs).add(o)
+    return outputs, outputs & inputs
+
+
+def test_an_input_and_an_output_never_share_a_name():
+    from cfmpa import _arguments as opt
+    from cfmpa.cli import _parser
+
+    outputs, shared = _shared_names(_parser())
+    assert shared == set()
+    assert {"--witness-out", "--log-out", "--json", "--out", "--audit"} <= outputs
+    # Seeded fault: plan writing a file named by --dr, which check reads, is caught.
+    planted = _parser()
+    plan = next(a for a in planted._actions if hasattr(a, "choices") and a.choices
+                and "plan" in a.choices).choices["plan"]
+    plan.add_argument("--dr")
+    opt.output(plan, "dr", "--dr", opt.FILE)
+    assert _shared_names(planted)[1] == {"--dr"}

@@ -95,7 +95,8 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
 #: The targets, in the table's order: full checking (check s, check MiB, full/off, BuiltDR s,
 #: the first run / a later one, peer/dr, plan s), monitoring (samples/s, its peak growth),
 #: proving (make prove s, obligations alone s).
-LIMITS = [5.0, 1024.0, 5.0, 0.10, 2.0, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0]
+LIMITS = [5.0, 1024.0, 5.0, 0.10, 2.0, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0,
+          20.0, 300.0, 200.0, 300.0, 1.0, 300.0, 4096.0, 2048.0]
 
 
 def made_up(default_mode: str = "full") -> dict[str, Any]:
@@ -131,6 +132,15 @@ def made_up(default_mode: str = "full") -> dict[str, Any]:
                             "cli_samples_per_s": 250_000.0, "samples_per_s": 300_000.0,
                             "peak_rss_mb": 120.0, "status": "inside"},
                     "log_tenth": {"peak_rss_mb": 118.0}, "peak_growth_mb": 2.0},
+        "certify_stream": {"runs": [
+            {"rows": n, "bytes": 66 * n, "seconds": sec, "peak_mib": 70.0, "clear": True,
+             "timings_s": {"load": sec / 2, "certificate": sec / 2}}
+            for n, sec in ((10**6, 12.0), (10**7, 230.0))]},
+        "dr_dask": {"speedup_2_over_1": 1.4, "workers_0": t(20.0), "workers_1": t(30.0),
+                    "workers_2": t(21.0), "same_store": True,
+                    "plan_store": {"dt": 0.0035, "cells": 1_110_000_000, "seconds": 320.0,
+                                   "peak_mib": 3000.0}},
+        "plan_scaling": {"rows": [{"dt": 0.005, "seconds": 50.0, "peak_mib": 2500.0}]},
     }
 
 
@@ -140,11 +150,18 @@ def test_targets_are_the_issues_with_their_limits_and_verdicts():
     rows = run.targets(made_up("full"), cfg)
     assert [r["limit"] for r in rows] == LIMITS
     assert [r["cmp"] for r in rows] == ["<=", "<=", "<=", "<=", "<=", ">=", "<=", ">=", "<=",
-                                        "<=", "<="]
+                                        "<=", "<=", "<=", "<=", "<=", "<=", ">=", "<=", "<=",
+                                        "<="]
     assert [r["measured"] for r in rows] == [3.3, 1500.0, 2.5, 0.55, 3.0, 2.0, 4.5, 250_000.0,
-                                             2.0, 90.0, 70.0]
+                                             2.0, 90.0, 70.0, 12.0, 70.0, 230.0, 70.0, 1.4,
+                                             320.0, 3000.0, 2500.0]
     assert [r["met"] for r in rows] == [True, False, True, False, False, False, False, True,
-                                        True, True, False]
+                                        True, True, False, True, True, False, True, True, False,
+                                        True, False]
+    # D_R on Dask: the note names both medians and that the stores agree.
+    assert "1 worker 30.0 s, 2 workers 21.0 s" in rows[15]["note"]
+    assert "1,110,000,000 cells" in rows[16]["note"]
+    assert "10,000,000-row" in rows[13]["target"] and "default limits" in rows[13]["target"]
     assert "full checking" in rows[0]["target"] and "monitoring" in rows[7]["target"]
     assert "make prove" in rows[9]["target"] and "first run" in rows[4]["target"]
     # BuiltDR: warm (the median) and cold (the first call) apart; the first run: both runs.
@@ -156,7 +173,7 @@ def test_targets_are_the_issues_with_their_limits_and_verdicts():
     assert rows[7]["wall_s"] == 4.0 and rows[7]["peak_rss_mb"] == 120.0
     assert all("quick run" not in r["note"] for r in rows)
     lines = run.target_lines(rows)
-    assert sum(" MISSED" in line for line in lines) == 6
+    assert sum(" MISSED" in line for line in lines) == 9
 
 
 def test_plan_target_follows_the_cli_default_contract_mode():
@@ -240,11 +257,22 @@ def test_certify_stream_reports_seconds_peak_and_bytes_a_row(tmp_path, monkeypat
     monkeypatch.setattr(run, "cli_run", fake_cli_run)
     sec = run.certify_stream_section(cfg, tmp_path)
     assert [n for n, _ in seen] == [100, 1000]
-    assert all(int(e["CFMPA_MAX_TRAJECTORY_BYTES"]) >= 32 * 2**20 for _, e in seen)
+    assert all(e is None for _, e in seen)          # by default: no limit raised
     assert [r["peak_bytes_per_row"] for r in sec["runs"]] == [
         round(100 * 2**20 / 100, 1), round(110 * 2**20 / 1000, 1)]
     assert sec["peak_growth_mib"] == 10.0
     assert "peak growth over the rows: 10.0 MiB" in run.certify_stream_lines(sec)[-1]
+    # The targets, met or unmet by row count; unmeasured row counts are unmet (None).
+    monkeypatch.setattr(run, "CERTIFY_STREAM", run.CERTIFY_STREAM | {
+        "targets": {100: (3.0, 105.0), 1000: (3.0, 105.0), 10**7: (200.0, 300.0)}})
+    got = {(t["target"], t["met"]) for t in run.certify_stream_targets(sec)}
+    assert got == {("certify: 100-row trajectory streamed, default limits (s)", True),
+                   ("certify: 100-row trajectory streamed, default limits (peak MiB)", True),
+                   ("certify: 1,000-row trajectory streamed, default limits (s)", True),
+                   ("certify: 1,000-row trajectory streamed, default limits (peak MiB)", False),
+                   ("certify: 10,000,000-row trajectory streamed, default limits (s)", None),
+                   ("certify: 10,000,000-row trajectory streamed, default limits (peak MiB)",
+                    None)}
 
 
 def test_the_slow_trajectory_is_valid_and_certified_clear(tmp_path):

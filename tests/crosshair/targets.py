@@ -15,7 +15,8 @@ from crosshair import realize
 
 from cfmpa.impl import SNAP, lattice_range, link_reach
 from cfmpa.impl._search import J2_MASK, SHIFT
-from cfmpa.spec import LeftArm, Scenario, Variant, left_box
+from cfmpa.spec import Scenario, Variant, left_box
+from cfmpa.spec._scenario import LeftArm
 from cfmpa.spec._counts import ceil_fraction
 
 

@@ -31,7 +31,9 @@ CAUGHT_BY = {"heights_compared_strictly": ("Safety.height_rule", "disjoint_no_co
              "height_gap_far_ends": ("Certificate.height_gap", "gap_vertical"),
              "tool_vertex_left_out": ("Safety.tool_region", "tool_points"),
              "tool_margin_nearest_vertex": ("Safety.tool_region", "far_vertex"),
-             "tool_in_link1_frame": ("Safety.tool_region", "tool_points")}
+             "tool_in_link1_frame": ("Safety.tool_region", "tool_points"),
+             "travel_time_min": ("Safety.modified.principal_in_layer_box", "travel"),
+             "spacing_bound_above_pi": ("Safety.modified.composition", "spacing_below_pi")}
 MUTANTS = {m.name: m for m in CODE_MUTANTS if m.name in CAUGHT_BY}
 
 
@@ -183,7 +185,8 @@ def test_every_tool_vc_proved_with_satisfiable_hypotheses(tool_kit: T.ToolKit):
     q = T.tool_region_query(tool_kit)
     assert [v.name for v in q.vcs] == ["comb_id", "hull_step", "root_norm", "far_vertex", "tool_reach",
                                        "margin_covers_tool", "grow_square", "grown_in_region",
-                                       "tool_points", "tool_in_region"]
+                                       "tool_points", "tool_in_region", "tool_statement_L",
+                                       "tool_statement_R"]
     for vc in q.vcs:
         assert _proved(vc), vc.name
         assert _refuted(vc.without(vc.key_premise), vc.counter_witness), vc.name
@@ -212,6 +215,116 @@ def test_each_tool_fault_refutes_its_vc(tool_kit: T.ToolKit, name: str):
     assert _refuted(vcs[target]), name
     # The rest still holds: the fault is caught where it is, not by a broken encoding.
     assert _proved(vcs["grow_square"])
+
+
+# --- the tool's statement, the compositions' premise (docs/model.md §10 (e)) -------------------
+
+def test_the_tool_statement_is_the_composition_premise(tool_kit: T.ToolKit):
+    from cfmpa.proofs import _obl_safety as S
+    vc = S.region_instance_vc("tight")
+    premises = dict(vc.hypotheses)
+    for tag, whose in (("L", "principal"), ("R", "subordinate")):
+        st = T.tool_statement_vc(tag, tool_kit)
+        assert z3.eq(premises[f"{S.TOOL_STATEMENT} for the {whose}'s tool"],
+                     z3.ForAll(*T.tool_statement(tag)))
+        assert z3.eq(st.goal, T.tool_statement(tag)[1])
+
+
+@pytest.mark.slow
+def test_the_tool_statement_rests_on_tool_in_region(tool_kit: T.ToolKit):
+    # The lemma's instance is used, not a copy, and the tool's definition places the point.
+    vc = T.tool_statement_vc("R", tool_kit)
+    for drop in ("by tool_in_region", "R: the tool's definition"):
+        name = next(n for n, _ in vc.hypotheses if n.startswith(drop))
+        assert answer([h for n, h in vc.hypotheses if n != name] + [z3.Not(vc.goal)], seeds=1,
+                      timeout_ms=4_000) != z3.unsat, drop
+
+
+@pytest.mark.slow
+def test_a_tool_region_grown_by_half_the_margin_fails_the_statement(tool_kit: T.ToolKit,
+                                                                      monkeypatch):
+    # Seeded fault: the tool's region (the hull's definition) grown by half of sweep_margin;
+    # tool_in_region keeps the full margin.
+    real = T.tool_margin
+    monkeypatch.setattr(T, "tool_margin", lambda *a: real(*a) / 2)
+    vc = T.tool_statement_vc("L", tool_kit)
+    assert answer([h for _, h in vc.hypotheses] + [z3.Not(vc.goal)], seeds=1,
+                  timeout_ms=10_000) != z3.unsat
+
+
+@pytest.mark.slow
+def test_a_vertex_left_out_of_the_tool_fails_the_statement(tool_kit: T.ToolKit, monkeypatch):
+    # Seeded fault: the tool's definition with the last vertex left out of the chain (the
+    # region's hull has every vertex): the lemma's point is no longer the tool's.
+    real = T.ToolModel.definition
+
+    def short(self, theta, p):
+        body = real(self, theta, p)
+        conds = list(body.arg(1).children())
+        return z3.Implies(body.arg(0), z3.And([c for c in conds if "16" not in str(c)]))
+    monkeypatch.setattr(T.ToolModel, "definition", short)
+    vc = T.tool_statement_vc("L", tool_kit)
+    assert answer([h for _, h in vc.hypotheses] + [z3.Not(vc.goal)], seeds=1,
+                  timeout_ms=10_000) != z3.unsat
+
+
+# --- what the compositions read of the code: Tf, N and the loader's spacing bound ----------------
+
+def test_tf_and_n_are_the_codes_on_floats():
+    # counts_on_terms runs spec.exact_tf / exact_n's own code; on numbers it gives their values.
+    from fractions import Fraction
+    from cfmpa.proofs import _obl_safety as S
+    from cfmpa.spec import exact_n, exact_tf
+    s = cfmpa.spec.load_scenario(Path(cfmpa.spec.__file__).parents[1] / "scenarios"
+                                 / "default.toml")
+    vals = [z3.RealVal(Fraction(x)) for x in (*s.left.start, *s.left.goal, *s.left.omega, s.dt)]
+    tf, n = S.counts_on_terms(tuple(vals[0:2]), tuple(vals[2:4]), tuple(vals[4:6]), vals[6])
+    assert z3.simplify(tf).as_fraction() == exact_tf(s)
+    assert z3.simplify(n).as_long() == exact_n(s)
+
+
+def test_tf_max_made_min_refutes_the_travel_lemma(monkeypatch):
+    from cfmpa.proofs import _obl_safety as S
+    mod = _planted("travel_time_min")
+    real = S.counts_on_terms
+    monkeypatch.setattr(S, "counts_on_terms",
+                        lambda *a, **k: real(*a, travel=mod.travel_time, **k))
+    vcs = {v.name: v for v in S._principal_query("modified").vcs}
+    assert _refuted(vcs[CAUGHT_BY["travel_time_min"][1]])
+    # ... and the composition reads the same Tf: its hypothesis is the mutant's.
+    hyp = dict(S.composition_vc("modified").hypotheses)[S.Principal.named().tf_def()[0]]
+    assert z3.eq(hyp.arg(1), real(*_principal_args(S), travel=mod.travel_time)[0])
+    assert not z3.eq(hyp.arg(1), real(*_principal_args(S))[0])
+
+
+def _principal_args(S):
+    P = S.Principal.named()
+    return P.start, P.goal, P.omega, P.dt
+
+
+def test_the_ceiling_on_terms_is_the_codes_on_fractions():
+    # counts_on_terms runs exact_n with spec.ceil_of for the code's exact ceiling.
+    from fractions import Fraction
+    from cfmpa.spec import ceil_of
+    from cfmpa.spec._counts import ceil_fraction
+    for x in (Fraction(7, 2), Fraction(-7, 2), Fraction(3), Fraction(1, 10**9), Fraction(-5, 3)):
+        assert ceil_of(x) == ceil_fraction(x)
+        assert z3.simplify(ceil_of(z3.RealVal(x))).as_long() == ceil_fraction(x)
+
+
+def test_the_proofs_read_the_loaders_spacing_bound():
+    from fractions import Fraction
+    from cfmpa.proofs import _obl_safety as S
+    from cfmpa.spec import MAX_SPACING
+    assert S.G_MAX.as_fraction() == MAX_SPACING == Fraction(157, 50)
+    assert _proved(S.spacing_bound_vc())
+
+
+def test_a_spacing_bound_past_pi_is_refuted():
+    from cfmpa.proofs import _obl_safety as S
+    mod = _planted("spacing_bound_above_pi")
+    bound = z3.Q(mod.MAX_SPACING.numerator, mod.MAX_SPACING.denominator)
+    assert _refuted(S.spacing_bound_vc(bound))
 
 
 def test_the_tool_faults_change_impls_floats():

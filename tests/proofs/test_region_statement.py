@@ -36,6 +36,13 @@ def _proves(vc: VC) -> bool:
                                         timeout_ms=20_000) == z3.unsat
 
 
+def _refuted(vc: VC, drop: str) -> bool:
+    """A counter-model without ``drop``, at the VC's small arm (its counter-witness pins)."""
+    hyps = [h for n, h in vc.hypotheses if n != drop]
+    return answer(hyps + [z3.Not(vc.goal)] + [c == v for c, v in vc.counter_witness], seeds=1,
+                  timeout_ms=10_000) == z3.sat
+
+
 def _not_proved(vc: VC, drop: str | None = None) -> bool:
     hyps = [h for n, h in vc.hypotheses if n != drop]
     return answer(hyps + [z3.Not(vc.goal)], seeds=1, timeout_ms=10_000) != z3.unsat
@@ -46,7 +53,8 @@ def _not_proved(vc: VC, drop: str | None = None) -> bool:
 def test_the_statement_is_derived_and_needs_the_hull(kit, tag, x):
     vc = S.region_statement_vc(S.ArmModel.named(tag), x, kit)
     assert _proves(vc)
-    assert _not_proved(vc, vc.key_premise)
+    # Without the hull's definition: a counter-model (found at once; no wait for a timeout).
+    assert _refuted(vc, vc.key_premise)
     # The lemma's instance is used, not a copy: without it nothing gives the corners.
     lemma = next(n for n, _ in vc.hypotheses if n.startswith(f"by link{x + 1}_in_region"))
     assert _not_proved(vc, lemma)
@@ -94,11 +102,35 @@ def test_a_lattice_one_index_short_fails(kit, monkeypatch, x):
 @pytest.mark.parametrize("variant", S.VARIANTS)
 def test_the_instances_need_the_loader_spacing_check(variant):
     vc = S.region_instance_vc(variant)
-    assert _not_proved(vc, "the loader's spacing checks: 0 < omega_q dt <= 157/50, "
-                           "0 < h_q <= 157/50")
+    drop = "the loader's spacing checks: 0 < omega_q dt <= 157/50, 0 < h_q <= 157/50"
+    assert drop in dict(vc.hypotheses)
+    # A counter-model at the small pins where Z3 finds one at once, else no proof in 10 s.
+    assert _refuted(vc, drop) or _not_proved(vc, drop)
 
 
 # --- the definitions against impl's construction ------------------------------------------------
+
+@pytest.mark.parametrize("x", S.LINKS)
+def test_the_rectangle_is_impls_read_on_terms(x):
+    # impl.link_rectangles, run on terms, has the corners of the definitions' rectangle.
+    vc = S.rectangle_vc(x)
+    assert _proves(vc)
+    hyps = [h for n, h in vc.hypotheses if n != vc.key_premise]
+    assert answer(hyps + [z3.Not(vc.goal)], seeds=1, timeout_ms=10_000) == z3.sat
+
+
+@pytest.mark.parametrize("x", S.LINKS)
+def test_a_rectangle_not_extended_past_its_joint_fails(x, monkeypatch):
+    # Seeded fault, planted in a copy of impl's source: the rectangle starts at its joint.
+    import sys
+    from mutant_module import mutated_module
+    mod = mutated_module("rect_short", "impl/_kinematics.py",
+                         (("    back = start - r * along\n", "    back = start\n"),),
+                         lambda n, m: monkeypatch.setitem(sys.modules, n, m))
+    vc = S.rectangle_vc(x, mod.link_rectangles)
+    assert answer([h for _, h in vc.hypotheses] + [z3.Not(vc.goal)], seeds=1,
+                  timeout_ms=10_000) == z3.sat
+
 
 def _num(f: z3.ExprRef, env: dict[str, float]) -> float:
     """f evaluated in floats, Cos and Sin read as math.cos and math.sin."""

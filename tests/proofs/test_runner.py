@@ -302,3 +302,92 @@ def test_the_summary_and_results_count_definitional_apart(tmp_path):
     text = render_report(run)
     assert "(1 theorems, 1 definitional)" in text
     assert "Definitional (counted apart from the theorems): Def1.segment" in text
+
+
+# --- a line per group as it ends (docs/model.md §6.1) --------------------------------------------
+
+def _data_check(ident: str, group: str, run=None):
+    from cfmpa.proofs import CheckOutcome, CheckQuery, Method, Obligation
+
+    def check():
+        return run() if run is not None else CheckOutcome(True, "holds")
+    return Obligation(ident, group, "docs/model.md §6.1", f"{ident} holds", Method.DATA,
+                      Verdict.PROVED, lambda: CheckQuery(check, f"check {ident}\n"))
+
+
+def _groups_told(obligations, tmp_path: Path, workers: int, seen: list[str]) -> str:
+    """Obligations A.1, A.2 (group A) then B.1 (group B), whose check records what the progress
+    stream held when it ran; the stream's text afterwards."""
+    from cfmpa.proofs import CheckOutcome
+
+    stream = io.StringIO()
+
+    def b_check():
+        seen.append(stream.getvalue())
+        return CheckOutcome(True, "holds")
+    obs = [_data_check("A.1", "Group A"), _data_check("A.2", "Group A"),
+           _data_check("B.1", "Group B", b_check), *obligations]
+    run = run_obligations(obs, tmp_path, [o.id for o in obs], workers=workers, progress=stream)
+    assert [(p.id, p.verdict) for p in run.proofs] == [(o.id, Verdict.PROVED) for o in obs]
+    return stream.getvalue()
+
+
+def test_a_group_is_told_as_it_ends_not_at_the_end(tmp_path: Path, monkeypatch):
+    import cfmpa.proofs._runner as runner
+
+    seen: list[str] = []
+    text = _groups_told([], tmp_path / "one", 1, seen)
+    lines = text.splitlines()
+    assert [ln.split(":")[1].strip() for ln in lines] == ["Group A", "Group B"]
+    assert lines[0].startswith("prove: Group A: 2 done, ") and " s of work, at " in lines[0]
+    assert lines[1].startswith("prove: Group B: 1 done, ")
+    # Group A was told before B's check ran: during the run, not with the summary.
+    assert seen == [lines[0] + "\n"]
+
+    # Seeded fault: every obligation settled only once all are discharged (the lines at the end).
+    def at_the_end(obligations, skip, told):
+        from cfmpa.proofs._cvc5 import Cvc5Pool
+        from cfmpa.proofs._obligation import discharge_pending
+        with Cvc5Pool() as pool:
+            pending = [discharge_pending(o, pool, skip) for o in obligations]
+        proofs = tuple(p.settle() for p in pending)
+        for o, p in zip(obligations, proofs):
+            told.done(o, p)
+        return proofs
+    monkeypatch.setattr(runner, "_discharge_in_turn", at_the_end)
+    late: list[str] = []
+    assert len(_groups_told([], tmp_path / "late", 1, late).splitlines()) == 2
+    assert late == [""] != seen                   # B's check saw nothing: the check above fails
+
+
+def test_side_by_side_each_group_is_told_once_and_the_results_do_not_change(tmp_path: Path):
+    from cfmpa.proofs import collect_controls
+
+    obs = collect_obligations("/nonexistent", ["Def1", "Margin.naive_hull"])
+    exp = [o.id for o in obs]
+    stream = io.StringIO()
+    told = run_obligations(obs, tmp_path / "told", exp, workers=2, progress=stream,
+                           controls=collect_controls(["Control.witness.forged"]))
+    quiet = run_obligations(obs, tmp_path / "quiet", exp, workers=2,
+                            controls=collect_controls(["Control.witness.forged"]))
+    assert told.ok and quiet.ok
+    lines = sorted(stream.getvalue().splitlines())
+    assert len(lines) == 3 and lines == sorted(set(lines))
+    assert lines[0].startswith("prove: Definitions 1-3, Lemmas 1-2: 2 done, ")
+    assert lines[1].startswith("prove: Swept regions (docs/model.md §4): 1 done, ")
+    assert lines[2].startswith("prove: negative controls: 1 done, ")
+    assert stream.getvalue().splitlines()[-1] == lines[2]        # the controls run last
+    docs = [json.loads((tmp_path / d / "results.json").read_text()) for d in ("told", "quiet")]
+    strip = [{k: v for k, v in c.items() if k != "seconds"} for d in docs for c in d.pop("controls")]
+    assert strip[0] == strip[1] and strip[0]["outcome"] == "rejected"
+    assert _strip_times(docs[0]) == _strip_times(docs[1])
+
+
+def test_prove_tells_the_groups_on_stderr_and_keeps_stdout_as_it_was(tmp_path: Path, capsys):
+    from cfmpa.cli import main
+
+    rc = main(["prove", "--out", str(tmp_path), "--only", "Def1.segment", "--workers", "1"])
+    out, err = capsys.readouterr()
+    assert rc == 0
+    assert err.startswith("prove: Definitions 1-3, Lemmas 1-2: 1 done, ")
+    assert "prove: " not in out and out.startswith("Summary of proof obligations")

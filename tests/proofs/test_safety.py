@@ -378,5 +378,66 @@ def test_composition_rests_on_the_proved_parts(queries):
     vc = S.composition_vc("modified")
     names = " | ".join(n for n, _ in vc.hypotheses)
     for part in ("by motion at", "by rest at", "by neighbour_move at", "by time_step at",
-                 S.EPS_HYP, S.ERR_HYP, "A12 at the eight pairs", "is_path L (fixed"):
+                 "by pair_apart at", S.EPS_HYP, S.ERR_HYP, "A12 at the eighteen pairs",
+                 "is_path L (fixed", S.HEIGHT_HYP):
         assert part in names
+
+
+# --- every part: the tools and the height rule (docs/model.md §10 (e)) ---------------------------
+
+def test_the_composition_ranges_over_every_part_pair():
+    # The goal names the prisms of all nine (left part, right part) pairs, tools included, and
+    # BuiltDR's postcondition the pairs the height rule keeps.
+    vc = S.composition_vc("tight")
+    pairs = [tuple(c.arg(0).as_long() for c in conj.arg(0).children())
+             for conj in vc.goal.children()]
+    assert pairs == [(x, y) for x in S.PARTS for y in S.PARTS]
+    post = dict(vc.hypotheses)[vc.key_premise]
+    names = set()
+    todo = [post]
+    while todo:
+        t = todo.pop()
+        if z3.is_const(t) and t.decl().kind() == z3.Z3_OP_UNINTERPRETED:
+            names.add(str(t))
+        todo += t.children()
+    assert {"L.has_tool", "R.has_tool", "L.z3.lo", "R.z3.hi"} <= names
+
+
+@pytest.mark.parametrize("variant", S.VARIANTS)
+def test_the_composition_needs_the_height_rule_and_the_tool_regions(variant):
+    # The negative controls' premises: without the height rule a pair at disjoint heights may
+    # share a point; without the tool's region hypothesis the tool is nowhere BuiltDR looked.
+    vc = S.composition_vc(variant)
+    assert _refuted(vc, S.HEIGHT_HYP)
+    tool = [n for n, _ in vc.hypotheses if n.startswith("(c) Safety.tool_region")]
+    assert len(tool) == 3
+    stripped = VC(vc.name, tuple(h for h in vc.hypotheses if h[0] not in tool), vc.goal)
+    assert _refuted(stripped, pins=vc.counter_witness)
+
+
+def test_the_height_instances_follow_from_the_prisms():
+    vc = S.height_instance_vc()
+    assert _proved(vc)
+    assert _refuted(vc, vc.key_premise)
+
+
+def test_heights_compared_strictly_fail_the_height_instances():
+    # Seeded fault: heights_overlap with < where <= is meant (touching ends called apart).
+    def strict(a, b):
+        if a is None or b is None:
+            return True
+        return a[0] < b[1] and b[0] < a[1]
+    assert _refuted(S.height_instance_vc(strict), pins=())
+
+
+def test_a_pair_the_height_rule_keeps_must_be_free():
+    # Seeded fault: the postcondition read without the tool pairs (the links' pairs only, as
+    # before the tools): the composition must fail.
+    real = S.pair_kept
+
+    def links_only(hl, hr, x, y, overlap=None):
+        return z3.And(z3.BoolVal(x != S.TOOL and y != S.TOOL), real(hl, hr, x, y, overlap))
+    import unittest.mock as um
+    with um.patch.object(S, "pair_kept", links_only):
+        bad = S.composition_vc("modified")
+    assert _refuted(bad)

@@ -40,9 +40,10 @@ from cfmpa.files import dumps_json
 from cfmpa.errors import InputError
 from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
-from cfmpa.report import AuditResult, build_audit, render_html, run_audit, write_report
-from cfmpa.report._audit import (SECTIONS, _controls_item, _proof_sections, _verdict,
-                                 contract_rows, row_requirements, workcell_summary)
+from cfmpa.report import build_audit, run_audit
+from cfmpa.report._audit import (SECTIONS, AuditResult, _controls_item, _proof_sections, _verdict,
+                                 contract_rows, render_html, row_requirements, workcell_summary,
+                                 write_report)
 from cfmpa.report._sections import Section, compute_order, verdict_of
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import BADGES, audited_ids, load_proofs
@@ -177,6 +178,79 @@ def test_run_audit_adds_the_writing_and_the_total(report, tmp_path, monkeypatch,
                       "audit: audit, in all"]
     # The progress goes to the stream given, never to stdout (which has the summary).
     assert "audit: " not in capsys.readouterr().out
+
+
+def _cheap_context(monkeypatch, stream):
+    """An audit context whose fresh prove run is two cheap obligations (and no controls)."""
+    import cfmpa.proofs as proofs
+    import cfmpa.report._audit as audit
+
+    cheap = proofs.collect_obligations("/nonexistent", ["Def1.segment", "Margin.naive_hull"])
+    monkeypatch.setattr(proofs, "collect_obligations", lambda *a, **k: list(cheap))
+    return audit._Context(sdir=ROOT / "scenarios", paths=[], loaded=[], given=False,
+                          argv=None, compare_n=0, compare_seed=0, recorded=None,
+                          campaign=None, proofs_json=None, expected_ids=[o.id for o in cheap],
+                          stages=audit._Progress(stream), plans=None)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("early", [False, True], ids=["here", "forked early"])
+def test_proofs_discharged_afresh_tell_each_group_before_the_stage_line(monkeypatch, early):
+    import cfmpa.report._audit as audit
+
+    ids = ["Def1.segment", "Margin.naive_hull"]
+
+    def told() -> list[str]:
+        stream = io.StringIO()
+        ctx = _cheap_context(monkeypatch, stream)
+        if early:
+            ctx.start_proofs()
+            assert ctx.background is not None
+        data = ctx.proofs()
+        assert [r.id for r in data.rows] == ids and not data.missing_ids
+        assert [r.verdict for r in data.rows] == ["proved", "refuted as expected"]
+        assert ctx.background is None
+        return stream.getvalue().splitlines()
+    lines = told()
+    assert sorted(ln.split(": ")[1] for ln in lines[:2]) == [
+        "Definitions 1-3, Lemmas 1-2", "Swept regions (docs/model.md §4)"]
+    assert all(ln.startswith("prove: ") and ": 1 done, " in ln for ln in lines[:2]), lines
+    assert len(lines) == 3 and lines[2].startswith("audit: proofs (discharged afresh)")
+    # Seeded fault: the stream not handed on to the run: only the stage's own line, at its end.
+    monkeypatch.setattr(audit, "load_proofs", lambda *a, progress=None, **k: load_proofs(*a, **k))
+    assert len(told()) == 1
+
+
+def test_proofs_begun_early_give_what_a_run_here_gives_and_raise_its_errors(monkeypatch):
+    import cfmpa.report._audit as audit
+
+    def rows(ctx):
+        return [dataclasses.replace(r, seconds=0.0) for r in ctx.proofs().rows]
+    ctx = _cheap_context(monkeypatch, None)
+    ctx.start_proofs()
+    early = rows(ctx)
+    # A forked run that dies without an answer: the obligations are run here instead, and the
+    # data is the same.
+    real = audit.load_proofs
+    monkeypatch.setattr(audit, "load_proofs", lambda *a, **k: os._exit(3))
+    ctx = _cheap_context(monkeypatch, None)
+    ctx.start_proofs()
+    monkeypatch.setattr(audit, "load_proofs", real)
+    assert rows(ctx) == early and len(early) == 2
+    # An error there is the error here, as if run here.
+    def bad(*a, **k):
+        raise InputError("--proofs", "x", "planted")
+    monkeypatch.setattr(audit, "load_proofs", bad)
+    ctx = _cheap_context(monkeypatch, None)
+    ctx.start_proofs()
+    with pytest.raises(InputError, match="planted"):
+        ctx.proofs()
+    # Not taken (another section failed): closing ends the process, nothing left running.
+    monkeypatch.setattr(audit, "load_proofs", lambda *a, **k: __import__("time").sleep(60))
+    ctx = _cheap_context(monkeypatch, None)
+    ctx.start_proofs()
+    proc = ctx.background._proc
+    ctx.background.close()
+    assert not proc.is_alive() and proc.exitcode is not None
 
 
 def test_report_json_validates_against_the_schema(report):
@@ -898,7 +972,7 @@ def test_a_fresh_run_of_every_obligation_runs_the_controls_too(monkeypatch):
 
     asked = {}
 
-    def run(obligations, out, expected, *, workers, controls=()):
+    def run(obligations, out, expected, *, workers, controls=(), progress=None):
         asked["controls"] = [c.id for c in controls]
         return types.SimpleNamespace(proofs=(), controls=tuple(
             ControlResult(c.id, c.checker, c.what, c.expected, c.expected[0], "", 0.1)

@@ -7,7 +7,8 @@ import json
 
 import pytest
 
-from cfmpa.report import campaign_json, run_compare
+from cfmpa.report import run_compare
+from cfmpa.report._compare import campaign_json
 from cfmpa.runs import load_campaign, run_campaign
 from cfmpa.spec import Variant
 

@@ -51,9 +51,11 @@ def test_plan_folders_are_found_at_any_depth_sorted(plans):
         "a-modified", "b-original", "d-costs", "e-no-dr", "nested/c-tight"]
 
 
-def test_a_batch_lists_every_plan_and_exits_1_when_one_fails(plans, tmp_path, capsys):
+@pytest.mark.parametrize("command", [["check-batch"], ["check", "--batch"]],
+                         ids=["check-batch", "old spelling check --batch"])
+def test_a_batch_lists_every_plan_and_exits_1_when_one_fails(plans, tmp_path, capsys, command):
     out = tmp_path / "summary.json"
-    code = main(["check", "--batch", str(plans / "plans"), str(plans / "small.toml"),
+    code = main([*command, str(plans / "plans"), str(plans / "small.toml"),
                  "--workers", "0", "--json", str(out)])
     text = capsys.readouterr().out
     assert code == 1
@@ -111,26 +113,33 @@ def test_without_scenario_each_plan_names_its_bundled_one(plans, tmp_path, capsy
 
 
 @pytest.mark.parametrize("args, field", [
-    (["--batch", "{missing}"], "--batch"),
-    (["--batch", "{empty}"], "--batch"),
-    (["--batch", "{plans}", "{missing}.toml"], "scenario"),
-    (["--batch", "{plans}", "--dr", "x.npy"], "--dr"),
-    (["--batch", "{plans}", "--workers", "1", "--scheduler", "tcp://127.0.0.1:8786"],
+    # cfmpa check-batch, and its old spelling cfmpa check --batch (docs/model.md §7.3).
+    (["check-batch", "{missing}"], "DIR"),
+    (["check-batch", "{empty}"], "DIR"),
+    (["check-batch", "{plans}", "{missing}.toml"], "scenario"),
+    (["check-batch", "{plans}", "--workers", "1", "--scheduler", "tcp://127.0.0.1:8786"],
      "--workers"),
-    (["--batch", "{plans}", "--scheduler", "nonsense"], "--scheduler"),
-    (["{small}", "--plan", "p.json"], "--dr"),
-    (["{small}", "--dr", "d.npy", "--plan", "p.json", "--workers", "2"], "--workers"),
+    (["check-batch", "{plans}", "--scheduler", "nonsense"], "--scheduler"),
+    (["check", "--batch", "{missing}"], "--batch"),
+    (["check", "--batch", "{empty}"], "--batch"),
+    (["check", "--batch", "{plans}", "{missing}.toml"], "scenario"),
+    (["check", "--batch", "{plans}", "--dr", "x.npy"], "--dr"),
+    (["check", "--batch", "{plans}", "--workers", "1", "--scheduler", "tcp://127.0.0.1:8786"],
+     "--workers"),
+    (["check", "--batch", "{plans}", "--scheduler", "nonsense"], "--scheduler"),
+    (["check", "{small}", "--plan", "p.json"], "--dr"),
+    (["check", "{small}", "--dr", "d.npy", "--plan", "p.json", "--workers", "2"], "--workers"),
 ])
 def test_bad_batch_input_is_exit_2_before_any_task(plans, tmp_path, capsys, args, field):
     (tmp_path / "empty").mkdir()
     subst = {"missing": str(tmp_path / "missing"), "empty": str(tmp_path / "empty"),
              "plans": str(plans / "plans"), "small": str(plans / "small.toml")}
-    code = main(["check", *[a.format(**subst) for a in args]])
+    code = main([a.format(**subst) for a in args])
     err = capsys.readouterr().err
     assert code == 2 and f"error: {field}" in err and "Traceback" not in err, err
     assert not (plans / "plans" / BATCH_JSON).exists()
 
 
 def test_run_batch_refuses_a_file_as_the_folder(plans):
-    with pytest.raises(InputError, match="--batch"):
+    with pytest.raises(InputError, match="DIR must be a folder of plan folders"):
         run_batch(plans / "small.toml")

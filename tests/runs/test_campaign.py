@@ -23,7 +23,8 @@ import pytest
 
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.report import campaign_json, run_compare
+from cfmpa.report import run_compare
+from cfmpa.report._compare import campaign_json
 from cfmpa.report._stats import mcnemar_exact_p, wilson_interval
 from cfmpa.runs import (STORE_NAME, Engine, ProgressBar, check_scheduler_address, open_store,
                         random_workcell, run_campaign, workcell_task)

@@ -67,7 +67,10 @@ def test_bad_options_exit_2_naming_the_field(capsys: pytest.CaptureFixture[str])
     assert main(["selftest", "--code", "--checks", "prove,bogus"]) == 2
     assert "--checks is not one of prove, contracts, tests, got 'bogus'" in capsys.readouterr().err
     assert main(["selftest", "--json", "x.json"]) == 2
-    assert "--json is an option of --code" in capsys.readouterr().err
+    assert "--json is an option of cfmpa mutants" in capsys.readouterr().err
+    # cfmpa mutants is the new spelling of selftest --code: the same checks of its options.
+    assert main(["mutants", "--mutant", "nope"]) == 2
+    assert "--mutant is not one of rest_layer_free" in capsys.readouterr().err
 
 
 @pytest.mark.slow

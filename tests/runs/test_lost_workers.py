@@ -322,7 +322,7 @@ def test_a_batch_that_loses_its_last_worker_stops_with_the_command_that_runs_it_
     _FIRST_CHECKED.clear()
     monkeypatch.setattr(batch_module, "check_plan_folder", _slow_after_the_first)
     summary = tmp_path / "summary.json"
-    argv = ["check", "--batch", str(plans / "plans"), str(plans / "small.toml"),
+    argv = ["check-batch", str(plans / "plans"), str(plans / "small.toml"),
             "--json", str(summary), "--scheduler", cluster.scheduler_address,
             "--worker-timeout", "2"]
     _when(_FIRST_CHECKED.is_set, lambda: _close_workers(cluster))

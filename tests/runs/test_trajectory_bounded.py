@@ -123,12 +123,16 @@ def test_a_file_over_its_size_limit_names_the_line_and_the_limit(cell, tmp_path,
     s, scen, traj = cell
     text = traj.read_text()
     monkeypatch.setenv("CFMPA_MAX_TRAJECTORY_BYTES", str(len(text) - 1))
-    assert main(["certify", str(scen), "--traj", str(traj)]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith(f"{traj}:{text.count(chr(10))}: error: file is larger than the limit "
-                          f"of {len(text) - 1:,} bytes") and "CFMPA_MAX_TRAJECTORY_BYTES" in err
-    monkeypatch.setenv("CFMPA_MAX_TRAJECTORY_BYTES", str(len(text)))
+    # A trajectory held whole is refused by its size, before its first line is read; the
+    # streamed certify has no byte limit (docs/model.md §12; tests/runs/test_trajectory_limits).
+    with pytest.raises(InputError) as e:
+        load_trajectory(traj, s)
+    err = e.value.render()
+    assert err.startswith(f"{traj}: error: file is larger than the limit of {len(text) - 1:,} "
+                          "bytes") and "CFMPA_MAX_TRAJECTORY_BYTES" in err
     assert main(["certify", str(scen), "--traj", str(traj)]) == 0
+    monkeypatch.setenv("CFMPA_MAX_TRAJECTORY_BYTES", str(len(text)))
+    assert load_trajectory(traj, s).rows == text.count("\n") - 1
     capsys.readouterr()
     monkeypatch.setenv("CFMPA_MAX_SCENARIO_BYTES", "100")
     with pytest.raises(InputError) as e:

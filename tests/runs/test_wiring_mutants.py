@@ -16,7 +16,9 @@ WIRING = {
     "monitor_gap_slice_short": ["Monitor.reference_speeds", "Control.monitor.gap_last_piece"],
     "witness_start_or_and": ["Witness.labels_sound", "Control.witness.raised_start"],
     "control_error_counted_rejected": ["Control.harness.error_is_not_a_pass"],
-    "theorem_made_definitional": ["Safety.separation"],
+    "theorem_made_definitional": ["Control.accept.kinds", "Control.kinds.theorem_moved"],
+    "exact_rest_layer_skipped": ["Control.exact.rest_layer_contact"],
+    "exact_tool_square_corner_dropped": ["Exact.gap_formula"],
     "loader_spacing_bound_raised": ["Control.loader.spacing_above_bound"],
 }
 

@@ -16,7 +16,8 @@ import cfmpa.spec._layers as layers_module
 from cfmpa.impl import search_opt_path, search_opt_path_fast
 from cfmpa.impl._search import WitnessLabels
 from cfmpa.spec import (MOVES, LayerSpill, Layers, SearchStatus, Witness, check_witness,
-                        load_witness, npz_layers, save_npz)
+                        load_witness, save_npz)
+from cfmpa.spec._layers import npz_layers
 from dr_strategies import random_dr
 
 WAIT = MOVES.index((0, 0))

@@ -11,7 +11,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
-from cfmpa.spec import polygon_distance, polygon_distances
+from cfmpa.spec import polygon_distance
+from cfmpa.spec._polygon import polygon_distances
 
 UNIT = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
 

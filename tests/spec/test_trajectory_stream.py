@@ -175,14 +175,14 @@ def test_seeded_fault_parts_without_the_carried_row_are_caught(workcell, tmp_pat
     p = tmp_path / "edge.csv"
     p.write_text(H + "0,0.3,0.8,3.3,0.5\n1,0.3,0.8,3.3,0.5\n2,0.3,0.8,3.3,0.5\n"
                  "3,0.3,0.8,3.3,0.5\n13,0.3,0.8,1.2,0.5\n14,0.3,0.8,1.2,0.5\n")
-    real = tr._csv_parts
+    real = tr._row_parts
 
     def dropped(*args, **kw):
         for n, (part, offset) in enumerate(real(*args, **kw)):
             yield (part, offset) if n == 0 else (Trajectory(part.t[1:], part.angles[1:],
                                                             part.source, part.lines[1:]),
                                                  offset + 1)
-    monkeypatch.setattr(tr, "_csv_parts", dropped)
+    monkeypatch.setattr(tr, "_row_parts", dropped)
     assert _invariants(s, p, chunks=(4,)) != []
 
 
@@ -190,8 +190,8 @@ def test_seeded_fault_a_row_offset_off_by_one_is_caught(workcell, tmp_path, monk
     s, _, _, _ = workcell
     p = tmp_path / "sweep.csv"
     p.write_text(trajectory_csv(_sweep(s, 41)))
-    real = tr._csv_parts
-    monkeypatch.setattr(tr, "_csv_parts", lambda *a, **k: ((part, offset + (offset > 0))
+    real = tr._row_parts
+    monkeypatch.setattr(tr, "_row_parts", lambda *a, **k: ((part, offset + (offset > 0))
                                                            for part, offset in real(*a, **k)))
     assert _invariants(s, p) != []
 

@@ -3,6 +3,7 @@ functions give on Z3 terms the numbers they give on floats."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
@@ -10,8 +11,8 @@ import z3
 from z3answer import as_float, exact_real
 
 from cfmpa.impl import lattice_range
-from cfmpa.spec import (Variant, cell_box, exact_tf, left_box, load_scenario, make_grid, rest_box,
-                        rule_of)
+from cfmpa.spec import Variant, cell_box, exact_tf, left_box, load_scenario, make_grid, rest_box
+from cfmpa.spec._grid import rule_of
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -24,6 +25,21 @@ def test_every_member_has_a_rule_and_an_unknown_value_raises():
     assert [v for v in Variant if v.rest_at_goal] == [Variant.TIGHT]
     with pytest.raises(ValueError, match="has no box rule"):
         rule_of("diagonal")
+
+
+def test_the_triples_rest_layer_follows_the_rule_not_the_name(monkeypatch):
+    # Theorem 3 (tight)'s rest layer is the goal because tight's rule says so; a rule table
+    # giving original a rest at the goal (a seeded fault) changes Theorem 1's statement with it.
+    from cfmpa.spec import _grid, _triples
+
+    def rest_of(v: Variant) -> str:
+        return _triples._builtdr("T", v, "ref", "note").postcondition[1].text
+
+    assert [v for v in Variant if "at rest at its goal" in rest_of(v)] == [Variant.TIGHT]
+    planted = dict(_grid._RULES, original=dataclasses.replace(_grid._RULES["original"],
+                                                              rest_at_goal=True))
+    monkeypatch.setattr(_grid, "_RULES", planted)
+    assert "at rest at its goal" in rest_of(Variant.ORIGINAL)
 
 
 @pytest.mark.parametrize("name", ["default", "narrow-gap"])
