@@ -40,6 +40,7 @@ proves it, and a wrong rule fails there).
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -349,11 +350,19 @@ def checker_controls() -> list[Control]:
 # --- the compositions without a premise --------------------------------------------------------
 
 
-def _without(variant: str, index: int) -> tuple[str, str]:
+@functools.cache
+def _composition(variant: str) -> Any:
+    """The composition VC of ``variant``, built once a process: its controls read the same
+    hypotheses (built in the parent before the workers fork, so each inherits it)."""
     from ._obl_safety import composition_vc
+
+    return composition_vc(variant)
+
+
+def _without(variant: str, index: int) -> tuple[str, str]:
     from ._obligation import _solver
 
-    vc = composition_vc(variant)
+    vc = _composition(variant)
     rest = [h for i, (_, h) in enumerate(vc.hypotheses) if i != index]
     answers = []
     for label, pins, ms in (("with the one-cell pins", vc.counter_witness, PREMISE_PINNED_MS),
@@ -375,11 +384,11 @@ LEMMA_INSTANCE = "by "
 def premise_controls() -> list[Control]:
     """For each composition, one control per hypothesis that is not a proved lemma's instance:
     the composition without it."""
-    from ._obl_safety import VARIANTS, composition_vc
+    from ._obl_safety import VARIANTS
 
     out = []
     for v in VARIANTS:
-        for i, (name, _) in enumerate(composition_vc(v).hypotheses):
+        for i, (name, _) in enumerate(_composition(v).hypotheses):
             if name.startswith(LEMMA_INSTANCE):
                 continue
             out.append(Control(f"Control.Safety.{v}.composition.without[{i}]",
