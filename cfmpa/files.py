@@ -23,12 +23,27 @@ import numpy as np
 from .errors import MISSING, InputError
 
 __all__ = ["ECHO_CHARS", "LIMITS", "JsonStyle", "Limit", "angle_text", "bounded_lines",
-           "cause_text", "check_file_size", "dumps_json", "echo", "jsonable", "mm_text",
-           "npy_bytes", "read_bounded", "save_npy_atomic", "write_atomic_with",
+           "cause_text", "check_file_size", "dumps_json", "echo", "env_positive_int", "jsonable",
+           "mm_text", "npy_bytes", "read_bounded", "save_npy_atomic", "write_atomic_with",
            "write_bytes_atomic", "write_json"]
 
 #: An echoed value (a row, a field) longer than this in a message is cut to it.
 ECHO_CHARS = 80
+
+
+def env_positive_int(env: str, default: int, unit: str) -> int:
+    """The environment variable ``env`` read as a positive integer (``unit`` names what it
+    counts in the refusal), or ``default`` where it is not set; anything else is exit 2."""
+    raw = os.environ.get(env)
+    if raw is None:
+        return default
+    try:
+        v = int(raw)
+    except ValueError:
+        v = 0
+    if v < 1:
+        raise InputError(env, echo(raw), f"must be a positive integer ({unit})")
+    return v
 
 
 @dataclass(frozen=True)
@@ -41,16 +56,7 @@ class Limit:
     what: str
 
     def value(self) -> int:
-        raw = os.environ.get(self.env)
-        if raw is None:
-            return self.default
-        try:
-            v = int(raw)
-        except ValueError:
-            v = 0
-        if v < 1:
-            raise InputError(self.env, echo(raw), "must be a positive integer (bytes)")
-        return v
+        return env_positive_int(self.env, self.default, "bytes")
 
     def words(self, v: int) -> str:
         return f"the limit of {v:,} bytes for {self.what} (environment variable {self.env})"

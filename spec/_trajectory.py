@@ -45,7 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import MISSING, InputError
-from ..files import LIMITS, bounded_lines, echo, read_bounded
+from ..files import LIMITS, bounded_lines, echo, env_positive_int, read_bounded
 from ._arith import max_of
 from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
                            Certificate, ContactDetail, Prover, link_rects, link_speeds,
@@ -96,16 +96,7 @@ class RowLimit:
     what: str
 
     def value(self) -> int:
-        raw = os.environ.get(self.env)
-        if raw is None:
-            return self.default
-        try:
-            v = int(raw)
-        except ValueError:
-            v = 0
-        if v < 1:
-            raise InputError(self.env, echo(raw), "must be a positive integer (rows)")
-        return v
+        return env_positive_int(self.env, self.default, "rows")
 
     def refusal(self, cap: int, source: str | None, line: int | None,
                 field: str = "trajectory") -> InputError:
