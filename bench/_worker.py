@@ -15,8 +15,8 @@ import sys
 import tempfile
 import time
 import tomllib
-from pathlib import Path
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np

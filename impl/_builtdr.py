@@ -11,15 +11,25 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Callable, Sequence
-from typing import Any
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from ..spec import (EPS, Grid, Scenario, Variant, left_angles, left_box, make_grid,
-                    pairs_to_test, parts, rest_box)
+from ..spec import (
+    EPS,
+    Grid,
+    Scenario,
+    Variant,
+    left_angles,
+    left_box,
+    make_grid,
+    pairs_to_test,
+    parts,
+    rest_box,
+)
 from ._collide import PolygonSet, blocked_against, pad_polygons
 from ._kinematics import link_rectangles
 from ._regions import Angles, Box, Polygon, convex_hull, swept_lattice, swept_points

@@ -53,13 +53,12 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from ..spec import (EPS, Arm, Grid, Scenario, Variant, left_angles, make_grid,
-                    pairs_to_test)
+from ..spec import EPS, Arm, Grid, Scenario, Variant, left_angles, make_grid, pairs_to_test
 from ._builtdr import DR, LeftRegions, RightRegions
-from ._fast_regions import left_regions_fast, right_regions_fast
 from ._collide import PolygonSet, blocked_against, pad_polygons
-from ._progress import progress_bar
+from ._fast_regions import left_regions_fast, right_regions_fast
 from ._kernel_cache import ensure_compiled
+from ._progress import progress_bar
 from ._threads import shared
 
 __all__ = ["MARGIN_REL", "MAX_COORD", "STAGES", "build_dr_fast", "build_from_regions",

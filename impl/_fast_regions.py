@@ -18,12 +18,11 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from ..spec import (Grid, Scenario, Variant, exact_tf, left_angles, make_grid, parts,
-                    rest_box)
+from ..spec import Grid, Scenario, Variant, exact_tf, left_angles, make_grid, parts, rest_box
 from ._builtdr import LeftRegions, RightRegions, left_spacing, right_row
+from ._kernel_cache import ensure_compiled
 from ._kinematics import link_rectangles
 from ._regions import HULL_SCALE_ABOVE, SNAP, Polygon, convex_hull, sweep_margin, swept_points
-from ._kernel_cache import ensure_compiled
 from ._threads import shared
 
 __all__ = ["convex_hulls", "left_regions_fast", "right_regions_fast"]

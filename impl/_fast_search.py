@@ -29,8 +29,7 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from ..spec import (MOVES, REASON_UNREACHABLE,
-                           Cell, SearchResult)
+from ..spec import MOVES, REASON_UNREACHABLE, Cell, SearchResult
 from ._kernel_cache import ensure_compiled
 from ._progress import progress_bar
 from ._search import INF, J2_MASK, SHIFT, WAIT, BackPointers, _prepare, _unwind, hold_waits

@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..spec import Arm, cases, ceil_of, floor_of, max_of, min_of
-from ._kinematics import link_rectangles, link_reach
+from ._kinematics import link_reach, link_rectangles
 
 __all__ = [
     "SNAP",

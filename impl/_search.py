@@ -17,9 +17,19 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import InputError
-from ..spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                   SPILL_BYTES, Cell, LayerSpill, SearchResult, Witness, check_search_inputs,
-                   spill_wanted)
+from ..spec import (
+    MOVES,
+    REASON_GOAL_BLOCKED,
+    REASON_START_BLOCKED,
+    REASON_UNREACHABLE,
+    SPILL_BYTES,
+    Cell,
+    LayerSpill,
+    SearchResult,
+    Witness,
+    check_search_inputs,
+    spill_wanted,
+)
 
 __all__ = ["BackPointers", "WitnessLabels", "hold_waits", "search_opt_path"]
 

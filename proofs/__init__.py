@@ -17,14 +17,39 @@ from ._controls import Control, ControlResult, collect_controls
 from ._ledger import ASSUMPTIONS, Assumption
 from ._obl_scenario import CHECKS as SCENARIO_CHECKS
 from ._obl_scenario import scenario_check_id, scenario_files, scenario_obligations
-from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Proof, VCResult,
-                          Verdict, Z3Query, discharge)
+from ._obligation import (
+    VC,
+    CheckOutcome,
+    CheckQuery,
+    Method,
+    Obligation,
+    Proof,
+    VCResult,
+    Verdict,
+    Z3Query,
+    discharge,
+)
+from ._runner import (
+    BUNDLED_DIR,
+    BUNDLED_SCENARIOS,
+    DEFINITIONAL,
+    EXPECTED_VERDICTS,
+    FIXED_IDS,
+    ProveRun,
+    collect_obligations,
+    compare_ids,
+    default_workers,
+    expected_ids,
+    is_bundled,
+    kind_of,
+    pinned_verdict,
+    render_report,
+    run_obligations,
+    run_record,
+    scenarios_note,
+    selected,
+)
 from ._summaries import obligation_summary, summary_problems
-from ._runner import (BUNDLED_DIR, BUNDLED_SCENARIOS, DEFINITIONAL, EXPECTED_VERDICTS,
-                      FIXED_IDS, ProveRun,
-                      collect_obligations, compare_ids, default_workers, expected_ids, is_bundled,
-                      kind_of, pinned_verdict, render_report, run_obligations, run_record,
-                      scenarios_note, selected)
 
 __all__ = [
     "ASSUMPTIONS", "Assumption", "BUNDLED_DIR", "BUNDLED_SCENARIOS", "CheckOutcome",

@@ -50,9 +50,23 @@ import numpy as np
 import z3
 
 from ..scenarios import SELFCHECK_WORKCELLS
-from ..spec import (J1, J2, MOVES, SearchResult, SearchStatus, Witness, certify,
-                    check_witness, dr_cell_failures, is_path, left_angles, make_grid,
-                    parse_scenario, path_violations, pose_distance)
+from ..spec import (
+    J1,
+    J2,
+    MOVES,
+    SearchResult,
+    SearchStatus,
+    Witness,
+    certify,
+    check_witness,
+    dr_cell_failures,
+    is_path,
+    left_angles,
+    make_grid,
+    parse_scenario,
+    path_violations,
+    pose_distance,
+)
 
 __all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS",
            "checker_controls", "collect_controls", "harness_controls", "positive_controls",

@@ -41,8 +41,8 @@ from __future__ import annotations
 
 import copy
 import math
-from fractions import Fraction
 from collections.abc import Callable
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -50,8 +50,18 @@ import numpy as np
 from .. import spec
 from ..errors import InputError
 from ..scenarios import SELFCHECK_WORKCELLS
-from ..spec import (MOVES, ReferenceSpeeds, Trajectory, Witness, between_samples_bound, certify,
-                    check_witness, left_angles, parse_scenario, trajectory_distances)
+from ..spec import (
+    MOVES,
+    ReferenceSpeeds,
+    Trajectory,
+    Witness,
+    between_samples_bound,
+    certify,
+    check_witness,
+    left_angles,
+    parse_scenario,
+    trajectory_distances,
+)
 from ._controls import Control, ControlNotMade, _case, _rejected, _require
 
 __all__ = ["MARGIN_M", "THEOREM_PREFIXES", "definitional_failures", "wiring_controls",

@@ -171,11 +171,13 @@ def builtdr_obligations() -> list[Obligation]:
             "and increasing; no VC uses the precondition or the correctness invariants, and "
             "the main VC (the bounds hold on entry) is valid without its hypothesis.")
     out = []
-    for ident, suffix, variant, ref, rest in (
-            ("Thm1", "", "original", "Theorem 1 (Algorithm 1)", "the region of layer N-1"),
-            ("Thm3", "", "modified", "Theorem 3 (Section IV.A)", "the region of layer N-1"),
+    for ident, suffix, variant, ref, rest, what in (
+            ("Thm1", "", "original", "Theorem 1 (Algorithm 1)", "the region of layer N-1",
+             "Theorem 1, the paper's original region"),
+            ("Thm3", "", "modified", "Theorem 3 (Section IV.A)", "the region of layer N-1",
+             "Theorem 3, the paper's modified, one-sided region"),
             ("Thm3", "_tight", "tight", "Theorem 3, tight variant (docs/model.md §4)",
-             "the principal at rest at its goal")):
+             "the principal at rest at its goal", "tight: swept between two instants only")):
         statement = (f"{{N >= 1, m, n >= 1}} BuiltDR ({variant}) {{for all k < N, i < m, j < n: "
                      f"P[k,i,j] = (SLarm_k ∩ SRarm_ij = Φ -> 0 | 1) with SLarm_k = "
                      f"regionL_{variant}(k), and the rest layer P[N,i,j] likewise with {rest}}}: "
@@ -187,9 +189,17 @@ def builtdr_obligations() -> list[Obligation]:
                      "nesting (Thm3.box_nesting) and the per-scenario containment check "
                      "(Scenario.*.containment).")
         out.append(Obligation(f"{ident}.builtdr{suffix}", GROUP, ref, statement, Z, P,
-                              lambda v=variant: _query(v, "correctness")))
+                              lambda v=variant: _query(v, "correctness"),
+                              summary=("BuiltDR as written in Algorithm 1 marks a cell of D_R "
+                                       "blocked exactly when the subordinate arm at that cell "
+                                       "meets the principal arm's swept region of that time "
+                                       f"step ({what}).")))
         out.append(Obligation(f"{ident}.termination{suffix}", GROUP, ref, term, Z, P,
-                              lambda v=variant: _query(v, "termination"), label="syntactic"))
+                              lambda v=variant: _query(v, "termination"), label="syntactic",
+                              definitional="a termination measure: counted loops end",
+                              summary=(f"BuiltDR ({variant}) always stops: each of its loops "
+                                       "counts up to a bound fixed before it starts, and "
+                                       "nothing inside a loop changes its counter or bound.")))
     out.append(Obligation(
         "Thm3.box_nesting", GROUP, "Section IV.A (modified box), docs/model.md §4 (tight box)",
         "Per joint, for symbolic start, goal, omega > 0, dt > 0, layer k >= 0 and Tf with "
@@ -200,5 +210,8 @@ def builtdr_obligations() -> list[Obligation]:
         "the code's own (spec.Variant's rule table run on Z3 terms, theta by spec.ptp_angles), "
         "so a changed rule changes the statement and a rule that no longer nests fails it. "
         "Quantifier-free nonlinear real arithmetic, no quantifier.",
-        Z, P, _box_nesting))
+        Z, P, _box_nesting,
+        summary=("Per joint and time step, the tight variant's box of principal angles lies inside "
+                 "the modified one, which lies inside the original one: each variant sweeps no "
+                 "more than the one before.")))
     return out

@@ -623,7 +623,10 @@ def constants_obligations() -> list[Obligation]:
             "joint speeds handed to link_speeds for a piece bound the motion's on it: "
             "Certificate.wiring.",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(certificate_vcs()),
-            label="speed integrated in prose"),
+            label="speed integrated in prose",
+            summary=("The speed bound the motion certificate uses is safe as computed: no point of "
+                     "a link moves faster than it says, so the arms' distance changes no faster "
+                     "than the sum of two links' bounds, and the interval bound holds.")),
         Obligation(
             "Tolerance.tube_factor", GROUP_TUBE, "docs/model.md §12 (tolerance tube)",
             "What spec.tolerance_rad returns is >= 0 and meets Tolerance.tube's premise "
@@ -639,7 +642,11 @@ def constants_obligations() -> list[Obligation]:
             "not checked: a point moves by at most |dtheta1| R_base + |dtheta2| R_elbow (the "
             "speed bound of Certificate.lipschitz integrated along the joint-space segment).",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(tube_factor_vcs()),
-            label="integration in prose"),
+            label="integration in prose",
+            summary=("The tolerance the tube reports is small enough: with the factor and the "
+                     "constant the code uses, twice the constant times the tolerance stays below "
+                     "the proved clearance, and no link point moves more than the constant times "
+                     "the tolerance.")),
         Obligation(
             "Exact.gap_formula", GROUP_EXACT, "docs/model.md §7.2 (exact re-decision)",
             "The ball-arithmetic gap is a lower bound on the distance between the two convex "
@@ -655,9 +662,9 @@ def constants_obligations() -> list[Obligation]:
             "point of the hull of many corners is a combination of three (Caratheodory, in the "
             "plane); arb's balls contain the exact values, upper() and lower() bound a ball.",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(exact_vcs()),
-            label="ball enclosure assumed"),
+            label="ball enclosure assumed",
+            summary=("The gap the exact re-check computes along a separating direction, divided by "
+                     "that direction's length, never exceeds the true distance between the two "
+                     "regions, a tool's polygon included.")),
     ]
-
-
-#: One plain sentence per obligation, for the report (copied into proofs/_summaries.py).
 

@@ -12,8 +12,16 @@ from fractions import Fraction
 
 import z3
 
-from ..spec.z3defs import (POINT_SET, convex_instance, hull_instance, hull_member, is_convex, segment_member,
-                            segment_member_paper, subset)
+from ..spec.z3defs import (
+    POINT_SET,
+    convex_instance,
+    hull_instance,
+    hull_member,
+    is_convex,
+    segment_member,
+    segment_member_paper,
+    subset,
+)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 
 __all__ = ["geometry_obligations"]
@@ -191,31 +199,50 @@ def geometry_obligations() -> list[Obligation]:
         Obligation("Def1.segment", GROUP_DEFS, "Def. 1 segment_def",
                    "Segment x y (read z = t x + (1 - t) y, 0 <= t <= 1) holds x and y "
                    "(weights 1 and 0 named), is symmetric (weight 1 - t named), and segment x x "
-                   "is {x}.", Z, P, _def1),
+                   "is {x}.", Z, P, _def1,
+                   definitional="the definition's weights named",
+                   summary=("The segment between two points (Definition 1, read as t x + (1 - t) "
+                            "y) contains both end points, is the same in either direction, and is "
+                            "a single point when its ends coincide.")),
         Obligation("Def1.segment_printed", GROUP_DEFS, "Def. 1 segment_def as printed",
                    "As printed (z = t x + (t - 1) y), segment x y contains y: refuted at "
                    "x = (0, 0), y = (1, 0), where no t in [0, 1] gives y (a typo for (1 - t) y).",
-                   Z, R, _def1_paper),
+                   Z, R, _def1_paper,
+                   summary=("Definition 1 as printed, t x + (t - 1) y, leaves the segment's second "
+                            "end point out: shown false with a counterexample (a typo for (1 - t) "
+                            "y).")),
         Obligation("Def2.is_convex", GROUP_DEFS, "Def. 2 is_convex_def",
                    "A half-plane {p | a.p <= c} is convex, and the intersection of two convex "
-                   "sets is convex.", Z, P, _def2),
+                   "sets is convex.", Z, P, _def2,
+                   summary=("A half-plane is convex, and so is the intersection of two convex sets "
+                            "(Definition 2).")),
         Obligation("Def3.convex_hull", GROUP_DEFS, "Def. 3 convex_def",
                    "convex X (the intersection of all convex supersets) contains X, lies in every "
                    "convex superset Y of X (instance at Y named), and is convex (for an arbitrary "
-                   "convex superset Y, named).", Z, P, _def3),
+                   "convex superset Y, named).", Z, P, _def3,
+                   summary=("The convex hull of a set (Definition 3) contains the set, lies inside "
+                            "every convex set containing it, and is itself convex.")),
         Obligation("Lemma1.convex_monotone", GROUP_DEFS, "Lemma 1 convex_monotone",
                    "X ⊆ Y implies convex X ⊆ convex Y; the hypothesis p in convex X is "
                    "instantiated at the goal's convex superset Z of Y (witness named).",
-                   Z, P, _lemma1),
+                   Z, P, _lemma1,
+                   summary="Lemma 1: a larger set has a larger convex hull."),
         Obligation("Lemma2.convex_union", GROUP_DEFS, "Lemma 2 convex_union",
                    "convex X ∪ convex Y ⊆ convex (X ∪ Y); the hypotheses are instantiated at the "
-                   "goal's convex superset Z of X ∪ Y (witness named).", Z, P, _lemma2),
+                   "goal's convex superset Z of X ∪ Y (witness named).", Z, P, _lemma2,
+                   summary=("Lemma 2: the hulls of two sets together lie inside the hull of the "
+                            "two sets' union.")),
         Obligation("Sep.separating_axis", GROUP_SEP, "docs/model.md §4 (intersection test)",
                    "If every vertex of A has a.p <= c and every vertex of B has a.p > c, the convex "
                    "hulls of the two vertex sets share no point (any vertex sets, any axis a; the "
-                   "hulls instantiated at the two half-planes, named).", Z, P, _separating_axis),
+                   "hulls instantiated at the two half-planes, named).", Z, P, _separating_axis,
+                   summary=("Two polygons whose corners lie strictly on opposite sides of a line "
+                            "share no point.")),
         Obligation("Sep.distance_monotone", GROUP_SEP, "docs/model.md §4 (free iff distance > eps)",
                    "If dist(A, B) >= delta > eps >= 0 then A and B share no point, and "
                    "dist(A', B') >= delta for A' ⊆ A, B' ⊆ B: the distance-based free decision "
-                   "is sound and monotone under containment (same delta named).", Z, P, _distance),
+                   "is sound and monotone under containment (same delta named).", Z, P, _distance,
+                   summary=("Declaring two regions apart when their distance exceeds a tiny "
+                            "threshold is sound, and stays sound for any smaller regions inside "
+                            "them.")),
     ]

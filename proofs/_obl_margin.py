@@ -19,8 +19,16 @@ import sympy as sp
 import z3
 
 from ..spec import MAX_SPACING
-from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Verdict, Z3Query,
-                          check_source)
+from ._obligation import (
+    VC,
+    CheckOutcome,
+    CheckQuery,
+    Method,
+    Obligation,
+    Verdict,
+    Z3Query,
+    check_source,
+)
 from ._sos import Certificate, Square
 
 __all__ = ["margin_obligations"]
@@ -362,14 +370,20 @@ def margin_obligations() -> list[Obligation]:
                    "f'' = 1 - cos x, f(-x) = f(x). The rest is prose, assumed (ledger A3): "
                    "f'' >= 0 as cos <= 1, so by the mean value theorem f' is non-decreasing, "
                    "f' >= 0 on [0, oo) and f >= f(0) = 0 there, and f even gives x < 0.",
-                   Method.SYMPY, P, _cos_bound, label="identities checked, inequality assumed"),
+                   Method.SYMPY, P, _cos_bound, label="identities checked, inequality assumed",
+                   summary=("1 - cos x is at most x^2/2 for every angle x: the calculus identities "
+                            "are checked exactly, the mean value theorem step is taken on trust "
+                            "(the ledger says so).")),
         Obligation("Margin.arc_chord", GROUP, "docs/model.md §4 (margin lemma, one joint)",
                    "A point at distance r from a pivot, turning through an angle in [0, g], "
                    "g <= 3.14, stays within r g^2/8 of the chord between its end positions "
                    "(within r (1 - cos(g/2)) of its projection on the chord, which lies on it); "
                    "pivot at the origin, arc symmetric about the x-axis (no loss: rigid motions); "
                    "sin, cos as real unknowns with the ledger's facts (A3); nearest point named.",
-                   Method.Z3, P, _arc_chord),
+                   Method.Z3, P, _arc_chord,
+                   summary=("A point at distance r from a joint, turning through an angle g of at "
+                            "most 3.14 rad, stays within r g^2/8 of the straight line between its "
+                            "first and last positions.")),
         Obligation("Lemma.sweep_margin", GROUP, "docs/model.md §4 (margin lemma, two joints)",
                    "A link point at (theta1, theta2) in a lattice cell [c1, c1+g1] x [c2, c2+g2] "
                    "is within delta = g1^2/8 R_base + g2^2/8 R_elbow of the hull of its four "
@@ -387,9 +401,15 @@ def margin_obligations() -> list[Obligation]:
                    "smaller constant is refuted. The setting, not proved here: that the link "
                    "point and the corners are such arcs' points at radii at most R_base about "
                    "the base and R_elbow about the elbow (the kinematics of docs/model.md §2).",
-                   Method.Z3, P, _sweep_margin),
+                   Method.Z3, P, _sweep_margin,
+                   summary=("Anywhere inside a grid cell of joint angles, a link stays within a "
+                            "margin of the hull of its positions at the cell's four corners; the "
+                            "margin grows with the square of the cell's size.")),
         Obligation("Margin.naive_hull", GROUP, "docs/model.md §4 (paper's corner hull)",
                    "The hull of a link at its end configurations contains it in between: refuted "
                    "exactly (sympy) for a segment turning by pi/2, whose tip at pi/4 has a "
-                   "negative barycentric coordinate.", Method.SYMPY, R, _naive_hull),
+                   "negative barycentric coordinate.", Method.SYMPY, R, _naive_hull,
+                   summary=("The paper's hull of a link at its two end positions does not hold the "
+                            "link in between: a link turning by 90 degrees leaves it, shown "
+                            "exactly.")),
     ]

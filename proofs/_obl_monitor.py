@@ -91,5 +91,8 @@ def monitor_obligations() -> list[Obligation]:
                    "(mean value theorem). That w_r, the trajectory's largest speed over the "
                    "pieces the gap meets, bounds its speed there: Monitor.reference_speeds.",
                    Method.Z3, Verdict.PROVED, _query,
-                   label="per joint; the speed bounds' integration is prose"),
+                   label="per joint; the speed bounds' integration is prose",
+                   summary=("Between two measured samples, a robot and a plan that each move at "
+                            "most their speed limit stay within the larger sampled deviation plus "
+                            "their speeds times half the gap.")),
     ]

@@ -14,10 +14,27 @@ from dataclasses import dataclass
 
 import z3
 
-from ..spec.z3defs import (REGION, Blocked, Z3Dims, Z3PathVar, blocked_exact, bound_path,
-                            costs, free_sound, in_grid, inter, inter_definition, is_optimal,
-                            is_path_fixed, is_path_paper, layer_value, lex_le, member, position,
-                            z3_path)
+from ..spec.z3defs import (
+    REGION,
+    Blocked,
+    Z3Dims,
+    Z3PathVar,
+    blocked_exact,
+    bound_path,
+    costs,
+    free_sound,
+    in_grid,
+    inter,
+    inter_definition,
+    is_optimal,
+    is_path_fixed,
+    is_path_paper,
+    layer_value,
+    lex_le,
+    member,
+    position,
+    z3_path,
+)
 from ._obligation import VC, Method, Obligation, Smoke, Verdict, Z3Query
 from ._while import Assign, Assume, Havoc, If, Seq, smoke_tests, verification_conditions
 
@@ -295,21 +312,34 @@ def path_obligations() -> list[Obligation]:
     return [
         Obligation("Prop1.state_meaning", G, "Property 1",
                    "Under Theorem 1's postcondition, P[k,i,j] = 0 implies SLarm_k ∩ SRarm_ij = Φ "
-                   "(no common point) and P[k,i,j] = 1 implies a common point.", Z, P, _prop1),
+                   "(no common point) and P[k,i,j] = 1 implies a common point.", Z, P, _prop1,
+                   summary=("Property 1: a cell marked 0 in D_R means the two arms share no point "
+                            "there; a cell marked 1 means they do.")),
         Obligation("Prop2.endpoints", G, "Property 2",
-                   "is_path(L) implies L_0 = startp and L_{LENGTH(L)-1} = goalp.", Z, P, _prop2),
+                   "is_path(L) implies L_0 = startp and L_{LENGTH(L)-1} = goalp.", Z, P, _prop2,
+                   definitional="a conjunct of is_path restated",
+                   summary=("Property 2: a path starts at the subordinate arm's start cell and "
+                            "ends at its goal cell.")),
         Obligation("Prop3.layer_free", G, "Property 3",
                    "is_path(L), k < N and the cell held at step k is (i, j) imply P[k,i,j] = 0 "
                    "(L_k read as the cell held at step k: the goal once the list has ended).",
-                   Z, P, lambda: _prop34(False)),
+                   Z, P, lambda: _prop34(False),
+                   definitional="a conjunct of is_path restated",
+                   summary=("Property 3: while the principal arm moves, every cell a path holds is "
+                            "free in that time step's layer of D_R.")),
         Obligation("Prop4.rest_free", G, "Property 4",
                    "is_path(L), k >= N and the cell held at step k is (i, j) imply P[N,i,j] = 0 "
                    "(rest layer) and, where R is layer N-1 (original, modified), P[N-1,i,j] = 0; "
-                   "for every k >= N, not only k < LENGTH(L).", Z, P, lambda: _prop34(True)),
+                   "for every k >= N, not only k < LENGTH(L).", Z, P, lambda: _prop34(True),
+                   summary=("Property 4: once the principal arm has stopped, every cell a path "
+                            "holds is free in the rest layer of D_R, however long it waits.")),
         Obligation("Prop5.optpath_is_path", G, "Property 5",
                    "If some path exists, optpath(startp, goalp) is a path: from Hilbert choice "
                    "(instance at the optimum named) and the well-foundedness of (J1, J2) on N x N "
-                   "(an optimum exists once a path does; assumed, see the ledger).", Z, P, _prop5),
+                   "(an optimum exists once a path does; assumed, see the ledger).", Z, P, _prop5,
+                   definitional="a choice instance: Hilbert choice at the named optimum",
+                   summary=("Property 5: if any path exists, the least-cost path the planner "
+                            "chooses is a path.")),
         Obligation("Prop5.printed", G, "Property 5 as printed",
                    "For all startp, goalp, optpath(startp, goalp) is a path: refuted when no path "
                    "exists (start blocked at step 0): Hilbert choice then picks a non-path. "
@@ -317,29 +347,45 @@ def path_obligations() -> list[Obligation]:
                    "'printed means the printed definitions': the flaw refuted is Property 5's "
                    "missing hypothesis that a path exists, which does not depend on Definition "
                    "4 (whose own flaws are Def4.is_path_printed and Def4.is_path_printed_off_grid).",
-                   Z, R, _prop5_printed),
+                   Z, R, _prop5_printed,
+                   summary=("Property 5 as printed (the chosen path is always a path) is false "
+                            "when no path exists, for example with the start cell blocked: the "
+                            "hypothesis that one exists is missing.")),
         Obligation("Prop6.opt_layer_free", G, "Property 6",
                    "optpath = O (a path existing), k < N and O holds (i, j) at step k imply "
-                   "P[k,i,j] = 0.", Z, P, lambda: _prop67(False)),
+                   "P[k,i,j] = 0.", Z, P, lambda: _prop67(False),
+                   definitional="a choice instance composed with a conjunct of is_path",
+                   summary=("Property 6: the least-cost path holds only free cells while the "
+                            "principal arm moves.")),
         Obligation("Prop7.opt_rest_free", G, "Property 7",
                    "optpath = O (a path existing), k >= N and O holds (i, j) at step k imply "
                    "P[N,i,j] = 0 (the rest layer) and, where R is layer N-1 (original, "
                    "modified: P[N] = P[N-1] on every cell), P[N-1,i,j] = 0.",
-                   Z, P, lambda: _prop67(True)),
+                   Z, P, lambda: _prop67(True),
+                   summary=("Property 7: the least-cost path holds only cells free in the rest "
+                            "layer once the principal arm has stopped.")),
         Obligation("Def4.is_path_printed", G, "Definition 4 as printed",
                    "Definition 4 as printed keeps the subordinate safe until the principal "
                    "arrives: refuted, a list that ends early and waits at a goal blocked in a "
-                   "later layer passes it (LENGTH(L) <= k < N unchecked).", Z, R, _def4_printed),
+                   "later layer passes it (LENGTH(L) <= k < N unchecked).", Z, R, _def4_printed,
+                   summary=("Definition 4 as printed lets a path end early and wait at a goal cell "
+                            "that the principal arm sweeps later: shown false, so it does not keep "
+                            "the subordinate safe.")),
         Obligation("Def4.is_path_printed_off_grid", G, "Definition 4 as printed",
                    "Definition 4 as printed keeps the path in the grid: refuted, its step "
                    "condition applies only when L_k and L_k+1 are both grid cells (i < m, "
                    "j < n), so with N = m = n = 3 and every cell blocked a 3-cell list from "
                    "(0, 0) to (2, 2) through a cell outside the grid passes (cells are naturals, "
-                   "as in HOL).", Z, R, _def4_off_grid),
+                   "as in HOL).", Z, R, _def4_off_grid,
+                   summary=("Definition 4 as printed lets a path step through a cell outside the "
+                            "grid: shown false on a 3 x 3 grid with every cell blocked.")),
         Obligation("Def4.is_path_fixed_safe", G, "Definition 4 fixed (docs/model.md §5)",
                    "The fixed is_path(L) implies that at every step k >= 0 the cell held is in "
                    "the grid and free in the layer in force (P[k] for k < N, the rest layer "
-                   "after).", Z, P, _def4_fixed),
+                   "after).", Z, P, _def4_fixed,
+                   summary=("With Definition 4 fixed, a path holds at every step a cell of the "
+                            "grid that is free in the layer in force (the rest layer once the "
+                            "principal arm has stopped).")),
     ]
 
 
@@ -445,12 +491,24 @@ def theorem_obligations() -> list[Obligation]:
     return [
         Obligation("Thm2.searchoptpath", GROUP_THM, "Theorem 2",
                    text.format(n=1, v="original"), Z, P, lambda: _thm("original"),
-                   label=SEARCH_ASSUMED),
+                   label=SEARCH_ASSUMED,
+                   summary=("Theorem 2: searchoptpath (original) reports no path only when none "
+                            "exists, and otherwise returns a least-cost path that is "
+                            "collision-free at every step; the search inside it is taken at its "
+                            "contract unless its witness is checked.")),
         Obligation("Thm4.searchoptpath", GROUP_THM, "Theorem 4",
                    text.format(n=3, v="modified"), Z, P, lambda: _thm("modified"),
-                   label=SEARCH_ASSUMED),
+                   label=SEARCH_ASSUMED,
+                   summary=("Theorem 4: searchoptpath (modified) reports no path only when none "
+                            "exists, and otherwise returns a least-cost path that is "
+                            "collision-free at every step; the search inside it is taken at its "
+                            "contract unless its witness is checked.")),
         Obligation("Thm4.searchoptpath_tight", GROUP_THM, "Theorem 4, tight variant (docs/model.md §4)",
-                   tight, Z, P, lambda: _thm("tight"), label=SEARCH_ASSUMED),
+                   tight, Z, P, lambda: _thm("tight"), label=SEARCH_ASSUMED,
+                   summary=("Theorem 4, tight: searchoptpath (tight) reports no path only when "
+                            "none exists, and otherwise returns a least-cost path that is "
+                            "collision-free at every step; the search inside it is taken at its "
+                            "contract unless its witness is checked.")),
     ]
 
 
@@ -600,24 +658,38 @@ def prop8_obligations() -> list[Obligation]:
         Obligation("Prop8.printed", G, "Property 8 as printed",
                    "S'_k ⊆ S_k and P per S (Theorem 1's postcondition) imply P per S' (Theorem "
                    "3's): refuted, a cell where S_k meets SRarm and S'_k does not.",
-                   Z, R, _prop8_printed),
+                   Z, R, _prop8_printed,
+                   summary=("Property 8 as printed (a smaller swept region keeps Theorem 1's D_R "
+                            "valid for Theorem 3) is false: a cell blocked for the larger region "
+                            "may be free for the smaller one.")),
         Obligation("Prop8.intersection_monotone", G, "Property 8, corrected",
                    "S'_k ⊆ S_k implies: S'_k meets a region only if S_k does.",
-                   Z, P, _prop8_intersection),
+                   Z, P, _prop8_intersection,
+                   definitional="the definition of a subset, at a point",
+                   summary=("A smaller swept region can meet the other arm only where the larger "
+                            "one does.")),
         Obligation("Prop8.subset_monotone", G, "Property 8, corrected",
                    "S' ⊆ S (every layer; used through Prop8.intersection_monotone) with P per S "
                    "and P' per S' implies P' <= P on every cell of every layer, the rest layer "
-                   "included.", Z, P, _prop8_monotone),
+                   "included.", Z, P, _prop8_monotone,
+                   summary=("Smaller swept regions in every layer block no more cells of D_R, the "
+                            "rest layer included.")),
         Obligation("Prop8.valid_transfer", G, "Property 8, corrected",
                    "0 <= P' <= P implies: a path valid under D is valid under D'.",
-                   Z, P, _prop8_valid),
+                   Z, P, _prop8_valid,
+                   summary=("A path valid for the larger swept regions stays valid for the smaller "
+                            "ones.")),
         Obligation("Prop8.path_exists", G, "Property 8, corrected",
                    "0 <= P' <= P implies: a path exists under D' whenever one exists under D.",
-                   Z, P, _prop8_exists),
+                   Z, P, _prop8_exists,
+                   summary=("Whenever a path exists for the larger swept regions, one exists for "
+                            "the smaller ones.")),
         Obligation("Prop8.optimal_cost", G, "Property 8, corrected",
                    "0 <= P' <= P implies: the optimal (J1, J2) under D' is lexicographically <= "
                    "the optimal under D (for any costs J1, J2; D''s optimality instantiated at "
-                   "D's optimum, named).", Z, P, _prop8_cost),
+                   "D's optimum, named).", Z, P, _prop8_cost,
+                   summary=("The least cost of a path for the smaller swept regions is at most the "
+                            "least cost for the larger ones.")),
         Obligation("Prop8.prestrength_thm4", G, "Pre-strength rule, Theorems 2 and 4",
                    "Theorem 2 holds for an arbitrary region family X (motion layers "
                    "regionL_X(k), and a rest region regionRest_X independent of them, so the "
@@ -627,5 +699,8 @@ def prop8_obligations() -> list[Obligation]:
                    "4's precondition implies that precondition at X := S'; by the rule "
                    "(P' ⇒ P, {P} C {Q} give {P'} C {Q}) Theorem 4's safety follows. (The paper "
                    "derives it from Property 8, which runs the other way and is not valid.)",
-                   Z, P, _prestrength, label=SEARCH_ASSUMED),
+                   Z, P, _prestrength, label=SEARCH_ASSUMED,
+                   summary=("Theorem 4's safety follows from Theorem 2 stated for any regions, by "
+                            "strengthening its precondition; the paper's route through Property 8 "
+                            "is not valid.")),
     ]

@@ -41,10 +41,28 @@ from fractions import Fraction
 import z3
 
 from ..impl import SNAP, lattice_range, link_reach, sweep_margin
-from ..spec import (DISTANCE_ERROR_M, EPS, MAX_SPACING, Arm, Variant, cell_box, ptp_angles,
-                    ptp_fraction)
-from ..spec.z3defs import (REGION, Z3Dims, abs_int, adjacent, blocked_exact, in_grid,
-                            is_path_fixed, member, position, z3_path)
+from ..spec import (
+    DISTANCE_ERROR_M,
+    EPS,
+    MAX_SPACING,
+    Arm,
+    Variant,
+    cell_box,
+    ptp_angles,
+    ptp_fraction,
+)
+from ..spec.z3defs import (
+    REGION,
+    Z3Dims,
+    abs_int,
+    adjacent,
+    blocked_exact,
+    in_grid,
+    is_path_fixed,
+    member,
+    position,
+    z3_path,
+)
 from ._obl_margin import margin_obligations
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 
@@ -1743,8 +1761,8 @@ def heights_kept(hl: Heights, hr: Heights, x: int, y: int,
     """spec.heights_overlap (or ``overlap``, the tests' mutant) on the two parts' intervals, read
     off its syntax tree and run on the terms (Safety.height_rule's reading), for each case of
     "has an interval" (None where not)."""
-    from ._obl_tools import _bool, run_on_terms
     from ..spec import heights_overlap
+    from ._obl_tools import _bool, run_on_terms
     fn = overlap or heights_overlap
 
     def ov(a: object, b: object) -> z3.BoolRef:
@@ -2395,7 +2413,10 @@ def safety_obligations() -> list[Obligation]:
             "fraction is 1 from N dt on), used by substitution in motion and rest; the box "
             "rule is docs/model.md §4.1's, and the tests check it against "
             "spec.left_box on every layer of the bundled scenarios.",
-            Z, P, lambda v=v: _principal_query(v)))
+            Z, P, lambda v=v: _principal_query(v),
+            summary=("The principal arm's straight joint-space motion stays, within each time "
+                     "step, inside the box of angles that step's layer is built for, and inside "
+                     f"the rest layer's box once it has stopped ({v} variant).")))
     out.append(Obligation(
         "Safety.subordinate_in_cell_box", GROUP, "docs/model.md §2, §4.1, §5, §10 (b)",
         "(neighbour_move) For cells c, c' with |c'_q - c_q| <= 1, grid angles lo_q + i h_q (h_q > "
@@ -2404,7 +2425,10 @@ def safety_obligations() -> list[Obligation]:
         "+ h2] (spec.right_box) over the whole step. (on_path) Under the fixed is_path, at every "
         "step k >= 0 the cell held (position(L, k)) is in the grid and the cell held at k + 1 is "
         "a neighbour of it or itself; once the list has ended (k + 1 >= LENGTH(L)) both are the "
-        "goal: the subordinate is at rest there.", Z, P, _subordinate_query))
+        "goal: the subordinate is at rest there.", Z, P, _subordinate_query,
+        summary=("The subordinate arm, moving straight from cell to neighbouring cell each time "
+                 "step, stays inside the box of angles of the cell it holds, and rests at its goal "
+                 "once the path ends.")))
     out.append(Obligation(
         "Safety.region_soundness", GROUP, "docs/model.md §2, §4.2, §10 (c)",
         "A point (u, v) of link 1's or link 2's rectangle (docs/model.md §2: half-width r = w/2, "
@@ -2441,7 +2465,10 @@ def safety_obligations() -> list[Obligation]:
         "(lattice indices, chord weights, points, the displacement D) are named by their "
         "definitions. For both arms: the subordinate's regions are built at t_i = 0 and turned "
         "by t_i, the same construction up to rounding (ledger A2).",
-        Z, P, region_query))
+        Z, P, region_query,
+        summary=("Every point of a link, at any joint angles inside a box, lies inside the swept "
+                 "region the planner builds for that box: the margin it adds covers the motion "
+                 "between the grid's sample angles.")))
     out.append(Obligation(
         "Safety.region_statement", GROUP, "docs/model.md §2, §4.2, §10 (c')",
         "For each arm (the principal L, the subordinate R) and each link x: for every box "
@@ -2466,7 +2493,10 @@ def safety_obligations() -> list[Obligation]:
         "points against impl.swept_points and (1)'s rectangle against the link rectangles impl "
         "computes on floats. The compositions' "
         "region_instances VC takes this statement, universally closed, as its premise.",
-        Z, P, region_statement_query))
+        Z, P, region_statement_query,
+        summary=("Hence, by what a link and a swept region are (a rectangle of the arm's geometry; "
+                 "the hull of the grown rectangles at the sample angles), every point of either "
+                 "arm's links at angles in a box is in that box's region.")))
     out.append(Obligation(
         "Safety.separation", GROUP, "docs/model.md §4.3, §10 (d)",
         "What eps buys. (eps_margin) BuiltDR frees a pair of regions when the distance it "
@@ -2478,7 +2508,10 @@ def safety_obligations() -> list[Obligation]:
         "any eps below err is refuted. (no_common_point) Regions at a positive distance hold "
         "links that share no point (the distance of compact sets is attained; definitional). "
         "Regions and links are opaque.",
-        Z, P, _separation_query))
+        Z, P, _separation_query,
+        summary=("A pair of regions the planner frees, its rounded distance above 1e-9 m, is truly "
+                 "apart, since rounding errs by under 3e-11 m; links in regions apart share no "
+                 "point.")))
     for v in VARIANTS:
         rest = ("the principal at rest at its goal" if v == "tight" else "layer N-1's region")
         out.append(Obligation(
@@ -2516,5 +2549,8 @@ def safety_obligations() -> list[Obligation]:
             "region hypotheses, from Safety.tool_region's tool_statement. Every "
             "hypothesis that is not a proved lemma's instance is needed: cfmpa prove's negative "
             "controls drop each and require the composition without it not proved.",
-            Z, P, lambda v=v: _composition_query(v)))
+            Z, P, lambda v=v: _composition_query(v),
+            summary=(f"The safety theorem ({v} variant): if D_R is as Theorems 1/3 say and the "
+                     "path is valid, the two arms share no point at any instant of the executed "
+                     "motion, in continuous time, not only at the grid's instants.")))
     return out

@@ -25,11 +25,20 @@ from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 
-from ..spec import (Grid, Scenario, Variant, decimal, link_name, load_scenario, make_grid,
-                    spacing_conditions)
-from ..spec import parts as part_indices
-from ..spec import MAX_SPACING, theorem_scope
 from ..errors import CfmpaError
+from ..spec import (
+    MAX_SPACING,
+    Grid,
+    Scenario,
+    Variant,
+    decimal,
+    link_name,
+    load_scenario,
+    make_grid,
+    spacing_conditions,
+    theorem_scope,
+)
+from ..spec import parts as part_indices
 from ._obligation import CheckOutcome, CheckQuery, Method, Obligation, Verdict, check_source
 
 __all__ = ["CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations"]
@@ -198,10 +207,17 @@ def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
     s = load_scenario(path)
     if what.startswith("translation_"):
         from ..impl import kernels
-        from ..spec import check_witness, dr_cell_failures, dr_shape_failures, search_failures
+
         # The checkers' sources (hashed: editing them is a change); the kernels' output is
         # judged by them, and its digest is in the detail.
-        from ..spec import exact_path_gaps, path_violations
+        from ..spec import (
+            check_witness,
+            dr_cell_failures,
+            dr_shape_failures,
+            exact_path_gaps,
+            path_violations,
+            search_failures,
+        )
         from ._obl_wiring import exact_cells, exact_coverage_failures, is_path_reads
         src = check_source(_translation, make_grid, kernels, dr_shape_failures, dr_cell_failures,
                            search_failures, check_witness, exact_path_gaps,
@@ -250,13 +266,19 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "readings can differ on a boundary: default's Tf = 1.2 = 60 * 0.02 and "
                        "limited-joints' Tf = 1.625 = 65 * 0.025 are exact multiples of dt in "
                        "decimal.",
-                       D, P, lambda f=f: _query(f, _time_grid, "time_grid")),
+                       D, P, lambda f=f: _query(f, _time_grid, "time_grid"),
+                       summary=(f"{f.stem}: the time steps cover the whole of the principal arm's "
+                                "motion, for the numbers as written in the file and as the computer "
+                                "stores them.")),
             Obligation(scenario_check_id(f.stem, "cspace_grid"), group, "docs/model.md §2 (C-space grid)",
                        f"{f.name}: h_q = (hi_q - lo_q)/(m_q - 1) <= omega_q dt for both joints "
                        f"exactly in the decimal reading (the speed limit as the file states it), "
                        f"and the float h the planner uses within rounding (1e-10 relative) of "
                        f"omega_q dt in both readings and <= 3.14 rad ({_READINGS}).",
-                       D, P, lambda f=f: _query(f, _cspace_grid, "cspace_grid")),
+                       D, P, lambda f=f: _query(f, _cspace_grid, "cspace_grid"),
+                       summary=(f"{f.stem}: the subordinate arm's grid of joint angles is no coarser "
+                                "than the angle its joints turn in one time step, as written and as "
+                                "stored.")),
             Obligation(scenario_check_id(f.stem, "margin_side"), group, "docs/model.md §4 (margin lemma's "
                        "side conditions)",
                        f"{f.name}: every lattice spacing the regions use (left: omega_q dt as "
@@ -265,7 +287,10 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "for every link of both arms at those spacings, is at least the lemma's "
                        "delta plus the snap slack SNAP g R per joint (ledger A10), exactly up "
                        "to 2^-48 relative float rounding (ledger A2).",
-                       D, P, lambda f=f: _query(f, _margin_side, "margin_side")),
+                       D, P, lambda f=f: _query(f, _margin_side, "margin_side"),
+                       summary=(f"{f.stem}: every angle step the swept regions use is at most 3.14 "
+                                "rad, and the margin the planner adds to each link is at least the "
+                                "margin lemma's bound.")),
             Obligation(scenario_check_id(f.stem, "containment"), group,
                        "docs/model.md §4 (containment chain)",
                        f"{f.name}: region_tight ⊆ region_modified ⊆ region_original on the computed "
@@ -274,7 +299,10 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "exactly on the doubles (a filtered cross product, Fractions where the "
                        "float sign is not certain); the least float slack and a digest of the "
                        "polygons are reported.",
-                       D, P, lambda f=f: _query(f, _containment, "containment")),
+                       D, P, lambda f=f: _query(f, _containment, "containment"),
+                       summary=(f"{f.stem}: the tight swept region lies inside the modified one, "
+                                "which lies inside the original one, in every layer and for both "
+                                "links, decided exactly.")),
         ]
         for v in Variant:
             what = f"translation_{v.value}"
@@ -294,6 +322,11 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                 "workcells.",
                 D, P, lambda f=f, v=v, what=what: _query(
                     f, lambda s: _translation(s, v), what),
+                summary=(f"{f.stem}, {v.value}: the fast code's D_R and path meet Theorem "
+                         f"{1 if v is Variant.ORIGINAL else 3}'s and Theorem "
+                         f"{2 if v is Variant.ORIGINAL else 4}'s postconditions at every cell; "
+                         "the search's answer is checked by its witness; the exact re-decision "
+                         "visits every cell of the path."),
                 label=EVERY_CELL, timeout_ms=TRANSLATION_TIMEOUT_MS))
         # A tool or heights: each of the workcell's lines says what the safety theorem does
         # not yet cover (docs/model.md §10), beside its verdict.

@@ -110,5 +110,8 @@ def tolerance_obligations() -> list[Obligation]:
                    "instances). Prose, not checked: integrating the speed bound along the "
                    "joint-space segment from the planned to the deviated configuration gives "
                    "|p - p'| <= delta (R_base + R_elbow) <= L delta.",
-                   Method.Z3, Verdict.PROVED, _query),
+                   Method.Z3, Verdict.PROVED, _query,
+                   summary=("A robot that tracks a plan proved clear by c to within delta in every "
+                            "joint cannot collide while c > 2 L delta, L the largest reach of a "
+                            "link about its two joints (metres per radian).")),
     ]

@@ -46,10 +46,37 @@ import z3
 
 from .. import spec
 from ._obl_constants import GROUP_CERTIFICATE, ExtractionError, _is_sqrt, _term, sqrt_free
-from ._obl_safety import (_COS, _SIN, G_MAX, SNAP_Q, ArcChord, Hyp, Kit, Lemma, N2, Vec, _add,
-                          _comb, _elbow, _pins, _point2, _rot, _sub, _v, _veq, _weighted, _wvec,
-                          a3_sum, a3_unit, e, grown_coords, lattice, lemma, margin_parts,
-                          region_kit)
+from ._obl_safety import (
+    _COS,
+    _SIN,
+    G_MAX,
+    N2,
+    SNAP_Q,
+    ArcChord,
+    Hyp,
+    Kit,
+    Lemma,
+    Vec,
+    _add,
+    _comb,
+    _elbow,
+    _pins,
+    _point2,
+    _rot,
+    _sub,
+    _v,
+    _veq,
+    _weighted,
+    _wvec,
+    a3_sum,
+    a3_unit,
+    e,
+    grown_coords,
+    lattice,
+    lemma,
+    margin_parts,
+    region_kit,
+)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 
 __all__ = ["GROUP", "V", "ReachReading", "SymTool", "ToolKit", "ToolReading", "check_none_reading",
@@ -1162,7 +1189,7 @@ def tool_statement(tag: str) -> tuple[list[z3.ExprRef], z3.BoolRef]:
     lattice anchor and spacing (0 < g_q <= G_MAX), configuration theta in the box and point p, a
     point of the arm's tool (part 3) at theta is a member of the region built for the tool, the
     box, the anchor and the spacing: Safety.region_statement's form for part 3."""
-    from ._obl_safety import region_statement, ArmModel
+    from ._obl_safety import ArmModel, region_statement
     return region_statement(ArmModel.named(tag), 2)
 
 
@@ -1640,7 +1667,10 @@ def tools_obligations() -> list[Obligation]:
             "fails the obligation): heights_overlap, run on terms, keeps a part without an "
             "interval against every part, and spec.pairs_to_test keeps exactly the pairs "
             "heights_overlap keeps (sample arms with and without heights and tools).",
-            Method.Z3, Verdict.PROVED, height_rule_query),
+            Method.Z3, Verdict.PROVED, height_rule_query,
+            summary=("Two parts whose height ranges the planner calls apart share no point in "
+                     "space, whatever their outlines, so their planar test may be skipped; ranges "
+                     "that only touch count as overlapping.")),
         Obligation(
             "Safety.tool_region", GROUP, "docs/model.md §2 (tools and heights), §4.2, §10 (c)",
             "A point of a tool (a convex polygon fixed in the forearm's frame: origin at the "
@@ -1679,7 +1709,10 @@ def tools_obligations() -> list[Obligation]:
             "substitution. Faults refuted: a vertex left out "
             "of the points (tool_points), the margin from the nearest vertex (far_vertex), the "
             "polygon turned with link 1 (tool_points).",
-            Method.Z3, Verdict.PROVED, tool_region_query, label="hull of sums stated"),
+            Method.Z3, Verdict.PROVED, tool_region_query, label="hull of sums stated",
+            summary=("Every point of a tool on the wrist, at any joint angles inside a box, lies "
+                     "inside the swept region the planner builds for the tool: its margin, taken "
+                     "from the farthest vertex, covers the motion between the sample angles.")),
         Obligation(
             "Certificate.height_gap", GROUP_CERTIFICATE,
             "docs/model.md §2 (tools and heights), §7.2",
@@ -1695,5 +1728,8 @@ def tools_obligations() -> list[Obligation]:
             "certificate's L, Certificate.lipschitz). Restated, not read: part_distances' "
             "hypot(planar, gap) where gap > 0 (tested against it).",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(height_gap_vcs()),
-            label="hypot restated"),
+            label="hypot restated",
+            summary=("Between two parts at disjoint heights the motion check's distance, made of "
+                     "the planar distance and the height gap, never exceeds their true distance in "
+                     "space, and changes no faster than the planar one.")),
     ]

@@ -40,8 +40,16 @@ import z3
 
 from .. import spec
 from ._obl_constants import GROUP_CERTIFICATE
-from ._obligation import (VC, CheckOutcome, CheckQuery, Method, Obligation, Verdict, Z3Query,
-                          check_source)
+from ._obligation import (
+    VC,
+    CheckOutcome,
+    CheckQuery,
+    Method,
+    Obligation,
+    Verdict,
+    Z3Query,
+    check_source,
+)
 from ._symexec import Explorer, ExtractionError, Path, SymArray, SymNumpy, obj, rebind
 
 __all__ = ["GROUP_MONITOR", "KEY_GAP", "KEY_ROW", "KEY_SEGMENT", "PIECE_CASES", "exact_cells",
@@ -453,7 +461,10 @@ def wiring_obligations() -> list[Obligation]:
             "its segment's step, cut at Tf, moving = (t0 < Tf).",
             Method.Z3, Verdict.PROVED,
             lambda: Z3Query(grid_motion_vcs() + trajectory_motion_vcs()),
-            label="pieces checked on data"),
+            label="pieces checked on data",
+            summary=("For each time piece of a motion the certificate checks, the speed it charges "
+                     "each arm is the speed that arm really has on that piece, and the angles it "
+                     "samples are the motion's own.")),
         Obligation(
             "Certificate.pieces", GROUP_CERTIFICATE, "docs/model.md §7.2 (the pieces)",
             "The grid motion's pieces() meets what Certificate.wiring assumes, on "
@@ -461,7 +472,10 @@ def wiring_obligations() -> list[Obligation]:
             "path's end, multiples of dt or not): 0 <= t0 <= t1; a segment's piece in its step "
             "(the same float products); a piece at rest after (n - 1) dt; moving = (t0 < Tf); "
             "none straddles Tf; together they tile [0, max((n - 1) dt, Tf)].",
-            Method.DATA, Verdict.PROVED, _pieces_query, label="checked on data"),
+            Method.DATA, Verdict.PROVED, _pieces_query, label="checked on data",
+            summary=("The certificate cuts the motion into pieces that each lie within one path "
+                     "step, stop where the principal arm stops, and together cover the whole "
+                     "motion without gaps.")),
         Obligation(
             "Monitor.reference_speeds", GROUP_MONITOR, "docs/model.md §12 (monitor between "
             "samples)",
@@ -474,6 +488,9 @@ def wiring_obligations() -> list[Obligation]:
             "between rows j - 1 and j), and no index leaves its array: the w_r "
             "Monitor.between_samples assumes.",
             Method.Z3, Verdict.PROVED, lambda: Z3Query(reference_speed_vcs()),
-            label="any number of pieces"),
+            label="any number of pieces",
+            summary=("For a gap between two measured samples, the plan's speed the monitor uses is "
+                     "at least its speed on every part of the plan the gap overlaps, however many "
+                     "parts that is.")),
     ]
 

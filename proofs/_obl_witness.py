@@ -48,11 +48,30 @@ from dataclasses import dataclass
 
 import z3
 
-from ..spec import (KEY_BASE, closure_breaks, edge_bound, edge_holds, exclusion_breaks,
-                    goal_holds, label_in_range, label_key, start_breaks, start_label_breaks,
-                    step_cost, stop_key)
-from ..spec.z3defs import (Z3Dims, Z3PathVar, abs_int, in_grid, is_path_fixed, lex_le, position,
-                            z3_path)
+from ..spec import (
+    KEY_BASE,
+    closure_breaks,
+    edge_bound,
+    edge_holds,
+    exclusion_breaks,
+    goal_holds,
+    label_in_range,
+    label_key,
+    start_breaks,
+    start_label_breaks,
+    step_cost,
+    stop_key,
+)
+from ..spec.z3defs import (
+    Z3Dims,
+    Z3PathVar,
+    abs_int,
+    in_grid,
+    is_path_fixed,
+    lex_le,
+    position,
+    z3_path,
+)
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
 
 __all__ = ["GROUP", "witness_obligations", "witness_vcs"]
@@ -311,7 +330,9 @@ def witness_obligations() -> list[Obligation]:
             "run on Z3 terms, with witness.form's range); VC optimal: a returned path whose "
             "cost passes spec's goal_holds against C is no worse than any valid L (Definition "
             "5): spec.check_witness's acceptance is sound (ledger A6).",
-            Z, P, lambda: Z3Query(_labels_vcs())),
+            Z, P, lambda: Z3Query(_labels_vcs()),
+            summary=("When the cost labels the search hands over pass the witness checker, no "
+                     "valid path costs less than the path returned: the path is optimal.")),
         Obligation(
             "Witness.reachable_sound", GROUP, "ours: McConnell et al.'s certifying algorithms",
             "For every grid, D_R, start and goal, and any set S of capped states: if S holds "
@@ -322,5 +343,7 @@ def witness_obligations() -> list[Obligation]:
             "S (VCs base; walk and step, closure at L's own edge), and its last is an "
             "admissible goal state (VC conclusion). So spec.check_witness's acceptance of 'no "
             "path' is sound (ledger A6).",
-            Z, P, lambda: Z3Query(_reachable_vcs())),
+            Z, P, lambda: Z3Query(_reachable_vcs()),
+            summary=("When the search reports no path and the set of reachable states it hands "
+                     "over passes the witness checker, no valid path exists.")),
     ]

@@ -1,7 +1,10 @@
 """`make prove`: collect the obligations, discharge them, compare with the last run, report.
 
-The run passes only if every verdict is the one pinned in EXPECTED_VERDICTS (and agrees with
-``Obligation.expected``) and the set of obligation ids equals the expected list, without
+Each obligation is declared once, by an ``Obligation(...)`` in a collector of COLLECTORS;
+EXPECTED_VERDICTS, DEFINITIONAL and FIXED_IDS are views of the declarations, and
+proofs/obligations.lock the independent pin (its ids are expected, its verdicts and kinds
+compared). The run passes only if every verdict is the declared one, the statements and kinds
+are the pinned ones, and the set of obligation ids equals the expected list, without
 repeats: the fixed ids below plus one per check (CHECKS) and scenario, by name for the bundled
 folder's scenarios (so a deleted file is a missing id) and per file found for any other folder
 (said in the report). Nothing can be dropped silently. Every obligation's query is saved under
@@ -17,7 +20,7 @@ import hashlib
 import json
 import os
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
@@ -29,20 +32,20 @@ from .. import __version__
 from ..files import dumps_json, write_bytes_atomic
 from ..gitstate import package_state
 from ..scenarios import BUNDLED_DIR
+from ._controls import Control, ControlResult, run_control
 from ._ledger import ASSUMPTIONS, Assumption
 from ._obl_builtdr import builtdr_obligations
+from ._obl_constants import constants_obligations
 from ._obl_geometry import geometry_obligations
 from ._obl_margin import margin_obligations
-from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
-from ._obl_witness import witness_obligations
-from ._obl_constants import constants_obligations
 from ._obl_monitor import monitor_obligations
-from ._obl_tolerance import tolerance_obligations
+from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
 from ._obl_safety import safety_obligations
+from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
+from ._obl_tolerance import tolerance_obligations
 from ._obl_tools import tools_obligations
 from ._obl_wiring import wiring_obligations
-from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
-from ._controls import Control, ControlResult, run_control
+from ._obl_witness import witness_obligations
 from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
 from ._pins import LOCK, Mismatch, check_kinds, check_pins, cvc5_skips, load_lock
 from ._pins import repin as repin_lock
@@ -50,13 +53,16 @@ from ._pins import repin as repin_lock
 __all__ = [
     "BUNDLED_DIR",
     "BUNDLED_SCENARIOS",
+    "COLLECTORS",
     "DEFINITIONAL",
     "EXPECTED_VERDICTS",
     "FIXED_IDS",
     "ProveRun",
     "collect_obligations",
+    "declared",
     "default_workers",
     "expected_ids",
+    "fixed_ids",
     "is_bundled",
     "kind_and_why",
     "kind_of",
@@ -67,55 +73,58 @@ __all__ = [
     "selected",
 ]
 
-_P, _R = Verdict.PROVED, Verdict.REFUTED_AS_EXPECTED
+#: The collector of each module of fixed obligations, in the order a run discharges them: the
+#: registry the views below and ``collect_obligations`` read (the per-scenario checks,
+#: ``scenario_obligations``, come after them). A new module of obligations is one entry here;
+#: a new obligation is one ``Obligation(...)`` in its module's collector.
+COLLECTORS: tuple[Callable[[], Sequence[Obligation]], ...] = (
+    geometry_obligations, margin_obligations, builtdr_obligations, path_obligations,
+    theorem_obligations, witness_obligations, prop8_obligations, tolerance_obligations,
+    monitor_obligations, constants_obligations, safety_obligations, tools_obligations,
+    wiring_obligations)
 
-#: Every fixed obligation id and the verdict it must get: the one place the expectation is
-#: pinned. Kept by hand, on purpose: an obligation that disappears from the code, or whose
-#: ``Obligation.expected`` drifts from this, makes the run fail.
-EXPECTED_VERDICTS: dict[str, Verdict] = {
-    "Def1.segment": _P, "Def1.segment_printed": _R, "Def2.is_convex": _P,
-    "Def3.convex_hull": _P, "Lemma1.convex_monotone": _P, "Lemma2.convex_union": _P,
-    "Sep.separating_axis": _P, "Sep.distance_monotone": _P,
-    "Margin.cos_bound": _P, "Margin.arc_chord": _P, "Lemma.sweep_margin": _P,
-    "Margin.naive_hull": _R,
-    "Thm1.builtdr": _P, "Thm1.termination": _P, "Thm3.builtdr": _P, "Thm3.termination": _P,
-    "Thm3.builtdr_tight": _P, "Thm3.termination_tight": _P, "Thm3.box_nesting": _P,
-    "Prop1.state_meaning": _P, "Prop2.endpoints": _P, "Prop3.layer_free": _P,
-    "Prop4.rest_free": _P, "Prop5.optpath_is_path": _P, "Prop5.printed": _R,
-    "Prop6.opt_layer_free": _P, "Prop7.opt_rest_free": _P,
-    "Def4.is_path_printed": _R, "Def4.is_path_printed_off_grid": _R,
-    "Def4.is_path_fixed_safe": _P,
-    "Thm2.searchoptpath": _P, "Thm4.searchoptpath": _P, "Thm4.searchoptpath_tight": _P,
-    "Witness.labels_sound": _P, "Witness.reachable_sound": _P,
-    "Prop8.printed": _R, "Prop8.intersection_monotone": _P, "Prop8.subset_monotone": _P,
-    "Prop8.valid_transfer": _P, "Prop8.path_exists": _P, "Prop8.optimal_cost": _P,
-    "Prop8.prestrength_thm4": _P,
-    "Tolerance.tube": _P, "Monitor.between_samples": _P,
-    "Certificate.lipschitz": _P, "Tolerance.tube_factor": _P, "Exact.gap_formula": _P,
-    "Certificate.wiring": _P, "Certificate.pieces": _P, "Monitor.reference_speeds": _P,
-    "Safety.original.principal_in_layer_box": _P, "Safety.modified.principal_in_layer_box": _P,
-    "Safety.tight.principal_in_layer_box": _P, "Safety.subordinate_in_cell_box": _P,
-    "Safety.region_soundness": _P, "Safety.region_statement": _P,
-    "Safety.separation": _P, "Safety.original.composition": _P,
-    "Safety.modified.composition": _P, "Safety.tight.composition": _P,
-    "Safety.height_rule": _P, "Safety.tool_region": _P, "Certificate.height_gap": _P,
-}
+
+@dataclass(frozen=True)
+class Declared:
+    """What the declarations (``Obligation(...)`` in each collector) say, by id: the expected
+    verdicts, why each definitional one is (docs/model.md §10), and the plain summaries."""
+
+    expected: dict[str, Verdict]
+    definitional: dict[str, str]
+    summaries: dict[str, str]
+
+
+def declared(collectors: Iterable[Callable[[], Sequence[Obligation]]] = COLLECTORS) -> Declared:
+    """The views of the fixed obligations' declarations (cheap: no query is built). An id
+    declared twice is an error here (the run would count it as a duplicate)."""
+    expected: dict[str, Verdict] = {}
+    definitional: dict[str, str] = {}
+    summaries: dict[str, str] = {}
+    for collect in collectors:
+        for o in collect():
+            if o.id in expected:
+                raise ValueError(f"obligation id {o.id!r} declared twice")
+            expected[o.id] = o.expected
+            if o.definitional:
+                definitional[o.id] = o.definitional
+            if o.summary:
+                summaries[o.id] = o.summary
+    return Declared(expected, definitional, summaries)
+
+
+_DECLARED = declared()
+
+#: Every fixed obligation id and the verdict it must get, as declared (``Obligation.expected``).
+#: proofs/obligations.lock pins it independently (a drifted expectation is a changed statement),
+#: and every id it pins is expected of a full run (FIXED_IDS), so an obligation that
+#: disappears from the code is a missing id.
+EXPECTED_VERDICTS: dict[str, Verdict] = dict(_DECLARED.expected)
 
 #: Obligations whose proof is definitional: true by a definition's own clauses, a termination
 #: measure or a named choice instance rather than a theorem about the robot (docs/model.md
-#: §10). Kept by hand beside EXPECTED_VERDICTS, with why; results.json, the summary and the
-#: report count them apart from the theorems.
-DEFINITIONAL: dict[str, str] = {
-    "Thm1.termination": "a termination measure: counted loops end",
-    "Thm3.termination": "a termination measure: counted loops end",
-    "Thm3.termination_tight": "a termination measure: counted loops end",
-    "Prop2.endpoints": "a conjunct of is_path restated",
-    "Prop3.layer_free": "a conjunct of is_path restated",
-    "Prop5.optpath_is_path": "a choice instance: Hilbert choice at the named optimum",
-    "Prop6.opt_layer_free": "a choice instance composed with a conjunct of is_path",
-    "Prop8.intersection_monotone": "the definition of a subset, at a point",
-    "Def1.segment": "the definition's weights named",
-}
+#: §10), with why, as declared (``Obligation.definitional``); results.json, the summary and
+#: the report count them apart from the theorems, and the lock pins each kind.
+DEFINITIONAL: dict[str, str] = dict(_DECLARED.definitional)
 
 
 def kind_of(ident: str) -> str:
@@ -128,8 +137,17 @@ def kind_and_why(ident: str) -> tuple[str, str]:
     return kind_of(ident), DEFINITIONAL.get(ident, "")
 
 
-#: The obligations every run must produce, besides the per-scenario ones.
-FIXED_IDS: tuple[str, ...] = tuple(EXPECTED_VERDICTS)
+def fixed_ids(declared_ids: Iterable[str], lock: dict[str, Any]) -> tuple[str, ...]:
+    """The fixed ids a run must produce: ``declared_ids``, then (sorted) every id ``lock`` pins
+    that none of them is, the per-scenario keys left out: an obligation that disappeared from
+    the code stays expected, so a run misses it."""
+    ids = tuple(declared_ids)
+    return ids + tuple(sorted(k for k in lock if not k.startswith("Scenario.") and k not in ids))
+
+
+#: The obligations every run must produce, besides the per-scenario ones: the declared ids,
+#: then any id proofs/obligations.lock pins that no declaration has (a missing id).
+FIXED_IDS: tuple[str, ...] = fixed_ids(EXPECTED_VERDICTS, load_lock(LOCK))
 
 #: The bundled scenario files (stems) of ``BUNDLED_DIR``: their checks are expected by name, so
 #: a deleted file is a missing id, not a quietly shorter run. Every scenario check must prove.
@@ -163,12 +181,8 @@ _COLUMNS = ("total", "proved (Z3)", "proved (sympy)", "checked on data", "refute
 def collect_obligations(scenarios_dir: str | Path = BUNDLED_DIR,
                         only: Iterable[str] | None = None) -> tuple[Obligation, ...]:
     """Every obligation (cheap: queries are built when discharged), optionally filtered."""
-    obs = (geometry_obligations() + margin_obligations() + builtdr_obligations()
-           + path_obligations() + theorem_obligations() + witness_obligations()
-           + prop8_obligations()
-           + tolerance_obligations() + monitor_obligations() + constants_obligations()
-           + safety_obligations() + tools_obligations() + wiring_obligations()
-           + scenario_obligations(scenarios_dir))
+    obs = [o for collect in COLLECTORS for o in collect()]
+    obs += scenario_obligations(scenarios_dir)
     return tuple(o for o in obs if selected(o.id, only))
 
 

@@ -36,19 +36,41 @@ import jinja2
 import markupsafe
 import numpy as np
 
-from ..files import jsonable, write_bytes_atomic, write_json
 from ..errors import CfmpaError, InputError
-from ..scenarios import BUNDLED_DIR
+from ..files import jsonable, write_bytes_atomic, write_json
 from ..impl import left_regions
 from ..runs import Campaign, load_campaign, run_campaign
-from ..spec import (Scenario, SearchStatus, Variant, certify_trajectory, executed_trajectory,
-                    load_scenario, theorem_scope, tolerance_rad, tube_lipschitz)
+from ..scenarios import BUNDLED_DIR
+from ..spec import (
+    Scenario,
+    SearchStatus,
+    Variant,
+    certify_trajectory,
+    executed_trajectory,
+    load_scenario,
+    theorem_scope,
+    tolerance_rad,
+    tube_lipschitz,
+)
 from . import _figures as F
 from ._compare import campaign_json, format_campaign
-from ._findings import (Finding, early_arrival_finding, inconsistency_finding, naive_hull_finding,
-                        prop8_finding, sample_clearance)
-from ._obligations import (ProofData, card_groups, control_summary, load_proofs, load_selftest,
-                           read_results, summary_table)
+from ._findings import (
+    Finding,
+    early_arrival_finding,
+    inconsistency_finding,
+    naive_hull_finding,
+    prop8_finding,
+    sample_clearance,
+)
+from ._obligations import (
+    ProofData,
+    card_groups,
+    control_summary,
+    load_proofs,
+    load_selftest,
+    read_results,
+    summary_table,
+)
 from ._provenance import VERSION_GROUPS, provenance
 from ._sections import Section, compute_order, numbers, verdict_of
 
@@ -332,12 +354,11 @@ class _FreshProofs:
 def _own_group(pid: int | None) -> None:
     """Make ``pid`` the leader of a process group of its own (called in both processes, so it
     holds whichever runs first): ``_FreshProofs.close`` ends it with all its processes."""
+    import contextlib
     import os
 
-    try:
+    with contextlib.suppress(OSError):  # it has ended already, or no such call here
         os.setpgid(pid or 0, pid or 0)
-    except OSError:                    # it has ended already, or no such call here
-        pass
 
 
 class _Lines(io.TextIOBase):

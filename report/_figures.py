@@ -25,12 +25,17 @@ import shapely  # noqa: E402
 import shapely.ops  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Patch, Polygon as MplPolygon, Rectangle  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
+from matplotlib.patches import Polygon as MplPolygon
 
-from ..spec import (TOOL, Grid, Scenario, Variant, arm_parts, left_angles, part_height,  # noqa: E402
-                    parts, reach)
-from ._findings import (EarlyArrivalData, InconsistencyData, NaiveHullData, Prop8Data,  # noqa: E402
-                        right_angles_at)
+from ..spec import TOOL, Grid, Scenario, Variant, arm_parts, left_angles, part_height, parts, reach  # noqa: E402
+from ._findings import (  # noqa: E402
+    EarlyArrivalData,
+    InconsistencyData,
+    NaiveHullData,
+    Prop8Data,
+    right_angles_at,
+)
 from ._stats import wilson_interval  # noqa: E402
 
 __all__ = [

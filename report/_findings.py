@@ -17,9 +17,20 @@ import numpy as np
 import numpy.typing as npt
 import shapely
 
-from ..impl import link_rectangles, left_regions, naive_hull, right_regions, swept_region
-from ..spec import (EPS, Grid, Scenario, Variant, certify, is_path_paper, left_angles, left_box,
-                    path_violations, polygon_distance, trajectory_distances)
+from ..impl import left_regions, link_rectangles, naive_hull, right_regions, swept_region
+from ..spec import (
+    EPS,
+    Grid,
+    Scenario,
+    Variant,
+    certify,
+    is_path_paper,
+    left_angles,
+    left_box,
+    path_violations,
+    polygon_distance,
+    trajectory_distances,
+)
 
 __all__ = [
     "Finding",

@@ -492,8 +492,16 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str],
            progress: TextIO | None = None) -> ProofData:
     import tempfile
 
-    from ..proofs import (ASSUMPTIONS, DEFINITIONAL, FIXED_IDS, collect_controls,
-                          default_workers, kind_of, obligation_summary, run_obligations)
+    from ..proofs import (
+        ASSUMPTIONS,
+        DEFINITIONAL,
+        FIXED_IDS,
+        collect_controls,
+        default_workers,
+        kind_of,
+        obligation_summary,
+        run_obligations,
+    )
 
     # The prove runner itself: its worker processes side by side, each with its cvc5 replay in
     # the background, and the lock's record of what cvc5 did not decide (one obligation at a

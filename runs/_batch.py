@@ -30,8 +30,14 @@ from ..scenarios import BUNDLED_DIR, bundled_names
 from ..spec import load_scenario, make_grid
 from ._check import check_outputs, read_plan
 from ._drstore import find_dr, load_dr
-from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
-                      error_message)
+from ._engine import (
+    CONNECT_TIMEOUT_S,
+    WORKER_TIMEOUT_S,
+    Engine,
+    ProgressBar,
+    TaskLost,
+    error_message,
+)
 
 __all__ = ["BATCH_JSON", "batch_table", "check_plan_folder", "find_plan_folders", "run_batch"]
 

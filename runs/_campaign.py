@@ -44,11 +44,25 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..errors import CfmpaError, InputError, WorkersLost
-from ..spec import (EPS, Scenario, SearchStatus, Variant, certify, make_grid,
-                    parse_scenario, pose_distance)
+from ..spec import (
+    EPS,
+    Scenario,
+    SearchStatus,
+    Variant,
+    certify,
+    make_grid,
+    parse_scenario,
+    pose_distance,
+)
+from ._engine import (
+    CONNECT_TIMEOUT_S,
+    WORKER_TIMEOUT_S,
+    Engine,
+    ProgressBar,
+    TaskLost,
+    error_message,
+)
 from ._limits import MAX_DT, MAX_WORKCELLS
-from ._engine import (CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost,
-                      error_message)
 from ._store import Store, open_store, read_store
 
 __all__ = ["COMPARE_DT", "CONTACT_NOTE", "KERNEL", "MAX_DRAWS", "MAX_DT", "MAX_WORKCELLS",

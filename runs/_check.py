@@ -25,13 +25,23 @@ from typing import Any, TextIO
 
 import numpy.typing as npt
 
-from ..errors import MISSING, ContractViolation, InputError
-from ..errors import value_text
+from ..errors import MISSING, ContractViolation, InputError, value_text
 from ..files import LIMITS, mm_text, read_bounded
-from ..spec import Grid, Scenario, Variant, load_scenario, make_grid
-from ..spec import certify, require_clear
-from ..spec import SearchResult, SearchStatus
-from ..spec import Witness, cost_failures, load_witness, search_triple
+from ..spec import (
+    Grid,
+    Scenario,
+    SearchResult,
+    SearchStatus,
+    Variant,
+    Witness,
+    certify,
+    cost_failures,
+    load_scenario,
+    load_witness,
+    make_grid,
+    require_clear,
+    search_triple,
+)
 from ._contracts import Mode, Settings, TripleRun, builtdr_post, search_post, search_pre
 from ._drstore import load_dr
 from ._plan import CERTIFICATE

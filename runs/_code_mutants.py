@@ -162,13 +162,13 @@ CODE_MUTANTS: tuple[CodeMutant, ...] = (
                "as rejected (Control.harness.error_is_not_a_pass)", "proofs/_controls.py",
                (("        outcome, detail = \"error\", f\"{type(exc).__name__}: {exc}\"\n",
                  "        outcome, detail = \"rejected\", f\"{type(exc).__name__}: {exc}\"\n"),)),
-    CodeMutant("theorem_made_definitional", "a theorem moved into the definitional list "
+    CodeMutant("theorem_made_definitional", "a theorem declared definitional "
                "(Control.accept.kinds rejected, Control.kinds.theorem_moved not made; its kind, "
                "pinned in obligations.lock, is not what --repin may change either)",
-               "proofs/_runner.py",
-               (("    \"Def1.segment\": \"the definition's weights named\",\n}\n",
-                 "    \"Def1.segment\": \"the definition's weights named\",\n"
-                 "    \"Safety.separation\": \"a definition restated\",\n}\n"),)),
+               "proofs/_obl_safety.py",
+               (("        summary=(\"A pair of regions the planner frees, its rounded distance",
+                 "        definitional=\"a definition restated\",\n"
+                 "        summary=(\"A pair of regions the planner frees, its rounded distance"),)),
     CodeMutant("exact_rest_layer_skipped", "the exact re-decision stops a step short, the path's "
                "rest-layer cell never re-decided (Control.exact.rest_layer_contact proved free; "
                "Scenario.*.translation_*'s exact.coverage)", "spec/_exact.py",

@@ -32,11 +32,25 @@ import numpy.typing as npt
 from ..errors import ContractViolation, InputError
 from ..files import jsonable
 from ..impl import build_dr, search_opt_path, search_opt_path_fast
-from ..spec import Grid, Scenario, Variant
-from ..spec import SearchResult, SearchStatus, Witness, check_witness
-from ..spec import (Failure, Triple, builtdr_triple, cells_failures, dr_cell_failures,
-                             dr_shape_failures, grid_failures, path_cells, search_failures,
-                             search_triple)
+from ..spec import (
+    Failure,
+    Grid,
+    Scenario,
+    SearchResult,
+    SearchStatus,
+    Triple,
+    Variant,
+    Witness,
+    builtdr_triple,
+    cells_failures,
+    check_witness,
+    dr_cell_failures,
+    dr_shape_failures,
+    grid_failures,
+    path_cells,
+    search_failures,
+    search_triple,
+)
 
 __all__ = [
     "DEFAULT_SAMPLE",

@@ -23,8 +23,9 @@ encoded (``encode_chunk``: zarr's own codecs, so the same bytes) with the block'
 blocked cells; the subordinate's regions, which every block needs, are made once per worker
 process and kept for the next block of the same scenario (one scenario's kept). The client
 writes each chunk file as its task completes into a temporary folder beside DIR/dr.zarr; once
-all are in, every file is flushed, the store is read back through the bounded reader (which
-gives dr_sha256, and `cfmpa plan` its array) and only then renamed into place
+all are in, every file is flushed, the store is read back a chunk at a time through the bounded
+reader (dr_sha256, and its blocked cells counted again; `cfmpa plan` then checks and searches it
+a layer at a time, ``ZarrDr.layers``, never whole) and only then renamed into place
 (``BuiltStore.publish``). Workers write nothing, so they need no shared file system.
 
 Failures (as in the campaigns, §13): a running cluster is reached (and has a worker) before
@@ -54,8 +55,16 @@ import numpy.typing as npt
 
 from ..errors import CfmpaError, InputError, WorkersLost
 from ..spec import Grid, Scenario, Variant, make_grid
-from ._drstore import (_sync_tree, chunk_file, chunk_layers, create_store, encode_chunk,
-                       open_zarr, publish_store, temporary_store)
+from ._drstore import (
+    _sync_tree,
+    chunk_file,
+    chunk_layers,
+    create_store,
+    encode_chunk,
+    open_zarr,
+    publish_store,
+    temporary_store,
+)
 from ._engine import CONNECT_TIMEOUT_S, WORKER_TIMEOUT_S, Engine, ProgressBar, TaskLost
 
 __all__ = ["TASKS_PER_WORKER", "TASK_BYTES", "BuiltStore", "EngineOptions", "block_dr",
@@ -182,16 +191,17 @@ def blocks_of(shape: tuple[int, int, int], workers: int,
 
 @dataclass
 class BuiltStore:
-    """A finished D_R store under a temporary name beside ``target``: flushed, read back
-    (dr_sha256, and the array when asked for), not yet in place. ``publish`` renames it to
-    ``target``; ``discard`` removes it (both idempotent)."""
+    """A finished D_R store under a temporary name beside ``target``: flushed, read back a
+    chunk at a time (dr_sha256, its blocked cells counted again), not yet in place; ``layers``
+    (when asked for) reads it a layer at a time (``ZarrDr.layers``) until it is published.
+    ``publish`` renames it to ``target``; ``discard`` removes it (both idempotent)."""
 
     tmp: Path
     target: Path
     sha256: str
     blocked: int
     shape: tuple[int, int, int]
-    array: npt.NDArray[np.uint8] | None = None
+    layers: Any = None
     timings_s: dict[str, float] = field(default_factory=dict)
     published: bool = False
 
@@ -213,7 +223,7 @@ class BuiltStore:
 def build_store(s: Scenario, variant: Variant | str, target: str | os.PathLike[str], *,
                 workers: int = 0, scheduler: str | None = None,
                 connect_timeout: float = CONNECT_TIMEOUT_S,
-                worker_timeout: float = WORKER_TIMEOUT_S, keep_array: bool = False,
+                worker_timeout: float = WORKER_TIMEOUT_S, keep_layers: bool = False,
                 stream: TextIO | None = None, progress: bool | None = None,
                 layers_per_chunk: int | None = None,
                 _faults: Mapping[int, str] | None = None,
@@ -221,13 +231,13 @@ def build_store(s: Scenario, variant: Variant | str, target: str | os.PathLike[s
     """D_R of ``s`` for ``variant`` built block by block on ``Engine(workers, scheduler)`` into
     a temporary store beside ``target`` (dr.zarr), returned unpublished (the module docstring).
 
-    ``keep_array``: also the array, read back from the store (`cfmpa plan` checks and searches
-    it). The engine is started, so a running cluster reached, before the folder of ``target``
-    is made. Raises WorkersLost (the caller adds the command that runs it again), CfmpaError
-    when a block's task failed after its retries; the temporary store is removed whenever this
-    raises. ``_faults`` (chunk index of a block's first chunk -> the campaign's fault; by default
-    CFMPA_TEST_FAULTS) and ``_after_block`` (called with the blocks written so far) are for
-    tests."""
+    ``keep_layers``: also the store as ``spec.Layers`` read a chunk at a time (`cfmpa plan`
+    checks and searches it so, never holding D_R whole). The engine is started, so a running
+    cluster reached, before the folder of ``target`` is made. Raises WorkersLost (the caller
+    adds the command that runs it again), CfmpaError when a block's task failed after its
+    retries; the temporary store is removed whenever this raises. ``_faults`` (chunk index of
+    a block's first chunk -> the campaign's fault; by default CFMPA_TEST_FAULTS) and
+    ``_after_block`` (called with the blocks written so far) are for tests."""
     from ._campaign import _env_faults
 
     v = Variant(variant)
@@ -241,7 +251,7 @@ def build_store(s: Scenario, variant: Variant | str, target: str | os.PathLike[s
     tmp: Path | None = None
     try:
         with engine:
-            n_workers = workers if scheduler is None else _workers_now(engine)
+            n_workers = engine.worker_count()
             L, blocks = blocks_of(shape, n_workers, layers_per_chunk)
             tmp = temporary_store(target)
             create_store(tmp, shape, L)
@@ -250,18 +260,16 @@ def build_store(s: Scenario, variant: Variant | str, target: str | os.PathLike[s
         t_read = time.perf_counter()
         _sync_tree(tmp)
         zarr = open_zarr(tmp, shape)
-        if keep_array:
-            array, sha = zarr.read()
-        else:
-            array, sha = None, zarr.sha256()
+        sha, counted = _sha256_and_blocked(zarr)
         timings = {"engine_start": engine.timings_s["engine_start"],
                    "dr_tasks": engine.timings_s["tasks"],
                    "dr_read_back": time.perf_counter() - t_read,
                    "dr_store": time.perf_counter() - t0}
-        if array is not None and int(np.count_nonzero(array)) != blocked:
+        if counted != blocked:
             raise CfmpaError("the store read back does not hold the blocks' cells (a bug of "
                              "cfmpa, not of the input)")
-        return BuiltStore(tmp, target, sha, blocked, shape, array, timings)
+        layers = zarr.layers(blocked) if keep_layers else None
+        return BuiltStore(tmp, target, sha, blocked, shape, layers, timings)
     except BaseException:
         if tmp is not None:
             shutil.rmtree(tmp, ignore_errors=True)
@@ -306,13 +314,18 @@ def _run_blocks(engine: Engine, s: Scenario, v: Variant, tmp: Path, L: int,
     return blocked, len(blocks)
 
 
-def _workers_now(engine: Engine) -> int:
-    """The workers of a running cluster now (the blocks are cut for them; at least 1)."""
-    client = getattr(engine, "_client", None)
-    try:
-        return max(1, len(client.nthreads())) if client is not None else 1
-    except Exception:        # the scheduler did not say: blocks for one worker
-        return 1
+def _sha256_and_blocked(zarr: Any) -> tuple[str, int]:
+    """dr_sha256 of an opened store and its blocked cells, from one pass a chunk at a time."""
+    import hashlib
+
+    from ._drstore import npy_header
+
+    h = hashlib.sha256(npy_header(zarr.shape))
+    blocked = 0
+    for _, block in zarr.blocks():
+        h.update(np.ascontiguousarray(block).data)
+        blocked += int(np.count_nonzero(block))
+    return h.hexdigest(), blocked
 
 
 def _warm() -> None:

@@ -338,6 +338,8 @@ class ZarrDr:
         try:
             st = os.stat(path)
         except FileNotFoundError:
+            if not self.root.is_dir():      # the store moved or removed: not an all-free chunk
+                raise self._bad(f"chunk {c} cannot be read: the store is gone") from None
             return np.full((valid, m, n), self.fill, dtype=np.uint8)
         except OSError as exc:
             raise self._bad(f"chunk {c} cannot be read ({exc.strerror or exc})", path) from None
@@ -392,10 +394,10 @@ class ZarrDr:
             h.update(np.ascontiguousarray(block).data)
         return h.hexdigest()
 
-    def layers(self) -> Any:
-        """The array as ``spec.Layers``: layer s read when asked for, one chunk held."""
-        from ..spec import Layers
-
+    def layers(self, blocked: int | None = None) -> Any:
+        """The array as ``StoreLayers`` (a ``spec.Layers``): layer s read when asked for, one
+        chunk held. ``blocked``: the store's count of blocked cells when known (its builder
+        counted them), so that the free fraction needs no pass over the store."""
         held: list[tuple[int, npt.NDArray[np.uint8]]] = []
 
         def read(s: int) -> npt.NDArray[np.uint8]:
@@ -404,7 +406,52 @@ class ZarrDr:
                 held[:] = [(c, self.chunk(c))]
             return held[0][1][s - c * self.layers_per_chunk]
 
-        return Layers(self.shape, np.uint8, read)
+        return _store_layers(self.shape, read, blocked)
+
+
+def _store_layers(shape: tuple[int, int, int], read: Callable[[int], npt.NDArray[np.uint8]],
+                  blocked: int | None) -> Any:
+    """A ``StoreLayers`` (the class is made on first use: ``spec`` is imported lazily here)."""
+    from ..spec import Layers
+
+    global StoreLayers
+    if StoreLayers is None:
+
+        class _StoreLayers(Layers):
+            """D_R read from its store a layer at a time (``spec.Layers``), which also answers
+            what the contracts ask of D_R without holding it: ``dr[k, i, j]`` for arrays of
+            cells (gathered a layer at a time, in the order given) and ``blocked_cells()``."""
+
+            blocked: int | None = None
+
+            def __getitem__(self, key: Any) -> Any:
+                if (isinstance(key, tuple) and len(key) == 3
+                        and isinstance(key[0], np.ndarray) and key[0].ndim >= 1):
+                    return self._gather(*(np.asarray(x, dtype=np.int64) for x in key))
+                return super().__getitem__(key)
+
+            def _gather(self, k: Any, i: Any, j: Any) -> npt.NDArray[np.uint8]:
+                k, i, j = np.broadcast_arrays(k, i, j)
+                out = np.empty(k.shape, dtype=np.uint8)
+                for layer in np.unique(k):
+                    at = k == layer
+                    out[at] = self.layer(int(layer))[i[at], j[at]]
+                return out
+
+            def blocked_cells(self) -> int:
+                """Blocked cells (ones) of D_R: the count its builder gave, else one pass."""
+                if self.blocked is None:
+                    self.blocked = sum(int(np.count_nonzero(a)) for a in self)
+                return self.blocked
+
+        StoreLayers = _StoreLayers
+    out = StoreLayers(shape, np.uint8, read)
+    out.blocked = blocked
+    return out
+
+
+#: The class ``ZarrDr.layers`` returns (made on first use; see ``_store_layers``).
+StoreLayers: Any = None
 
 
 def open_zarr(path: str | Path, expect: tuple[int, int, int] | None = None,

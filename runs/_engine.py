@@ -108,7 +108,7 @@ def _probe_scheduler(address: str, timeout: float) -> None:
     import asyncio
     from concurrent.futures import ThreadPoolExecutor
 
-    from distributed.comm.core import connect     # what distributed.comm re-exports
+    from distributed.comm.core import connect  # what distributed.comm re-exports
     from distributed.security import Security
 
     args = Security().get_connection_args("client")   # as Client's (TLS from dask's config)
@@ -190,6 +190,20 @@ class Engine:
     @property
     def serial(self) -> bool:
         return self.scheduler is None and self.workers == 0
+
+    def worker_count(self) -> int:
+        """The workers the tasks run on now: 1 in this process, the local cluster's processes,
+        or a running cluster's workers as its scheduler reports them (1 when it does not say,
+        or before the engine is entered). Blocks of work are cut for this many."""
+        if self.serial:
+            return 1
+        client = self._client
+        if client is None:
+            return max(1, self.workers)
+        try:
+            return max(1, len(client.nthreads()))
+        except Exception:        # the scheduler did not say: work cut for one worker
+            return 1
 
     def options(self) -> list[str]:
         """This engine's settings as the command line's options (for a command that resumes)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import math
 import platform
 import sys
 import time
@@ -23,17 +24,44 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from ..files import dumps_json, write_atomic_with, write_bytes_atomic
 from ..errors import ContractViolation
-from ..impl import (build_dr_fast, kernel_name, load_fast_kernels, search_opt_path,
-                    search_opt_path_fast)
-from ..spec import Grid, Scenario, Variant, make_grid
-from ..spec import Certificate, certificate_json, certify, contact_links_text, require_clear
-from ..spec import SearchResult, SearchStatus
-from ..spec import executed_trajectory, tolerance_rad, trajectory_csv
-from ..spec import save_npz, theorem_scope
-from ._contracts import (Builder, Mode, Searcher, Settings, TripleRun, checked_build_dr,
-                         checked_search, contracts_json, violation_json)
+from ..files import dumps_json, write_atomic_with, write_bytes_atomic
+from ..impl import (
+    build_dr_fast,
+    kernel_name,
+    load_fast_kernels,
+    search_opt_path,
+    search_opt_path_fast,
+)
+from ..spec import (
+    Certificate,
+    Grid,
+    Scenario,
+    SearchResult,
+    SearchStatus,
+    Variant,
+    certificate_json,
+    certify,
+    contact_links_text,
+    executed_trajectory,
+    make_grid,
+    require_clear,
+    save_npz,
+    theorem_scope,
+    tolerance_rad,
+    trajectory_csv,
+)
+from ._contracts import (
+    Builder,
+    Mode,
+    Searcher,
+    Settings,
+    TripleRun,
+    checked_build_dr,
+    checked_search,
+    contracts_json,
+    violation_json,
+)
 
 if TYPE_CHECKING:     # the exact re-decision loads python-flint: only plan() needs it
     from ..spec import ExactGaps
@@ -53,6 +81,7 @@ class PlanResult:
     scenario: Scenario
     variant: Variant
     grid: Grid
+    #: D_R: the array, or on Dask the store read a layer at a time (``ZarrDr.layers``).
     dr: npt.NDArray[np.uint8]
     search: SearchResult
     certificate: Certificate | None
@@ -71,7 +100,12 @@ class PlanResult:
 
     @property
     def free_fraction(self) -> float:
-        return 1.0 - float(self.dr.mean())
+        """1 - the mean of D_R; for D_R read from its store a layer at a time (`cfmpa plan
+        --workers | --scheduler`), from its count of blocked cells: the same float, as the
+        mean of a 0/1 array is its exact count over the cells."""
+        if isinstance(self.dr, np.ndarray):
+            return 1.0 - float(self.dr.mean())
+        return 1.0 - self.dr.blocked_cells() / math.prod(self.dr.shape)
 
     @property
     def violations(self) -> list[ContractViolation]:
@@ -165,7 +199,7 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
         if stop:
             require_clear(cert, name=CERTIFICATE)
         t0 = time.perf_counter()
-        from ..spec import exact_path_gaps   # python-flint, for plan only (not `cfmpa dr`)
+        from ..spec import exact_path_gaps  # python-flint, for plan only (not `cfmpa dr`)
         exact = exact_path_gaps(s, v, g, result.path)
         t["exact_gaps"] = time.perf_counter() - t0
         if stop and not exact.ok:
@@ -242,7 +276,7 @@ def plan_json(p: PlanResult, dr_bytes: bytes | None = None,
     true minimum); ``lower_bound_m`` is the PROVED lower bound over every instant.
     """
     if dr_sha256 is None:
-        from ._drstore import dr_sha256_of     # npy_bytes(p.dr)'s hash, a layer at a time
+        from ._drstore import dr_sha256_of  # npy_bytes(p.dr)'s hash, a layer at a time
 
         dr_sha256 = (dr_sha256_of(p.dr) if dr_bytes is None
                      else hashlib.sha256(dr_bytes).hexdigest())
@@ -300,8 +334,9 @@ def write_plan(p: PlanResult, out: str | Path, *, witness: str | Path | None = N
 
     dr.npy and the witness are streamed to their files (the witness layer by layer,
     ``spec.save_npz``) and hashed by reading the files back, so neither is held as bytes.
-    ``built``: D_R is that store, built on Dask (runs/_drdask.py) and read back into ``p.dr``;
-    it is renamed into place as DIR/dr.zarr (``store`` is then zarr) instead of written."""
+    ``built``: D_R is that store, built on Dask (runs/_drdask.py), which ``p.dr`` reads a
+    layer at a time; it is renamed into place as DIR/dr.zarr (``store`` is then zarr) instead
+    of written."""
     out = Path(out)
     witness_sha = None
     if witness is not None:
@@ -341,8 +376,8 @@ def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *
     (runs/_drdask.py); the cluster losing its workers is WorkersLost naming the command that
     runs it again."""
     from ..impl import kernels
-    from ._drstore import _remove_other, default_store, write_dr
     from ..spec import load_scenario
+    from ._drstore import _remove_other, default_store, write_dr
 
     so = sys.stdout if stdout is None else stdout
     v = Variant(variant)
@@ -392,8 +427,9 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
     """`cfmpa plan`: ``plan`` with the ``kernel`` pair, not stopping at a violation, then
     ``write_plan`` into ``out`` (D_R as ``store``, by default by the grid's cells; and the
     witness file); print the summary. ``engine`` (--workers K >= 1 or --scheduler): D_R built
-    on Dask into dr.zarr as `cfmpa dr` does (runs/_drdask.py), read back, then checked and
-    searched here as the one-process build's array would be.
+    on Dask into dr.zarr as `cfmpa dr` does (runs/_drdask.py), then checked and searched here
+    from the store a layer at a time (``ZarrDr.layers``, the searches' streamed input, §9),
+    never read back whole.
 
     0 when nothing was violated; 1 when a contract failed or the certificate is not clear (a
     contact or an undecided interval is a violation in every contracts mode, off included); the
@@ -420,12 +456,12 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
 
         built: list[BuiltStore] = []
 
-        def on_dask(s: Scenario, v: Variant, g: Grid) -> npt.NDArray[np.uint8]:
-            b = build_store(s, v, Path(out) / "dr.zarr", keep_array=True, stream=so,
+        def on_dask(s: Scenario, v: Variant, g: Grid) -> Any:
+            b = build_store(s, v, Path(out) / "dr.zarr", keep_layers=True, stream=so,
                             **engine.kwargs())
             built.append(b)
-            assert b.array is not None
-            return b.array
+            assert b.layers is not None
+            return b.layers
 
         command = ["plan", str(scenario_path if name is None else name), "--variant",
                    Variant(variant).value, "--out", str(out), "--contracts", str(contracts),

@@ -143,7 +143,7 @@ def _joint_indices(names: Sequence[str], joints: Sequence[str], where: str,
 
 def _reader(path: Path, option: str, source: str) -> Any:
     """An open rosbags Reader of the bag, or InputError naming the option and the path."""
-    import sqlite3      # here, not at the top: a CSV run loads no bag machinery
+    import sqlite3  # here, not at the top: a CSV run loads no bag machinery
 
     from rosbags.rosbag2 import Reader, ReaderError
 

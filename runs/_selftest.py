@@ -27,11 +27,25 @@ from typing import Any, TextIO
 import numpy as np
 import numpy.typing as npt
 
-from ..scenarios import SELFCHECK_WORKCELLS
 from ..errors import CertificateViolation, CfmpaError, ContractViolation
 from ..impl import build_dr, search_opt_path
-from ..spec import Grid, Scenario, Variant, exact_tf, make_grid, parse_scenario
-from ..spec import J1, J2, MOVES, SearchResult, SearchStatus, Witness, is_path_paper, opt_path
+from ..scenarios import SELFCHECK_WORKCELLS
+from ..spec import (
+    J1,
+    J2,
+    MOVES,
+    Grid,
+    Scenario,
+    SearchResult,
+    SearchStatus,
+    Variant,
+    Witness,
+    exact_tf,
+    is_path_paper,
+    make_grid,
+    opt_path,
+    parse_scenario,
+)
 from ._contracts import Mode
 from ._plan import plan
 

@@ -27,16 +27,44 @@ import numpy.typing as npt
 
 from ..errors import MISSING, InputError
 from ..files import angle_text, bounded_lines, dumps_json, echo, write_bytes_atomic
+from ..spec import (
+    TRAJECTORY_COLUMNS,
+    Certificate,
+    ReferenceSpeeds,
+    Scenario,
+    StreamedReference,
+    Trajectory,
+    TrajectorySummary,
+    WholeReference,
+    between_samples_bound,
+    certify_trajectory_file,
+    certify_trajectory_rows,
+    closest_links,
+    contact_links_text,
+    contact_parts,
+    csv_column_order,
+    load_scenario,
+    load_trajectory,
+    log_end_bound,
+    row_blocks,
+    tolerance_rad,
+    trajectory_distances,
+    trajectory_file_blocks,
+    tube_lipschitz,
+)
 from ._limits import MAX_LOG_SAMPLES
-from ._rosbag import (BagOptions, BagReading, bag_row_name, bag_rows, bag_sha256,
-                      bag_trajectory_rows, is_bag, load_bag_trajectory, log_output_kind,
-                      write_bag)
-from ..spec import (TRAJECTORY_COLUMNS, Certificate, ReferenceSpeeds, Scenario,
-                    StreamedReference, Trajectory, TrajectorySummary, WholeReference,
-                    between_samples_bound, certify_trajectory_file, certify_trajectory_rows,
-                    closest_links, contact_links_text, contact_parts, csv_column_order,
-                    load_scenario, load_trajectory, log_end_bound, row_blocks, tolerance_rad,
-                    trajectory_distances, trajectory_file_blocks, tube_lipschitz)
+from ._rosbag import (
+    BagOptions,
+    BagReading,
+    bag_row_name,
+    bag_rows,
+    bag_sha256,
+    bag_trajectory_rows,
+    is_bag,
+    load_bag_trajectory,
+    log_output_kind,
+    write_bag,
+)
 
 __all__ = ["AFTER_LOG", "BEFORE_LOG", "BETWEEN_SAMPLES", "BLOCK_ROWS", "Excursion",
            "LISTED_UNOBSERVED", "MISSING_MESSAGES",

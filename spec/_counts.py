@@ -87,7 +87,7 @@ def written(value: int | float | str) -> float:
     """``value`` as a float that keeps its decimal (tomllib's ``parse_float``, and the reader's
     numbers): a text or an int exactly as written; a plain float, or a text that is not a finite
     decimal (inf, nan: refused later by name), stays a plain float."""
-    if isinstance(value, Written) or isinstance(value, bool):
+    if isinstance(value, (Written, bool)):
         return value
     if isinstance(value, (int, str)):
         try:

@@ -21,9 +21,16 @@ from typing import Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from ._counts import (READINGS, joint_grid, joint_points, spacing_readings, time_readings,
-                      time_steps, travel_time)
 from ._arith import cases, if_then, is_term, max_of, min_of
+from ._counts import (
+    READINGS,
+    joint_grid,
+    joint_points,
+    spacing_readings,
+    time_readings,
+    time_steps,
+    travel_time,
+)
 from ._scenario import Scenario
 
 __all__ = [

@@ -29,8 +29,16 @@ from typing import Any
 
 from ..errors import MISSING, InputError
 from ..files import LIMITS, echo, read_bounded
-from ._counts import (MAX_SPACING, GridRefused, joint_grid, min_points, spacing_conditions,
-                      time_steps, Written, written)
+from ._counts import (
+    MAX_SPACING,
+    GridRefused,
+    Written,
+    joint_grid,
+    min_points,
+    spacing_conditions,
+    time_steps,
+    written,
+)
 
 __all__ = [
     "Arm",

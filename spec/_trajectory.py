@@ -47,9 +47,17 @@ import numpy.typing as npt
 from ..errors import MISSING, InputError
 from ..files import LIMITS, bounded_lines, echo, env_positive_int, read_bounded
 from ._arith import max_of
-from ._certificate import (DEFAULT_BOUND_RATIO, DEFAULT_MAX_DEPTH, DEFAULT_MAX_INTERVALS,
-                           Certificate, ContactDetail, Prover, link_rects, link_speeds,
-                           part_distances)
+from ._certificate import (
+    DEFAULT_BOUND_RATIO,
+    DEFAULT_MAX_DEPTH,
+    DEFAULT_MAX_INTERVALS,
+    Certificate,
+    ContactDetail,
+    Prover,
+    link_rects,
+    link_speeds,
+    part_distances,
+)
 from ._grid import EPS, Grid, exact_tf, left_angles
 from ._kinematics import parts, reach
 from ._polygon import polygon_distances

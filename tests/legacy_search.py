@@ -18,8 +18,16 @@ import numpy as np
 import numpy.typing as npt
 
 from cfmpa.errors import InputError
-from cfmpa.spec import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                           Cell, SearchResult, Witness, check_search_inputs)
+from cfmpa.spec import (
+    MOVES,
+    REASON_GOAL_BLOCKED,
+    REASON_START_BLOCKED,
+    REASON_UNREACHABLE,
+    Cell,
+    SearchResult,
+    Witness,
+    check_search_inputs,
+)
 
 __all__ = ["WitnessLabels", "hold_waits", "search_opt_path"]
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cfmpa.spec._paths import MOVES, J1, J2, is_path, layer_of_step
+from cfmpa.spec._paths import J1, J2, MOVES, is_path, layer_of_step
 
 Cell = tuple[int, int]
 

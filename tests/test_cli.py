@@ -458,8 +458,8 @@ def test_simulate_within_budget_still_writes(tmp_path, rest_traj):
     # The budget refuses what is over it, not what is at it: a million samples exactly pass
     # the option's check (the run's own count is the same number).
     from cfmpa.runs import MAX_LOG_SAMPLES, simulate_log
-    from cfmpa.spec import load_scenario, load_trajectory
     from cfmpa.scenarios import resolve
+    from cfmpa.spec import load_scenario, load_trajectory
 
     traj = load_trajectory(rest_traj, load_scenario(resolve("default")))
     assert len(simulate_log(traj, samples=MAX_LOG_SAMPLES)[0]) == MAX_LOG_SAMPLES
@@ -524,9 +524,9 @@ def test_every_numeric_option_is_budgeted():
         checked = {(dest, option) for dest, option, check in p.get_default("_checks") or ()
                    if isinstance(check, Budget)}
         for a in p._actions:
-            if a.type in (int, float) or getattr(a.type, "__name__", "") == "positive":
-                if (a.dest, a.option_strings[0]) not in checked:
-                    unbudgeted.append(f"{name} {a.option_strings[0]}")
+            if ((a.type in (int, float) or getattr(a.type, "__name__", "") == "positive")
+                    and (a.dest, a.option_strings[0]) not in checked):
+                unbudgeted.append(f"{name} {a.option_strings[0]}")
     assert unbudgeted == []
 
 

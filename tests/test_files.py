@@ -30,7 +30,7 @@ def test_the_pinned_lock_is_written_as_it_reads():
 
 
 def test_nan_is_refused_unless_allowed_and_the_write_is_whole(tmp_path):
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="not JSON compliant: nan"):
         dumps_json({"x": math.nan})
     assert dumps_json({"x": math.nan}, allow_nan=True) == '{\n  "x": NaN\n}\n'
     path = write_json(tmp_path / "d" / "x.json", DOC)

@@ -6,9 +6,8 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from crosshair import realize
-
 from cfmpa.impl import SNAP
+from crosshair import realize
 
 
 def _lattice_range_floor_hi(lo: float, hi: float, anchor: float, g: float) -> tuple[int, int]:

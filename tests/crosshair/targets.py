@@ -11,13 +11,12 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from crosshair import realize
-
 from cfmpa.impl import SNAP, lattice_range, link_reach
 from cfmpa.impl._search import J2_MASK, SHIFT
 from cfmpa.spec import Scenario, Variant, left_box
-from cfmpa.spec._scenario import LeftArm
 from cfmpa.spec._counts import ceil_fraction
+from cfmpa.spec._scenario import LeftArm
+from crosshair import realize
 
 
 def lattice_range_covers_the_box(lo: float, hi: float, anchor: float, g: float) -> None:

@@ -7,8 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cfmpa.impl import _search
-from cfmpa.impl import search_opt_path, search_opt_path_fast
+from cfmpa.impl import _search, search_opt_path, search_opt_path_fast
 from cfmpa.impl._search import BackPointers
 
 

@@ -11,9 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dr_strategies import random_workcells
 from cfmpa.impl import build_dr, build_dr_fast, build_dr_loops, builtdr_loop_nest, right_regions
 from cfmpa.spec import Variant, make_grid, parse_scenario
+from dr_strategies import random_workcells
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 

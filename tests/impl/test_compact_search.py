@@ -10,11 +10,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import legacy_search
 from cfmpa.impl._fast_search import search_opt_path_fast
 from cfmpa.impl._search import BackPointers, search_opt_path
 from dr_strategies import random_dr
-
-import legacy_search
 
 
 def random_drs() -> st.SearchStrategy:

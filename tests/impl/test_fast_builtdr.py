@@ -14,11 +14,17 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import factory
-from dr_strategies import random_workcells
-from cfmpa.impl import (_fast_builtdr, _progress, build_dr, kernel_threads, right_regions,
-                        set_kernel_threads)
+from cfmpa.impl import (
+    _fast_builtdr,
+    _progress,
+    build_dr,
+    kernel_threads,
+    right_regions,
+    set_kernel_threads,
+)
 from cfmpa.impl._fast_builtdr import build_dr_fast
 from cfmpa.spec import Variant, load_scenario, make_grid, parse_scenario
+from dr_strategies import random_workcells
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 SMALL = [p for p in SCENARIOS if p.stem != "default"]

@@ -12,13 +12,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dr_strategies import random_workcells
 from cfmpa.impl import build_dr, convex_hull, left_regions, right_regions, swept_region
 from cfmpa.impl._collide import pad_polygons
 from cfmpa.impl._fast_builtdr import build_dr_fast
 from cfmpa.impl._fast_regions import _hulls, convex_hulls, left_regions_fast, right_regions_fast
 from cfmpa.impl._regions import HULL_SCALE_ABOVE
 from cfmpa.spec import Variant, load_scenario, make_grid
+from dr_strategies import random_workcells
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 

@@ -18,8 +18,13 @@ from cfmpa.impl._fast_builtdr import build_dr_fast
 from cfmpa.impl._fast_search import search_opt_path_fast
 from cfmpa.impl._search import search_opt_path
 from cfmpa.spec import Variant, load_scenario
-from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                               SearchStatus, is_path)
+from cfmpa.spec._paths import (
+    REASON_GOAL_BLOCKED,
+    REASON_START_BLOCKED,
+    REASON_UNREACHABLE,
+    SearchStatus,
+    is_path,
+)
 from dr_strategies import random_dr
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))

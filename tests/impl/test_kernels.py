@@ -16,8 +16,15 @@ import numpy as np
 import pytest
 
 import factory
-from cfmpa.impl import (KERNELS, build_dr, build_dr_fast, kernel_name, kernels, search_opt_path,
-                        search_opt_path_fast)
+from cfmpa.impl import (
+    KERNELS,
+    build_dr,
+    build_dr_fast,
+    kernel_name,
+    kernels,
+    search_opt_path,
+    search_opt_path_fast,
+)
 from cfmpa.impl._kernels import REGISTRY, Kernel, registry
 from cfmpa.spec import Variant, make_grid
 

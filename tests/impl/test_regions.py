@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import factory
-from cfmpa.impl import link_rectangles, naive_hull, swept_region
 from cfmpa.impl import containment_slack as _slack
+from cfmpa.impl import link_rectangles, naive_hull, swept_region
 
 TOL = 1e-12
 ARM = factory.scenario().left

@@ -11,9 +11,18 @@ from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
 from cfmpa.impl._search import _check_size, search_opt_path
-from cfmpa.spec._paths import (MOVES, REASON_GOAL_BLOCKED, REASON_START_BLOCKED,
-                               REASON_UNREACHABLE, J1, J2, SearchResult, SearchStatus, is_path,
-                               opt_path)
+from cfmpa.spec._paths import (
+    J1,
+    J2,
+    MOVES,
+    REASON_GOAL_BLOCKED,
+    REASON_START_BLOCKED,
+    REASON_UNREACHABLE,
+    SearchResult,
+    SearchStatus,
+    is_path,
+    opt_path,
+)
 from cfmpa.spec._paths_z3 import length_bound, z3_opt_path
 from dr_strategies import random_dr
 from path_enumeration import optimal_lists

@@ -15,14 +15,22 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dr_strategies import random_workcells
 from cfmpa.impl import _kinematics as impl_kinematics
 from cfmpa.impl import build_dr, right_regions
 from cfmpa.impl._fast_builtdr import build_dr_fast
-from cfmpa.spec import (Variant, _kinematics, left_box, load_scenario, make_grid, pairs_to_test,
-                        parse_scenario, right_box)
-from cfmpa.spec._polygon import polygon_distances
+from cfmpa.spec import (
+    Variant,
+    _kinematics,
+    left_box,
+    load_scenario,
+    make_grid,
+    pairs_to_test,
+    parse_scenario,
+    right_box,
+)
 from cfmpa.spec._certificate import link_rects
+from cfmpa.spec._polygon import polygon_distances
+from dr_strategies import random_workcells
 
 ROOT = Path(__file__).resolve().parents[2]
 BUNDLED = ROOT / "tests" / "data" / "tools-heights.toml"

@@ -71,7 +71,7 @@ def test_a_gap_slice_without_its_last_piece_covers_the_gap(monkeypatch):
 
 
 def test_a_start_test_with_and_accepts_a_raised_start_label(monkeypatch):
-    import cfmpa.spec._witness as SW   # the checker reads its module's function
+    import cfmpa.spec._witness as SW  # the checker reads its module's function
 
     monkeypatch.setattr(SW, "start_label_breaks", lambda j1, j2: (j1 != 0) & (j2 != 0))
     r = C.run_control(_control("Control.witness.raised_start"))

@@ -98,7 +98,7 @@ def test_nonlinear_flags_products_and_divisions_of_unknowns():
 
 
 def test_results_record_the_flag_per_vc(tmp_path):
-    from cfmpa.proofs import Method, Obligation, Verdict, VC, Z3Query, run_obligations
+    from cfmpa.proofs import VC, Method, Obligation, Verdict, Z3Query, run_obligations
 
     x, y = z3.Reals("x y")
     ob = Obligation("T.nonlinear", "t", "test", "x y > 0 from x, y > 0", Method.Z3,

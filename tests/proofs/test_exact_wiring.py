@@ -10,8 +10,6 @@ import pytest
 import z3
 
 import cfmpa.spec
-from mutant_module import mutated_module
-from z3answer import answer
 from cfmpa.proofs import _controls as C
 from cfmpa.proofs import _controls_wiring as W
 from cfmpa.proofs._obl_constants import exact_vcs
@@ -21,6 +19,8 @@ from cfmpa.proofs._obl_wiring import exact_cells, exact_coverage_failures, is_pa
 from cfmpa.scenarios import BUNDLED_DIR
 from cfmpa.spec import Variant, load_scenario
 from cfmpa.spec._exact import ExactCell, ExactGaps
+from mutant_module import mutated_module
+from z3answer import answer
 
 # --- coverage --------------------------------------------------------------------------------
 

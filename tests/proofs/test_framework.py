@@ -8,8 +8,16 @@ import time
 import pytest
 import z3
 
-from cfmpa.proofs import (VC, CheckOutcome, CheckQuery, Method, Obligation, Verdict, Z3Query,
-                          discharge)
+from cfmpa.proofs import (
+    VC,
+    CheckOutcome,
+    CheckQuery,
+    Method,
+    Obligation,
+    Verdict,
+    Z3Query,
+    discharge,
+)
 
 
 def _ob(build, expected=Verdict.PROVED, method=Method.Z3, timeout_ms=5_000) -> Obligation:

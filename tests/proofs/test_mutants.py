@@ -42,6 +42,15 @@ def mutant(monkeypatch: pytest.MonkeyPatch, modname: str, old: str, new: str, *,
     return mod
 
 
+def use_collectors(monkeypatch: pytest.MonkeyPatch, mod: types.ModuleType, *names: str) -> None:
+    """The run collects the mutant module's collectors ``names`` in place of the originals
+    (runner.COLLECTORS holds the functions, so each is swapped there by its name)."""
+    swapped = tuple(getattr(mod, c.__name__) if c.__name__ in names else c
+                    for c in runner.COLLECTORS)
+    assert sum(a is not b for a, b in zip(swapped, runner.COLLECTORS)) == len(names)
+    monkeypatch.setattr(runner, "COLLECTORS", swapped)
+
+
 def _prove(only: list[str], out: Path) -> tuple[int, dict[str, dict]]:
     rc = run_prove(out_dir=out, only=only, stream=io.StringIO())
     doc = json.loads((out / "results.json").read_text())
@@ -53,7 +62,7 @@ def _prove(only: list[str], out: Path) -> tuple[int, dict[str, dict]]:
 def test_a_smaller_margin_constant_fails_the_margin_lemma(monkeypatch, tmp_path):
     # r g^2/8 -> r g^2/16 in Lemma.sweep_margin: the lemma's margins R g^2/16.
     m = mutant(monkeypatch, "_obl_margin", "/ 8", "/ 16", within="_sweep_margin")
-    monkeypatch.setattr(runner, "margin_obligations", m.margin_obligations)
+    use_collectors(monkeypatch, m, "margin_obligations")
     rc, obs = _prove(["Lemma.sweep_margin"], tmp_path)
     assert rc == 1
     assert obs["Lemma.sweep_margin"]["verdict"] == "failed"
@@ -63,7 +72,7 @@ def test_a_smaller_margin_constant_fails_the_margin_lemma(monkeypatch, tmp_path)
 def test_cfmpa_prove_exits_1_on_the_margin_mutant(monkeypatch, tmp_path, capsys):
     from cfmpa.cli import main
     m = mutant(monkeypatch, "_obl_margin", "/ 8", "/ 16", within="_sweep_margin")
-    monkeypatch.setattr(runner, "margin_obligations", m.margin_obligations)
+    use_collectors(monkeypatch, m, "margin_obligations")
     assert main(["prove", "--out", str(tmp_path), "--only", "Lemma.sweep_margin"]) == 1
     assert "counterexample to compose" in capsys.readouterr().out
 
@@ -80,8 +89,7 @@ def test_assuming_found_in_the_search_wrapper_fails(monkeypatch, tmp_path):
     # On a copy of the source: "the search always finds a path".
     m = mutant(monkeypatch, "_obl_paths", "Assume(contract)", "Assume(z3.And(contract, found))",
                within="search_top_level")
-    monkeypatch.setattr(runner, "theorem_obligations", m.theorem_obligations)
-    monkeypatch.setattr(runner, "prop8_obligations", m.prop8_obligations)
+    use_collectors(monkeypatch, m, "theorem_obligations", "prop8_obligations")
     only = ["Thm2.searchoptpath", "Thm4.searchoptpath", "Prop8.prestrength_thm4"]
     rc, obs = _prove(only, tmp_path)
     assert rc == 1

@@ -11,10 +11,10 @@ from __future__ import annotations
 import pytest
 import z3
 
-from z3answer import answer
 from cfmpa.proofs import Method, Verdict, collect_obligations, discharge
 from cfmpa.proofs._obl_builtdr import _query as builtdr_query
 from cfmpa.proofs._obligation import VC, Obligation
+from z3answer import answer
 
 PROVED_Z3 = [o for o in collect_obligations(scenarios_dir="/nonexistent")
              if o.method is Method.Z3 and o.expected is Verdict.PROVED]

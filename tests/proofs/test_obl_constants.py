@@ -10,14 +10,19 @@ import pytest
 import z3
 
 import cfmpa.spec
-from z3answer import answer
-from mutant_module import mutated_module, source
 from cfmpa.proofs import Verdict, discharge
-from cfmpa.proofs._obl_constants import (ExtractionError, constants_obligations, on_terms,
-                                         sqrt_free, tolerance_parts)
+from cfmpa.proofs._obl_constants import (
+    ExtractionError,
+    constants_obligations,
+    on_terms,
+    sqrt_free,
+    tolerance_parts,
+)
+from cfmpa.proofs._obligation import VC, Obligation, Z3Query
 from cfmpa.proofs._summaries import SUMMARIES as ALL_SUMMARIES
 from cfmpa.runs import CODE_MUTANTS
-from cfmpa.proofs._obligation import VC, Obligation, Z3Query
+from mutant_module import mutated_module, source
+from z3answer import answer
 
 IDS = ["Certificate.lipschitz", "Tolerance.tube_factor", "Exact.gap_formula"]
 SUMMARIES = {i: ALL_SUMMARIES[i] for i in IDS}

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import z3
 
-from z3answer import answer
 from cfmpa.proofs import Verdict, discharge
 from cfmpa.proofs._obl_monitor import KEY_PREMISE, between_samples_vc, monitor_obligations
 from cfmpa.proofs._obligation import VC
 from cfmpa.spec import between_samples_bound, max_of
+from z3answer import answer
 
 
 def _answer(vc: VC) -> z3.CheckSatResult:

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import z3
 
-from z3answer import answer
 from cfmpa.proofs import Verdict, collect_obligations, discharge
 from cfmpa.proofs._obl_tolerance import KEY_PREMISE, tolerance_obligations, tube_vc
 from cfmpa.proofs._obligation import VC
 from cfmpa.proofs._runner import EXPECTED_VERDICTS
+from z3answer import answer
 
 
 def _answer(vc: VC) -> z3.CheckSatResult:

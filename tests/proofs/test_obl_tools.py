@@ -14,14 +14,14 @@ import pytest
 import z3
 
 import cfmpa.spec
-from z3answer import answer
-from mutant_module import mutated_module
 from cfmpa.impl import link_reach, link_rectangles, sweep_margin
 from cfmpa.proofs import FIXED_IDS, Verdict, collect_obligations
 from cfmpa.proofs import _obl_tools as T
 from cfmpa.proofs._obl_constants import ExtractionError
 from cfmpa.proofs._obligation import VC
 from cfmpa.runs import CODE_MUTANTS
+from mutant_module import mutated_module
+from z3answer import answer
 
 IDS = ["Safety.height_rule", "Safety.tool_region"]
 ALL_IDS = IDS + ["Certificate.height_gap"]
@@ -273,6 +273,7 @@ def test_a_vertex_left_out_of_the_tool_fails_the_statement(tool_kit: T.ToolKit, 
 def test_tf_and_n_are_the_codes_on_floats():
     # counts_on_terms runs spec.exact_tf / exact_n's own code; on numbers it gives their values.
     from fractions import Fraction
+
     from cfmpa.proofs import _obl_safety as S
     from cfmpa.spec import exact_n, exact_tf
     s = cfmpa.spec.load_scenario(Path(cfmpa.spec.__file__).parents[1] / "scenarios"
@@ -305,6 +306,7 @@ def _principal_args(S):
 def test_the_ceiling_on_terms_is_the_codes_on_fractions():
     # counts_on_terms runs exact_n with spec.ceil_of for the code's exact ceiling.
     from fractions import Fraction
+
     from cfmpa.spec import ceil_of
     from cfmpa.spec._counts import ceil_fraction
     for x in (Fraction(7, 2), Fraction(-7, 2), Fraction(3), Fraction(1, 10**9), Fraction(-5, 3)):
@@ -314,6 +316,7 @@ def test_the_ceiling_on_terms_is_the_codes_on_fractions():
 
 def test_the_proofs_read_the_loaders_spacing_bound():
     from fractions import Fraction
+
     from cfmpa.proofs import _obl_safety as S
     from cfmpa.spec import MAX_SPACING
     assert S.G_MAX.as_fraction() == MAX_SPACING == Fraction(157, 50)

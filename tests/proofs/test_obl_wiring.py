@@ -11,12 +11,19 @@ import numpy as np
 import pytest
 import z3
 
-from z3answer import answer
 from cfmpa import spec
 from cfmpa.proofs import Verdict, collect_obligations
-from cfmpa.proofs._obl_wiring import (KEY_GAP, KEY_ROW, KEY_SEGMENT, grid_motion_vcs,
-                                      pieces_failures, reference_speed_vcs,
-                                      trajectory_motion_vcs, wiring_obligations)
+from cfmpa.proofs._obl_wiring import (
+    KEY_GAP,
+    KEY_ROW,
+    KEY_SEGMENT,
+    grid_motion_vcs,
+    pieces_failures,
+    reference_speed_vcs,
+    trajectory_motion_vcs,
+    wiring_obligations,
+)
+from z3answer import answer
 
 
 def _holds(vc) -> z3.CheckSatResult:

@@ -10,8 +10,17 @@ from pathlib import Path
 
 import z3
 
-from cfmpa.proofs import (VC, Method, Obligation, Verdict, Z3Query, collect_obligations,
-                          expected_ids, render_report, run_obligations)
+from cfmpa.proofs import (
+    VC,
+    Method,
+    Obligation,
+    Verdict,
+    Z3Query,
+    collect_obligations,
+    expected_ids,
+    render_report,
+    run_obligations,
+)
 from cfmpa.proofs._pins import LOCK, check_pins, cvc5_skips, load_lock, pin_key
 
 REPO = Path(__file__).resolve().parents[2]

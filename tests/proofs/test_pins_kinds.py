@@ -8,9 +8,19 @@ from pathlib import Path
 
 import z3
 
-from cfmpa.proofs import (DEFINITIONAL, VC, Method, Obligation, Verdict, Z3Query, expected_ids,
-                          kind_of, render_report, run_obligations)
-from cfmpa.proofs import _runner
+from cfmpa.proofs import (
+    DEFINITIONAL,
+    VC,
+    Method,
+    Obligation,
+    Verdict,
+    Z3Query,
+    _runner,
+    expected_ids,
+    kind_of,
+    render_report,
+    run_obligations,
+)
 from cfmpa.proofs._pins import check_kinds, load_lock, pin_key
 
 

@@ -123,6 +123,7 @@ def test_the_rectangle_is_impls_read_on_terms(x):
 def test_a_rectangle_not_extended_past_its_joint_fails(x, monkeypatch):
     # Seeded fault, planted in a copy of impl's source: the rectangle starts at its joint.
     import sys
+
     from mutant_module import mutated_module
     mod = mutated_module("rect_short", "impl/_kinematics.py",
                          (("    back = start - r * along\n", "    back = start\n"),),
@@ -223,7 +224,7 @@ def test_the_hull_definition_generates_impl_s_swept_points(arm, x, lo1, w1, lo2,
     rb, re = link_reach(arm, x)
     env = {**_env(arm, "R"), "R.Rb1": rb if x == 0 else 0.0, "R.Re2": re}
     # Read on symbols (impl_margin reads sweep_margin on symbolic spacings), then evaluated.
-    names = "lo1 hi1 lo2 hi2 A1 A2 g1 g2".split()
+    names = ["lo1", "hi1", "lo2", "hi2", "A1", "A2", "g1", "g2"]
     sym = z3.Reals(" ".join(f"m!{n}" for n in names))
     term = model.margin(x, ((sym[0], sym[1]), (sym[2], sym[3])), (sym[4], sym[5]),
                         (sym[6], sym[7]))

@@ -13,9 +13,18 @@ from pathlib import Path
 import pytest
 import z3
 
-from cfmpa.proofs import (ASSUMPTIONS, FIXED_IDS, Verdict, collect_obligations, expected_ids,
-                          render_report, run_obligations, run_prove, scenarios_note,
-                          selected)
+from cfmpa.proofs import (
+    ASSUMPTIONS,
+    FIXED_IDS,
+    Verdict,
+    collect_obligations,
+    expected_ids,
+    render_report,
+    run_obligations,
+    run_prove,
+    scenarios_note,
+    selected,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 CHEAP = ["Def1", "Lemma1", "Prop2", "Margin.naive_hull"]
@@ -147,8 +156,14 @@ def test_full_run_discharges_everything_as_expected(tmp_path: Path):
 
 def test_verdicts_are_checked_against_the_pinned_map(tmp_path: Path):
     # An obligation claiming its own (wrong) expectation passes Obligation.expected, not the pin.
-    from cfmpa.proofs import (EXPECTED_VERDICTS, CheckOutcome, CheckQuery, Method, Obligation,
-                              pinned_verdict)
+    from cfmpa.proofs import (
+        EXPECTED_VERDICTS,
+        CheckOutcome,
+        CheckQuery,
+        Method,
+        Obligation,
+        pinned_verdict,
+    )
     assert EXPECTED_VERDICTS["Margin.cos_bound"] is Verdict.PROVED
     assert pinned_verdict("Scenario.x.time_grid") is Verdict.PROVED
     assert pinned_verdict("Ghost.id") is None

@@ -10,13 +10,13 @@ from pathlib import Path
 
 import pytest
 import z3
-from z3answer import answer, as_float, exact_real
+
 from cfmpa.impl import SNAP, link_reach, sweep_margin
 from cfmpa.proofs import FIXED_IDS, collect_obligations
 from cfmpa.proofs import _obl_safety as S
 from cfmpa.proofs._obligation import VC
-from cfmpa.spec import (exact_n, exact_tf, left_angles, left_box, load_scenario, make_grid,
-                        right_box)
+from cfmpa.spec import exact_n, exact_tf, left_angles, left_box, load_scenario, make_grid, right_box
+from z3answer import answer, as_float, exact_real
 
 REPO = Path(__file__).resolve().parents[2]
 IDS = [f"Safety.{v}.principal_in_layer_box" for v in S.VARIANTS] + [
@@ -286,7 +286,7 @@ def test_the_margin_read_from_impl_is_its_formula():
             s.add(read != want)
             assert s.check() == z3.unsat, (link, flags)
     # A margin function the reading cannot follow is refused, not read wrong.
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="the margin read"):
         S.impl_margin_term(1, (g1, g2), (rb, re), (True, True),
                            lambda arm, link, g, moving: sweep_margin(arm, link, (0.5, 0.5), moving))
 

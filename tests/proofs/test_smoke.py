@@ -9,11 +9,17 @@ from pathlib import Path
 import pytest
 import z3
 
-from cfmpa.proofs import (Method, Obligation, Verdict, Z3Query, collect_obligations,
-                          discharge, run_prove)
+from cfmpa.proofs import (
+    Method,
+    Obligation,
+    Verdict,
+    Z3Query,
+    collect_obligations,
+    discharge,
+    run_prove,
+)
 from cfmpa.proofs._obligation import _smoke
-from cfmpa.proofs._while import (Assign, Assume, For, If, Seq, smoke_tests,
-                                 verification_conditions)
+from cfmpa.proofs._while import Assign, Assume, For, If, Seq, smoke_tests, verification_conditions
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -9,8 +9,7 @@ from fractions import Fraction
 import pytest
 import z3
 
-from cfmpa.proofs import (VC, Method, Obligation, Verdict, Z3Query, collect_obligations,
-                          discharge)
+from cfmpa.proofs import VC, Method, Obligation, Verdict, Z3Query, collect_obligations, discharge
 from cfmpa.proofs._cvc5 import Cvc5Answer, Cvc5Worker, cvc5_version
 from cfmpa.proofs._obligation import discharge_pending
 from cfmpa.proofs._smtlib import NotStandard, smtlib_query

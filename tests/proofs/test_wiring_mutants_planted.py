@@ -10,14 +10,18 @@ import pytest
 import z3
 
 import cfmpa.spec
-from mutant_module import mutated_module, source
-from z3answer import answer
 from cfmpa.proofs import _controls as C
 from cfmpa.proofs import _controls_wiring as W
 from cfmpa.proofs._obl_exact_polygon import polygon_gap_vcs
-from cfmpa.proofs._obl_wiring import (exact_coverage_failures, grid_motion_vcs,
-                                      reference_speed_vcs, trajectory_motion_vcs)
+from cfmpa.proofs._obl_wiring import (
+    exact_coverage_failures,
+    grid_motion_vcs,
+    reference_speed_vcs,
+    trajectory_motion_vcs,
+)
 from cfmpa.runs import CODE_MUTANTS
+from mutant_module import mutated_module, source
+from z3answer import answer
 
 #: What catches each wiring mutant (a VC refuted, a control not as expected).
 CAUGHT_BY = {
@@ -45,10 +49,9 @@ def _refuted(vcs, names=None) -> set[str]:
     """The VCs (of ``names``, default all) that Z3 refutes (sat) within 10 s each."""
     out = set()
     for vc in vcs:
-        if names is None or any(n in vc.name for n in names):
-            if answer([h for _, h in vc.hypotheses] + [z3.Not(vc.goal)],
-                      timeout_ms=10_000) == z3.sat:
-                out.add(vc.name)
+        if (names is None or any(n in vc.name for n in names)) and answer(
+                [h for _, h in vc.hypotheses] + [z3.Not(vc.goal)], timeout_ms=10_000) == z3.sat:
+            out.add(vc.name)
     return out
 
 
@@ -86,7 +89,7 @@ def test_monitor_gap_slice_short(monkeypatch):
 
 
 def test_witness_start_or_and(monkeypatch):
-    import cfmpa.spec._witness as SW   # check_witness reads its module's start test
+    import cfmpa.spec._witness as SW  # check_witness reads its module's start test
 
     mod = _plant(monkeypatch, "witness_start_or_and")
     monkeypatch.setattr(SW, "start_label_breaks", mod.start_label_breaks)
@@ -129,7 +132,9 @@ def test_theorem_made_definitional(monkeypatch):
     mod = _plant(monkeypatch, "theorem_made_definitional")
     assert all(C.run_control(_control(i)).ok
                for i in ("Control.accept.kinds", "Control.kinds.theorem_moved"))
-    monkeypatch.setattr(R, "kind_of", mod.kind_of)
+    # The kinds are a view of the declarations: the mutated module's declare it definitional.
+    monkeypatch.setattr(R, "DEFINITIONAL", {**R.DEFINITIONAL,
+                                            **R.declared((mod.safety_obligations,)).definitional})
     r = C.run_control(_control("Control.accept.kinds"))
     assert r.outcome == "rejected" and not r.ok and "Safety.separation" in r.detail, r.detail
     r = C.run_control(_control("Control.kinds.theorem_moved"))

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 import z3
 
-from z3answer import answer
-from cfmpa.proofs import _obl_witness as OW
 from cfmpa.proofs import _controls as C
+from cfmpa.proofs import _obl_witness as OW
 from cfmpa.spec import MOVES, Witness, check_witness, start_label_breaks
+from z3answer import answer
 
 
 def _base():

@@ -4,8 +4,8 @@ rest on (``complete_proofs``), so that a row can be "safe" without a whole prove
 from __future__ import annotations
 
 import copy
-from pathlib import Path
 from collections.abc import Callable, Iterable
+from pathlib import Path
 from typing import Any
 
 import pytest

@@ -32,23 +32,32 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 import jsonschema
-import factory
 import pytest
 from markupsafe import escape
 
-from cfmpa.files import dumps_json
+import factory
 from cfmpa.errors import InputError
+from cfmpa.files import dumps_json
+from cfmpa.gitstate import MAX_PATHS, git_state
 from cfmpa.proofs import expected_ids, obligation_summary, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import build_audit, run_audit
-from cfmpa.report._audit import (SECTIONS, AuditResult, _controls_item, _proof_sections, _verdict,
-                                 contract_rows, render_html, row_requirements, workcell_summary,
-                                 write_report)
-from cfmpa.report._sections import Section, compute_order, verdict_of
+from cfmpa.report._audit import (
+    SECTIONS,
+    AuditResult,
+    _controls_item,
+    _proof_sections,
+    _verdict,
+    contract_rows,
+    render_html,
+    row_requirements,
+    workcell_summary,
+    write_report,
+)
 from cfmpa.report._figures import workcell_instants
 from cfmpa.report._obligations import BADGES, audited_ids, load_proofs
-from cfmpa.gitstate import MAX_PATHS, git_state
 from cfmpa.report._provenance import REPORTED_DISTRIBUTIONS, VERSION_GROUPS
+from cfmpa.report._sections import Section, compute_order, verdict_of
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = Path(__file__).parent / "golden"
@@ -132,6 +141,7 @@ def test_a_six_panel_workcell_figure_keeps_its_legend_off_the_labels(tiny_file, 
 
 def test_the_layout_check_sees_a_legend_over_an_axis_label():
     import matplotlib.pyplot as plt
+
     from cfmpa.report._figures import legend_overlaps
 
     fig, ax = plt.subplots(figsize=(4, 3))

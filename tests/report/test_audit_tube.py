@@ -25,9 +25,18 @@ from cfmpa.files import dumps_json
 from cfmpa.proofs import expected_ids, run_prove
 from cfmpa.proofs._runner import selected
 from cfmpa.report import _audit, build_audit
-from cfmpa.report._audit import (MONITOR_EXCURSION, MONITOR_SIMULATION, AuditResult, _monitor,
-                                 _Plans, _verdict, monitor_problems, render_html, tube_problems,
-                                 write_report)
+from cfmpa.report._audit import (
+    MONITOR_EXCURSION,
+    MONITOR_SIMULATION,
+    AuditResult,
+    _monitor,
+    _Plans,
+    _verdict,
+    monitor_problems,
+    render_html,
+    tube_problems,
+    write_report,
+)
 from cfmpa.spec import load_scenario, tube_lipschitz
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -20,8 +20,13 @@ from cfmpa import cli
 from cfmpa.errors import InputError
 from cfmpa.proofs import FIXED_IDS, CheckOutcome, run_prove
 from cfmpa.report import build_audit, run_audit
-from cfmpa.report._audit import (MONITOR_SIMULATION, MONITOR_MAX_SAMPLES, _proofs_of_this_tree,
-                                 _verdict, monitor_settings)
+from cfmpa.report._audit import (
+    MONITOR_MAX_SAMPLES,
+    MONITOR_SIMULATION,
+    _proofs_of_this_tree,
+    _verdict,
+    monitor_settings,
+)
 from cfmpa.report._obligations import audited_ids, load_proofs
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -204,9 +209,8 @@ def test_the_audit_monitors_each_audited_workcell_and_names_it(mine: Path, tmp_p
 
 
 def test_a_narrow_tube_scales_the_simulation_to_fit_it() -> None:
-    from cfmpa.runs import parse_max_speed
+    from cfmpa.runs import parse_max_speed, plan
     from cfmpa.spec import ReferenceSpeeds, executed_trajectory
-    from cfmpa.runs import plan
 
     s = factory.scenario(dt=0.04, right__omega=[5.0, 5.0], right__limits=[[0.0, 3.0], [0.0, 3.0]],
                          right__start_cell=[2, 3], right__goal_cell=[14, 13])

@@ -38,5 +38,5 @@ def test_mcnemar_exact_uses_only_the_discordant_pairs():
     assert mcnemar_exact_p(0, 0) == 1.0
     # a large campaign: exact integers, no underflow to 0 before the float division
     assert 0 < mcnemar_exact_p(0, 1000) < 1e-290
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match=r"k must be an integer in \[0, n\], got 3"):
         wilson_interval(3, 2)

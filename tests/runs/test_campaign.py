@@ -26,8 +26,16 @@ from cfmpa.errors import InputError
 from cfmpa.report import run_compare
 from cfmpa.report._compare import campaign_json
 from cfmpa.report._stats import mcnemar_exact_p, wilson_interval
-from cfmpa.runs import (STORE_NAME, Engine, ProgressBar, check_scheduler_address, open_store,
-                        random_workcell, run_campaign, workcell_task)
+from cfmpa.runs import (
+    STORE_NAME,
+    Engine,
+    ProgressBar,
+    check_scheduler_address,
+    open_store,
+    random_workcell,
+    run_campaign,
+    workcell_task,
+)
 
 SEED, N, DT = 5, 6, 0.2
 

@@ -14,8 +14,14 @@ import factory
 from cfmpa.cli import main
 from cfmpa.runs import plan, write_plan
 from cfmpa.scenarios import BUNDLED_DIR, bundled_names
-from cfmpa.spec import (Trajectory, certify_trajectory, load_scenario, load_trajectory,
-                        tolerance_rad, trajectory_distances)
+from cfmpa.spec import (
+    Trajectory,
+    certify_trajectory,
+    load_scenario,
+    load_trajectory,
+    tolerance_rad,
+    trajectory_distances,
+)
 
 START, GOAL = [2, 8], [13, 5]
 DOC = factory.doc(right__start_cell=START, right__goal_cell=GOAL)

@@ -12,15 +12,34 @@ import factory
 from cfmpa.errors import ContractViolation, InputError
 from cfmpa.files import jsonable
 from cfmpa.impl import build_dr, search_opt_path
-from cfmpa.runs._contracts import (DEFAULT_SAMPLE, Mode, Settings, builtdr_path_cells,
-                                     builtdr_post, checked_build_dr, checked_search,
-                                     sample_cells)
+from cfmpa.runs._contracts import (
+    DEFAULT_SAMPLE,
+    Mode,
+    Settings,
+    builtdr_path_cells,
+    builtdr_post,
+    checked_build_dr,
+    checked_search,
+    sample_cells,
+)
 from cfmpa.spec import Variant, Witness, make_grid
 from cfmpa.spec._paths import J1, J2, SearchResult
-from cfmpa.spec._triples import (THEOREM_1, THEOREM_2, THEOREM_3, THEOREM_3_TIGHT, THEOREM_4,
-                                 THEOREM_4_TIGHT, TRIPLES, Command, builtdr_triple,
-                                 dr_shape_failures, grid_failures, path_cells, search_failures,
-                                 search_triple)
+from cfmpa.spec._triples import (
+    THEOREM_1,
+    THEOREM_2,
+    THEOREM_3,
+    THEOREM_3_TIGHT,
+    THEOREM_4,
+    THEOREM_4_TIGHT,
+    TRIPLES,
+    Command,
+    builtdr_triple,
+    dr_shape_failures,
+    grid_failures,
+    path_cells,
+    search_failures,
+    search_triple,
+)
 
 START, GOAL = (2, 8), (13, 5)   # a pair with a path of 15 cells in the coarse workcell
 

@@ -133,13 +133,14 @@ def test_a_store_built_in_blocks_is_the_one_process_store_byte_for_byte(small, t
                                                                          variant):
     _, s, whole, stores = small
     want, sha = stores[variant]
-    built = build_store(s, variant, tmp_path / "dr.zarr", keep_array=True, layers_per_chunk=2)
+    built = build_store(s, variant, tmp_path / "dr.zarr", keep_layers=True, layers_per_chunk=2)
     assert not (tmp_path / "dr.zarr").exists()           # not in place before publish
+    assert np.array_equal(np.asarray(built.layers), whole[variant])   # read in layers
+    assert built.layers.blocked_cells() == int(np.count_nonzero(whole[variant]))
     assert built.publish() == tmp_path / "dr.zarr"
     assert_same_store(tmp_path / "dr.zarr", want)
     assert built.sha256 == sha == _drstore.dr_sha256_of(whole[variant])
-    assert np.array_equal(built.array, whole[variant])
-    assert built.free_fraction == pytest.approx(1.0 - float(whole[variant].mean()))
+    assert built.free_fraction == 1.0 - float(whole[variant].mean())     # the same float
     assert _leftovers(tmp_path) == []
 
 
@@ -219,7 +220,7 @@ def test_seeded_fault_a_store_built_in_place_is_left_half_written(small, tmp_pat
 
 # --- options refused before any work -------------------------------------------------------------
 
-@pytest.mark.parametrize(("extra", "said"), [
+@pytest.mark.parametrize("extra, said", [
     (["--workers", "2", "--store", "npy"], "error: --store must be zarr with --workers or "
                                            "--scheduler"),
     (["--workers", "2", "--kernel", "reference"], "error: --kernel must be fast with --workers"),
@@ -347,6 +348,80 @@ def test_cfmpa_plan_on_a_cluster_writes_the_one_process_plan(small, two_layer_ch
     assert _plan_doc(dask) == _plan_doc(one)
     assert (dask / "traj.csv").read_bytes() == (one / "traj.csv").read_bytes()
     assert not (dask / "dr.npy").exists()            # a folder keeps one D_R
+
+
+def test_a_plan_on_a_cluster_searches_the_store_and_never_reads_dr_whole(
+        small, two_layer_chunks, started, tmp_path, monkeypatch, capsys):
+    """`plan --scheduler` checks and searches the store it built a layer at a time (§9): with
+    the whole-store read and the layers' whole-array conversion made to raise, its plan.json is
+    the in-process `--store zarr` plan's, and the search read the store's chunks."""
+    from cfmpa.spec import Layers
+
+    toml = small[0]
+    one, dask = tmp_path / "one", tmp_path / "dask"
+    argv = ["--contracts", "off"]
+    assert main(["plan", str(toml), "--out", str(one), "--store", "zarr", *argv]) == 0
+
+    def whole(*args: Any, **kw: Any) -> Any:
+        raise AssertionError("D_R materialised whole")
+
+    monkeypatch.setattr(_drstore.ZarrDr, "read", whole)
+    monkeypatch.setattr(Layers, "__array__", whole)
+    read: list[int] = []
+    chunk = _drstore.ZarrDr.chunk
+    monkeypatch.setattr(_drstore.ZarrDr, "chunk",
+                        lambda self, c: read.append(c) or chunk(self, c))
+    assert main(["plan", str(toml), "--out", str(dask), "--scheduler", started, *argv]) == 0
+    capsys.readouterr()
+    assert _plan_doc(dask) == _plan_doc(one)
+    assert (dask / "traj.csv").read_bytes() == (one / "traj.csv").read_bytes()
+    g = make_grid(small[1])
+    chunks = -(-(g.N + 1) // 2)
+    # the sha pass reads every chunk once; the search reads them again, layer after layer
+    assert read[:chunks] == list(range(chunks)) and set(read[chunks:]) == set(range(chunks))
+    # Seeded fault: the store read back whole for the search (as before) is caught.
+    monkeypatch.setattr(_drstore.ZarrDr, "layers", lambda self, blocked=None: self.read()[0])
+    with pytest.raises(AssertionError, match="materialised whole"):
+        main(["plan", str(toml), "--out", str(tmp_path / "whole"), "--scheduler", started,
+              *argv])
+    capsys.readouterr()
+    assert not (tmp_path / "whole" / "plan.json").exists()
+
+
+def test_a_plan_on_a_cluster_with_full_contracts_does_not_read_the_store_whole(
+        small, two_layer_chunks, started, tmp_path, monkeypatch, capsys):
+    """Full contracts too: the store's whole read is never used (the contracts' checkers read
+    D_R through ``spec.Layers``; docs/model.md §9 says which of them still convert it)."""
+    toml = small[0]
+
+    def whole(*args: Any, **kw: Any) -> Any:
+        raise AssertionError("the store read whole")
+
+    monkeypatch.setattr(_drstore.ZarrDr, "read", whole)
+    out = tmp_path / "out"
+    assert main(["plan", str(toml), "--out", str(out), "--scheduler", started]) == 0
+    capsys.readouterr()
+    doc = _plan_doc(out)
+    assert doc["contracts"]["mode"] == "full" and not doc["contracts"]["violations"]
+    assert (out / "dr.zarr" / "zarr.json").exists()
+    # Seeded fault: a builder that reads the store back whole for the contracts is caught.
+    monkeypatch.setattr(_drdask, "_sha256_and_blocked",
+                        lambda zarr: (zarr.read()[1], zarr.layers().blocked_cells()))
+    with pytest.raises(AssertionError, match="read whole"):
+        main(["plan", str(toml), "--out", str(tmp_path / "again"), "--scheduler", started])
+    capsys.readouterr()
+
+
+def test_the_engine_says_how_many_workers_it_has(started):
+    from cfmpa.runs._engine import Engine
+
+    assert Engine().worker_count() == 1
+    assert Engine(3).worker_count() == 3          # a local cluster not started: its processes
+    with Engine(0, started, connect_timeout=20) as e:
+        assert e.worker_count() == 1
+    import inspect
+
+    assert "_client" not in inspect.getsource(_drdask)    # the engine's count, not its client
 
 
 def test_a_block_that_keeps_failing_ends_the_run_without_a_store(small, two_layer_chunks,

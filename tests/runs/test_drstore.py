@@ -19,8 +19,14 @@ from cfmpa.errors import InputError
 from cfmpa.files import npy_bytes
 from cfmpa.impl import search_opt_path, search_opt_path_fast
 from cfmpa.runs import _drstore
-from cfmpa.runs._drstore import (dr_sha256_of, load_dr, open_dr_layers, open_zarr, write_dr,
-                                 zarr_threshold)
+from cfmpa.runs._drstore import (
+    dr_sha256_of,
+    load_dr,
+    open_dr_layers,
+    open_zarr,
+    write_dr,
+    zarr_threshold,
+)
 from cfmpa.runs._plan import plan, write_plan
 from cfmpa.runs._selftest import WORKCELLS
 from cfmpa.spec import load_scenario, make_grid
@@ -313,7 +319,7 @@ def test_an_interrupted_rewrite_keeps_the_earlier_store(tmp_path, monkeypatch):
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(_drstore, "_write_block", fail)
-    with pytest.raises(OSError):
+    with pytest.raises(OSError, match="No space left on device"):
         write_dr(tmp_path, np.ones((4, 3, 3), np.uint8), "zarr")
     assert [p.name for p in tmp_path.iterdir()] == ["dr.zarr"]
     assert np.array_equal(load_dr(tmp_path / "dr.zarr")[0], old)
@@ -412,3 +418,30 @@ def test_a_streamed_store_holds_one_chunk(tmp_path, monkeypatch):
     assert (r.J1, r.J2) == (6, 4)               # three diagonal moves
     # the start's and the goal's layers first (layer 0, the rest layer), then in order
     assert read == [0, 3, 0, 1, 2, 3]
+
+
+def test_a_store_in_layers_gives_the_cells_the_contracts_ask_for(tmp_path, monkeypatch):
+    """``dr[k, i, j]`` for arrays of cells (any order, repeats) is the array's, read a layer at
+    a time; the count of blocked cells is the builder's when given, else one pass; a store
+    moved away is an error, not an all-free D_R."""
+    rng = np.random.default_rng(7)
+    dr = (rng.random((9, 5, 6)) < 0.3).astype(np.uint8)
+    path, _ = write_dr(tmp_path, dr, "zarr", layers_per_chunk=2)
+    layers = open_zarr(path, dr.shape).layers()
+    k, i, j = (rng.integers(0, x, size=40) for x in dr.shape)
+    assert np.array_equal(layers[k, i, j], dr[k, i, j])
+    assert layers[3, 2, 4] == dr[3, 2, 4] and np.array_equal(layers[5], dr[5])
+    assert layers.blocked_cells() == int(np.count_nonzero(dr))
+    monkeypatch.setattr(_drstore.ZarrDr, "chunk", lambda self, c: pytest.fail("read a chunk"))
+    assert open_zarr(path, dr.shape).layers(blocked=17).blocked_cells() == 17
+    monkeypatch.undo()
+    # Seeded fault: a gather that takes the cells in layer order answers otherwise.
+    order = np.argsort(k, kind="stable")
+    assert not np.array_equal(layers[k, i, j][order], dr[k, i, j])
+    fresh = open_zarr(path, dr.shape).layers()
+    shutil.move(path, tmp_path / "moved.zarr")
+    with pytest.raises(InputError, match="chunk 0 cannot be read: the store is gone"):
+        fresh[0]
+    # A chunk missing from a store that is there reads as the fill value, as Zarr says.
+    (tmp_path / "moved.zarr" / "c" / "0" / "0" / "0").unlink()
+    assert not open_zarr(tmp_path / "moved.zarr", dr.shape).layers()[1].any()

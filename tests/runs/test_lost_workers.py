@@ -343,7 +343,7 @@ def test_a_batch_that_loses_its_last_worker_stops_with_the_command_that_runs_it_
 
 # --- --worker-timeout's budget ------------------------------------------------------------------
 
-@pytest.mark.parametrize(("value", "said"), [
+@pytest.mark.parametrize("value, said", [
     ("1e9", "--worker-timeout must be at most 86400 (a day)"),
     ("inf", "--worker-timeout must be a finite number"),
     ("nan", "--worker-timeout must be a finite number"),

@@ -22,8 +22,8 @@ import mutant_module
 from cfmpa.cli import main
 from cfmpa.errors import InputError
 from cfmpa.runs import Excursion, log_csv, monitor_json, monitor_log, simulate_log
-from cfmpa.spec import certify_trajectory_file, load_trajectory, tolerance_rad, trajectory_csv
 from cfmpa.spec import _trajectory as tr
+from cfmpa.spec import certify_trajectory_file, load_trajectory, tolerance_rad, trajectory_csv
 
 H = "t,left1,left2,right1,right2\n"
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import factory
-from cfmpa.files import dumps_json
 from cfmpa.errors import CertificateViolation, ContractViolation
+from cfmpa.files import dumps_json
 from cfmpa.impl import build_dr, search_opt_path
 from cfmpa.runs._plan import CERTIFICATE, EXACT, plan, plan_json, write_plan
 from cfmpa.runs._selftest import FAULTS, workcell

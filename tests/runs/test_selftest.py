@@ -9,8 +9,17 @@ import pytest
 
 import cfmpa.runs._selftest as st
 from cfmpa.runs._contracts import Mode
-from cfmpa.runs._selftest import (FAULTS, SAMPLE, WORKCELLS, FaultNotMade, run_fault,
-                                    run_selftest, selftest_rows, selftest_table, workcell)
+from cfmpa.runs._selftest import (
+    FAULTS,
+    SAMPLE,
+    WORKCELLS,
+    FaultNotMade,
+    run_fault,
+    run_selftest,
+    selftest_rows,
+    selftest_table,
+    workcell,
+)
 from cfmpa.spec import load_scenario, make_grid
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -147,19 +147,21 @@ def test_the_line_limit_is_the_limit(tmp_path, monkeypatch):
     monkeypatch.setenv("CFMPA_MAX_LINE_BYTES", "10")
     f = tmp_path / "x"
     f.write_bytes(b"123456789\n1234567890\n")          # 10 bytes, then 11 with the newline
-    lines = bounded_lines(open(f, "rb"), str(f))
-    assert next(lines) == "123456789\n"
-    with pytest.raises(InputError) as e:
-        next(lines)
+    with open(f, "rb") as fh:
+        lines = bounded_lines(fh, str(f))
+        assert next(lines) == "123456789\n"
+        with pytest.raises(InputError) as e:
+            next(lines)
     assert e.value.line == 2 and "10 bytes" in e.value.render()
     with pytest.raises(InputError) as e:
         read_bounded(f, LIMITS["scenario"], str(f))
     assert e.value.line == 2
     f.write_bytes(b"a\r\nb\xff\n")
-    lines = bounded_lines(open(f, "rb"), str(f))
-    assert next(lines) == "a\n"
-    with pytest.raises(InputError) as e:
-        next(lines)
+    with open(f, "rb") as fh:
+        lines = bounded_lines(fh, str(f))
+        assert next(lines) == "a\n"
+        with pytest.raises(InputError) as e:
+            next(lines)
     assert e.value.line == 2 and "UTF-8" in e.value.render()
 
 

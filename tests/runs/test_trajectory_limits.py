@@ -20,8 +20,8 @@ from cfmpa.cli import main
 from cfmpa.errors import InputError
 from cfmpa.runs import BagOptions, certify_json, load_bag_trajectory
 from cfmpa.runs._rosbag import bag_row_name, bag_trajectory_rows, write_bag
-from cfmpa.spec import certify_trajectory, certify_trajectory_file, load_trajectory
 from cfmpa.spec import _trajectory as tr
+from cfmpa.spec import certify_trajectory, certify_trajectory_file, load_trajectory
 
 ROWS = "CFMPA_MAX_TRAJECTORY_ROWS"
 

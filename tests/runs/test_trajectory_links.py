@@ -12,8 +12,17 @@ import pytest
 import factory
 from cfmpa.cli import main
 from cfmpa.errors import CertificateViolation
-from cfmpa.spec import (Trajectory, certificate_json, certify_trajectory, closest_links,
-                        link_name, load_trajectory, require_clear, tolerance_rad, trajectory_csv)
+from cfmpa.spec import (
+    Trajectory,
+    certificate_json,
+    certify_trajectory,
+    closest_links,
+    link_name,
+    load_trajectory,
+    require_clear,
+    tolerance_rad,
+    trajectory_csv,
+)
 from cfmpa.spec._kinematics import LINK_WORDS
 
 HEADER = "t,left1,left2,right1,right2\n"
@@ -38,7 +47,7 @@ def test_link_name_is_one_based_with_words():
     assert LINK_WORDS == {1: "upper arm", 2: "forearm"}
     assert link_name("right", 3) == "right tool"      # part 3: the tool (docs/model.md §2)
     for bad in (("left", 0), ("right", 4), ("middle", 1)):
-        with pytest.raises(ValueError):
+        with pytest.raises(ValueError, match=f"no part {bad[1]} of arm '{bad[0]}'"):
             link_name(*bad)
     d = np.full((2, 2), 1.0)
     d[1, 1] = 0.0                                     # array index (1, 1): the forearms

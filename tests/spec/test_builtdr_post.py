@@ -15,8 +15,15 @@ from hypothesis import strategies as st
 
 import factory
 from cfmpa.impl import build_dr_fast
-from cfmpa.spec import EPS, Variant, joint_points, load_scenario, make_grid, parse_scenario
-from cfmpa.spec import _builtdr_post
+from cfmpa.spec import (
+    EPS,
+    Variant,
+    _builtdr_post,
+    joint_points,
+    load_scenario,
+    make_grid,
+    parse_scenario,
+)
 from cfmpa.spec._builtdr_post import BAND, dr_postcondition, expected_cells, full_verdicts
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))

@@ -11,8 +11,7 @@ import pytest
 
 import factory
 from cfmpa.impl import build_dr_fast
-from cfmpa.spec import Variant, make_grid
-from cfmpa.spec import _builtdr_post
+from cfmpa.spec import Variant, _builtdr_post, make_grid
 from cfmpa.spec._builtdr_post import dr_postcondition
 
 

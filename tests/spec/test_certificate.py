@@ -13,11 +13,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cfmpa.errors import CertificateViolation, InputError
-from cfmpa.spec import (certificate_json, certify, left_angles, load_scenario, make_grid,
-                        parse_scenario, polygon_distance, require_clear)
+from cfmpa.spec import (
+    certificate_json,
+    certify,
+    left_angles,
+    load_scenario,
+    make_grid,
+    parse_scenario,
+    polygon_distance,
+    require_clear,
+)
+from cfmpa.spec._certificate import _link_rects, _link_speeds
 from cfmpa.spec._kinematics import link_corners
 from cfmpa.spec._polygon import polygon_distances
-from cfmpa.spec._certificate import _link_rects, _link_speeds
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
 TWO_PI = 6.283185307179586

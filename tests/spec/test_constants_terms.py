@@ -11,8 +11,16 @@ import z3
 from flint import arb, ctx
 
 import cfmpa.spec as spec
-from cfmpa.spec import (gap_over_norm, hypot_of, interval_bound, link_speeds, pair_lipschitz,
-                        projection_bounds, reach, sqrt_of)
+from cfmpa.spec import (
+    gap_over_norm,
+    hypot_of,
+    interval_bound,
+    link_speeds,
+    pair_lipschitz,
+    projection_bounds,
+    reach,
+    sqrt_of,
+)
 
 
 class _Arm:

@@ -20,9 +20,19 @@ import factory
 from cfmpa import cli
 from cfmpa.errors import InputError
 from cfmpa.proofs._obl_scenario import _cspace_grid, _margin_side, _time_grid
-from cfmpa.spec import (Grid, Variant, builtdr_triple, decimal, exact_n, grid_failures,
-                        joint_grid, load_scenario, make_grid, parse_scenario)
-from cfmpa.spec import _counts
+from cfmpa.spec import (
+    Grid,
+    Variant,
+    _counts,
+    builtdr_triple,
+    decimal,
+    exact_n,
+    grid_failures,
+    joint_grid,
+    load_scenario,
+    make_grid,
+    parse_scenario,
+)
 from cfmpa.spec._counts import ceil_fraction, min_points
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))

@@ -15,8 +15,16 @@ from hypothesis import strategies as st
 import cfmpa.spec._layers as layers_module
 from cfmpa.impl import search_opt_path, search_opt_path_fast
 from cfmpa.impl._search import WitnessLabels
-from cfmpa.spec import (MOVES, LayerSpill, Layers, SearchStatus, Witness, check_witness,
-                        load_witness, save_npz)
+from cfmpa.spec import (
+    MOVES,
+    Layers,
+    LayerSpill,
+    SearchStatus,
+    Witness,
+    check_witness,
+    load_witness,
+    save_npz,
+)
 from cfmpa.spec._layers import npz_layers
 from dr_strategies import random_dr
 
@@ -49,7 +57,7 @@ def test_layers_index_like_the_array_they_hold():
     assert all(np.array_equal(x, y) for x, y in zip(v, a))
     with pytest.raises(IndexError):
         v[4]
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="read-only"):
         v[1][0, 0, 0] = 7                      # read-only: a checker cannot change a witness
     m = v.map(lambda x: x % 2 == 0, np.bool_)
     assert m.dtype == np.bool_ and np.array_equal(np.asarray(m), a % 2 == 0)
@@ -66,19 +74,19 @@ def test_the_view_reads_again_what_its_cache_let_go():
 
 def test_a_spill_refuses_a_wrong_layer_and_an_unfinished_read():
     spill = LayerSpill((2, 1, 3), np.uint16)
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match=r"LayerSpill.append: layer 0 of shape \(4,\)"):
         spill.append(np.zeros(4))
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match=r"LayerSpill.append: layer 0 of shape \(1, 2\)"):
         spill.append(np.zeros((1, 2)), (0, 1, 2, 4))          # the box leaves the layer
     spill.append(np.array([[1, 65535, 3]]))
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="LayerSpill.layers: 1 of 2 written"):
         spill.layers()
     wide = spill.widened(np.uint32)
     wide.append(np.array([[70000, 4, 4294967295]]))
     assert np.array_equal(np.asarray(wide.layers()),
                           [[[1, 4294967295, 3]], [[70000, 4, 4294967295]]])
     spill.append(np.zeros((1, 3)))
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="LayerSpill.append: layer 2 .* at most 2 layers"):
         spill.append(np.zeros((1, 3)))
 
 

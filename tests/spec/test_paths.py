@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 import z3
@@ -10,9 +9,20 @@ from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
-from cfmpa.spec._paths import (REASON_GOAL_BLOCKED, REASON_START_BLOCKED, REASON_UNREACHABLE,
-                               J1, J2, SearchResult, SearchStatus, is_opt_path, is_path,
-                               is_path_paper, opt_path, path_violations)
+from cfmpa.spec._paths import (
+    J1,
+    J2,
+    REASON_GOAL_BLOCKED,
+    REASON_START_BLOCKED,
+    REASON_UNREACHABLE,
+    SearchResult,
+    SearchStatus,
+    is_opt_path,
+    is_path,
+    is_path_paper,
+    opt_path,
+    path_violations,
+)
 from cfmpa.spec._paths_z3 import dr_free, length_bound, path_vars, z3_is_path, z3_J1, z3_J2
 from dr_strategies import random_dr
 from path_enumeration import optimal_lists
@@ -173,7 +183,7 @@ def test_search_result_as_json_and_status_from_text() -> None:
     assert found.as_json() == {"status": "found", "reason": None, "path": [[0, 0], [0, 1]],
                                "J1": 1, "J2": 2}
     assert SearchResult.no_path(REASON_UNREACHABLE).as_json()["status"] == "no_path"
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="'lost' is not a valid SearchStatus"):
         SearchResult("lost", None, (), None, None)
 
 

@@ -16,8 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cfmpa.scenarios import BUNDLED_DIR
-from cfmpa.spec import Trajectory, certificate_json, certify_trajectory, load_scenario
-from cfmpa.spec import _polygon
+from cfmpa.spec import Trajectory, _polygon, certificate_json, certify_trajectory, load_scenario
 
 coord = st.floats(min_value=-2.0, max_value=2.0, allow_nan=False, allow_infinity=False)
 #: Small integers too, so that touching, collinear and repeated vertices are common.

@@ -16,11 +16,20 @@ from hypothesis import given, settings
 import factory
 from cfmpa import cli
 from cfmpa.errors import MISSING, InputError
-from cfmpa.spec import (Variant, exact_n, exact_tf, left_angles, left_box, load_scenario,
-                        make_grid, parse_scenario, right_box)
+from cfmpa.spec import (
+    Variant,
+    exact_n,
+    exact_tf,
+    left_angles,
+    left_box,
+    load_scenario,
+    make_grid,
+    parse_scenario,
+    right_box,
+)
 from cfmpa.spec._kinematics import link_corners
-from cfmpa.spec._scenario import DEFAULT_MAX_CELLS
 from cfmpa.spec._regions import SNAP, right_region_polygons
+from cfmpa.spec._scenario import DEFAULT_MAX_CELLS
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
 

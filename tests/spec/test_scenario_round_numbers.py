@@ -23,8 +23,7 @@ from hypothesis import HealthCheck, Phase, given, settings
 
 from cfmpa import cli
 from cfmpa.errors import InputError
-from cfmpa.spec import Variant, load_scenario, make_grid
-from cfmpa.spec import _counts
+from cfmpa.spec import Variant, _counts, load_scenario, make_grid
 
 #: Keeps every drawn grid small: (N + 1) m n stays below this (seconds for the whole test).
 MAX_TEST_CELLS = 200_000

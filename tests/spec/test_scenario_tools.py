@@ -12,8 +12,16 @@ import pytest
 import factory
 from cfmpa import cli
 from cfmpa.errors import InputError
-from cfmpa.spec import (TOOL, Tool, heights_overlap, link_name, load_scenario, pairs_to_test,
-                        parse_scenario, parts)
+from cfmpa.spec import (
+    TOOL,
+    Tool,
+    heights_overlap,
+    link_name,
+    load_scenario,
+    pairs_to_test,
+    parse_scenario,
+    parts,
+)
 
 BUNDLED = Path(__file__).resolve().parents[2] / "scenarios"
 GRIPPER = [[-0.02, -0.04], [0.12, -0.025], [0.12, 0.025], [-0.02, 0.04]]

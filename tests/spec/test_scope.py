@@ -11,8 +11,16 @@ import pytest
 import factory
 from cfmpa.errors import CertificateViolation
 from cfmpa.scenarios import BUNDLED_DIR
-from cfmpa.spec import (Certificate, certificate_json, closest_links, contact_links_text,
-                        contact_parts, load_scenario, require_clear, theorem_scope)
+from cfmpa.spec import (
+    Certificate,
+    certificate_json,
+    closest_links,
+    contact_links_text,
+    contact_parts,
+    load_scenario,
+    require_clear,
+    theorem_scope,
+)
 from cfmpa.spec._scope import SCOPE_CHECKED
 
 DATA = Path(__file__).resolve().parents[1] / "data"

@@ -11,9 +11,17 @@ import pytest
 import factory
 from cfmpa.errors import InputError
 from cfmpa.runs import plan
-from cfmpa.spec import (Trajectory, certify, certify_trajectory, executed_trajectory,
-                        load_trajectory, parse_trajectory_csv, tolerance_rad, trajectory_csv,
-                        tube_lipschitz)
+from cfmpa.spec import (
+    Trajectory,
+    certify,
+    certify_trajectory,
+    executed_trajectory,
+    load_trajectory,
+    parse_trajectory_csv,
+    tolerance_rad,
+    trajectory_csv,
+    tube_lipschitz,
+)
 from cfmpa.spec._trajectory import parse_trajectory_json
 
 START, GOAL = [2, 8], [13, 5]

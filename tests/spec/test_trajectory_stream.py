@@ -17,10 +17,18 @@ import pytest
 
 import factory
 from cfmpa.cli import main
+from cfmpa.errors import InputError
 from cfmpa.runs import certify_json
 from cfmpa.scenarios import BUNDLED_DIR
-from cfmpa.spec import (CHUNK_ROWS, Trajectory, certify_trajectory, certify_trajectory_file,
-                        load_scenario, load_trajectory, trajectory_csv)
+from cfmpa.spec import (
+    CHUNK_ROWS,
+    Trajectory,
+    certify_trajectory,
+    certify_trajectory_file,
+    load_scenario,
+    load_trajectory,
+    trajectory_csv,
+)
 from cfmpa.spec import _trajectory as tr
 from cfmpa.spec._certificate import prove_motion
 
@@ -197,7 +205,7 @@ def test_seeded_fault_a_row_offset_off_by_one_is_caught(workcell, tmp_path, monk
 
 
 def _error(s, path: Path, chunk_rows: int) -> str:
-    with pytest.raises(Exception) as exc:
+    with pytest.raises(InputError) as exc:
         certify_trajectory_file(path, s, chunk_rows=chunk_rows)
     return str(exc.value)
 
@@ -225,7 +233,7 @@ def test_errors_are_the_loaders_in_any_part_size(workcell, tmp_path):
     for name, text in BAD.items():
         p = tmp_path / f"{name}.csv"
         p.write_text(text)
-        with pytest.raises(Exception) as exc:
+        with pytest.raises(InputError) as exc:
             load_trajectory(p, s)
         want = str(exc.value)
         assert {_error(s, p, c) for c in (2, 3, CHUNK_ROWS)} == {want}, name

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 import z3
-from z3answer import as_float, exact_real
 
 from cfmpa.impl import lattice_range
 from cfmpa.spec import Variant, cell_box, exact_tf, left_box, load_scenario, make_grid, rest_box
 from cfmpa.spec._grid import rule_of
+from z3answer import as_float, exact_real
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -20,8 +20,19 @@ from hypothesis import strategies as st
 
 from cfmpa.errors import InputError
 from cfmpa.impl import build_dr_fast, search_opt_path, search_opt_path_fast
-from cfmpa.spec import (J1, J2, MOVES, SearchResult, SearchStatus, Variant, Witness,
-                        check_witness, load_scenario, load_witness, make_grid)
+from cfmpa.spec import (
+    J1,
+    J2,
+    MOVES,
+    SearchResult,
+    SearchStatus,
+    Variant,
+    Witness,
+    check_witness,
+    load_scenario,
+    load_witness,
+    make_grid,
+)
 from dr_strategies import random_dr
 
 SCENARIOS = sorted(Path(__file__).resolve().parents[2].joinpath("scenarios").glob("*.toml"))
