@@ -37,6 +37,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Any
 
 import z3
 
@@ -1121,6 +1122,105 @@ def _pins(pairs: Sequence[tuple[z3.ExprRef, int | z3.ArithRef]]
     return [(c, z3.RealVal(x) if isinstance(x, int) else x) for c, x in pairs]
 
 
+@dataclass(frozen=True)
+class _Chain:
+    """What _snapped_to_corners adds, and the terms the caller's goal reads."""
+
+    hyps: list[Hyp]
+    ws: tuple[z3.ArithRef, ...]
+    Qs: list[Vec]
+    D: Vec
+
+
+def _snapped_to_corners(kit: Kit, k: dict[str, Lemma], tag: str,
+                        frame: tuple[Vec, z3.ArithRef, z3.ArithRef, z3.ArithRef],
+                        theta: tuple[z3.ArithRef, ...], lats: tuple[Any, Any],
+                        radii: tuple[z3.ArithRef, ...], named: tuple[Any, ...],
+                        alphas: tuple[z3.ArithRef, ...], phis: tuple[z3.ArithRef, ...],
+                        points: str, grown: str,
+                        grow: Callable[[int, z3.ArithRef, z3.ArithRef, Vec], list[Hyp]]
+                        ) -> _Chain:
+    """The lemma instances that carry a point (u, v) rigidly fixed to link 2 from the box's
+    configuration to the hull of the lattice cell's corners (docs/model.md §2, §10 (c)):
+    snapping theta1 and theta2 (chord, transport), the three arcs (arc_in_place,
+    transport_chord), the two joints' bounds added (combine2_norm, combine2_weights), each
+    corner's part grown (``grow``: the rectangle's or the tool's square), the corners' points
+    shifted (shift_eq) and summed (sum_subst4). One chain for link 2 (link2_in_region) and the
+    tool (grown_in_region); ``tag`` prefixes its Z3 names, ``points`` and ``grown`` name its
+    instances."""
+    b, l1, u, v = frame
+    th1, th2, g1, g2 = theta
+    L1, L2 = lats
+    rb, re, r1, r2, dl = radii
+    X0, X1, X2, A, B, Ks = named
+    t1c, t2c = L1.theta_c, L2.theta_c
+    c1, G1, c2, G2 = L1.c, L1.G, L2.c, L2.G
+    c1e = c1 + G1
+
+    def P(alpha: z3.ArithRef, phi: z3.ArithRef) -> Vec:
+        return _point2(b, l1, alpha, phi, u, v)
+    hyps: list[Hyp] = []
+    for alpha, beta, where in ((th1, th2, "theta"), (t1c, th2, "(theta1', theta2)"),
+                               (t1c, t2c, "theta'"), (c1, t2c, "(c1, theta2')"),
+                               (c1e, t2c, "(c1 + G1, theta2')")):
+        hyps.append(a3_sum(alpha + beta, alpha, beta, where))
+        hyps += k["kin"].at(where, A=e(alpha), B=e(beta), AB=e(alpha + beta), l1=l1, u=u, v=v,
+                            b=b)
+    hyps += k["chord"].at("snapping theta1", alpha=th1, beta=t1c, o=b, w=_wvec(l1, th2, u, v),
+                          R=rb, s=SNAP_Q * g1)
+
+    def nested(alpha: z3.ArithRef, beta: z3.ArithRef) -> Vec:
+        return _add(b, _rot(e(alpha), _wvec(l1, beta, u, v)))
+    s1, s2, e1, e2 = margin_parts(kit.arc, (g1, g2), (rb, re), (G1, G2))
+    hyps += k["transport"].at("snapping theta1, in docs/model.md §2's form", X=nested(th1, th2),
+                              Y=nested(t1c, th2), X2=X0, Y2=X1, m=s1 * s1)
+    hyps += k["chord"].at("snapping theta2", alpha=t1c + th2, beta=t1c + t2c,
+                          o=_elbow(b, l1, t1c), w=(u, v), R=re, s=SNAP_Q * g2)
+    aip = k["arc_in_place"]
+    arcs = (("the base arc", dict(theta=t1c, a0=c1, G=G1, o=b, w=_wvec(l1, t2c, u, v), r=r1,
+                                  R=rb)),
+            ("the elbow arc at c1", dict(theta=c1 + t2c, a0=c1 + c2, G=G2, o=_elbow(b, l1, c1),
+                                         w=(u, v), r=r2, R=re)),
+            ("the elbow arc at c1 + G1", dict(theta=c1e + t2c, a0=c1e + c2, G=G2,
+                                              o=_elbow(b, l1, c1e), w=(u, v), r=r2, R=re)))
+    lam, mu, nu = z3.Reals(f"{tag}.lam {tag}.mu {tag}.nu")
+    for t, (where, arc_at) in zip((lam, mu, nu), arcs):
+        hyps.append((f"{t} = Margin.arc_chord's chord weight on {where}",
+                     t == aip.term(kit.arc_t, **arc_at)))
+        hyps += aip.at(where, t=t, **arc_at)
+    hyps += k["transport_chord"].at("the base arc, in docs/model.md §2's form",
+                                    X=nested(t1c, t2c), A=nested(c1, t2c), B=nested(c1e, t2c),
+                                    X2=X2, A2=A, B2=B, t=lam, m=e1 * e1)
+    for where, X2_, A2_, B2_, alpha, t in (("the elbow arc at c1", A, Ks[0], Ks[1], c1, mu),
+                                           ("the elbow arc at c1 + G1", B, Ks[2], Ks[3], c1e,
+                                            nu)):
+        # The elbow arcs' points, named (A, B and the corners): what combine2_norm reads.
+        hyps += k["transport_chord"].at(f"{where}, in docs/model.md §2's form",
+                                        X=P(alpha, alpha + t2c), A=P(alpha, alpha + c2),
+                                        B=P(alpha, (alpha + c2) + G2), X2=X2_, A2=A2_, B2=B2_,
+                                        t=t, m=e2 * e2)
+    D = _v(f"{tag}.D")
+    hyps.append(("D = X0 - h, h = (1 - lam) A' + lam B' (named)",
+                 _veq(D, _sub(X0, _comb(_comb(Ks[0], Ks[1], mu), _comb(Ks[2], Ks[3], nu), lam)))))
+    # The two joints' bounds add (combine2_norm) and the corners' weights (combine2_weights).
+    cb2 = dict(X0=X0, X1=X1, X2=X2, A=A, B=B, K00=Ks[0], K01=Ks[1], K10=Ks[2], K11=Ks[3],
+               lam=lam, mu=mu, nu=nu, s1=s1, s2=s2, e1=e1, e2=e2, Delta=dl, D=D)
+    hyps += k["combine2_norm"].at(points, **cb2)
+    hyps += k["combine2_weights"].at(points, **cb2)
+    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
+        hyps += grow(i, alpha, phi, D)
+    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
+    Qs = [_add(_elbow(b, l1, a), _rot(e(ph), grown_coords(ph, u, v, D)))
+          for a, ph in zip(alphas, phis)]
+    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
+        hyps += k["shift_eq"].at(f"corner {i}", K=Ks[i], M=P(alpha, phi), d=D, Q=Qs[i])
+    sub: dict[str, object] = dict(X=X0)
+    for i in range(4):
+        sub.update({f"P{i}": _add(Ks[i], D), f"Q{i}": Qs[i], f"w{i}": ws[i]})
+    hyps += k["sum_subst4"].at(grown, **sub)
+    return _Chain(hyps, ws, Qs, D)
+
+
 def _link2(kit: Kit) -> Lemma:
     """Link 2 at any configuration of a box lies in the region built for it."""
     k = kit.lemmas
@@ -1170,65 +1270,13 @@ def _link2(kit: Kit) -> Lemma:
                                         moving1=L1.moving, moving2=L2.moving, G1=G1, G2=G2)
     for beta, where in ((th2, "theta2"), (t2c, "theta2'")):
         hyps += k["reach_link2"].at(where, beta=beta, l1=l1, l2=l2, r=r, Re=re, u=u, v=v)
-    for alpha, beta, where in ((th1, th2, "theta"), (t1c, th2, "(theta1', theta2)"),
-                               (t1c, t2c, "theta'"), (c1, t2c, "(c1, theta2')"),
-                               (c1e, t2c, "(c1 + G1, theta2')")):
-        hyps.append(a3_sum(alpha + beta, alpha, beta, where))
-        hyps += k["kin"].at(where, A=e(alpha), B=e(beta), AB=e(alpha + beta), l1=l1, u=u, v=v,
-                            b=b)
-    hyps += k["chord"].at("snapping theta1", alpha=th1, beta=t1c, o=b, w=_wvec(l1, th2, u, v),
-                          R=rb, s=SNAP_Q * g1)
-
-    def nested(alpha: z3.ArithRef, beta: z3.ArithRef) -> Vec:
-        return _add(b, _rot(e(alpha), _wvec(l1, beta, u, v)))
-    s1, s2, e1, e2 = margin_parts(kit.arc, (g1, g2), (rb, re), (G1, G2))
-    hyps += k["transport"].at("snapping theta1, in docs/model.md §2's form", X=nested(th1, th2),
-                              Y=nested(t1c, th2), X2=X0, Y2=X1, m=s1 * s1)
-    hyps += k["chord"].at("snapping theta2", alpha=t1c + th2, beta=t1c + t2c,
-                          o=_elbow(b, l1, t1c), w=(u, v), R=re, s=SNAP_Q * g2)
-    aip = k["arc_in_place"]
-    arcs = (("the base arc", dict(theta=t1c, a0=c1, G=G1, o=b, w=_wvec(l1, t2c, u, v), r=r1,
-                                  R=rb)),
-            ("the elbow arc at c1", dict(theta=c1 + t2c, a0=c1 + c2, G=G2, o=_elbow(b, l1, c1),
-                                         w=(u, v), r=r2, R=re)),
-            ("the elbow arc at c1 + G1", dict(theta=c1e + t2c, a0=c1e + c2, G=G2,
-                                              o=_elbow(b, l1, c1e), w=(u, v), r=r2, R=re)))
-    lam, mu, nu = z3.Reals("lk2.lam lk2.mu lk2.nu")
-    for t, (where, arc_at) in zip((lam, mu, nu), arcs):
-        hyps.append((f"{t} = Margin.arc_chord's chord weight on {where}",
-                     t == aip.term(kit.arc_t, **arc_at)))
-        hyps += aip.at(where, t=t, **arc_at)
-    hyps += k["transport_chord"].at("the base arc, in docs/model.md §2's form",
-                                    X=nested(t1c, t2c), A=nested(c1, t2c), B=nested(c1e, t2c),
-                                    X2=X2, A2=A, B2=B, t=lam, m=e1 * e1)
-    for where, X2_, A2_, B2_, alpha, t in (("the elbow arc at c1", A, Ks[0], Ks[1], c1, mu),
-                                           ("the elbow arc at c1 + G1", B, Ks[2], Ks[3], c1e,
-                                            nu)):
-        # The elbow arcs' points, named (A, B and the corners): what combine2_norm reads.
-        hyps += k["transport_chord"].at(f"{where}, in docs/model.md §2's form",
-                                        X=P(alpha, alpha + t2c), A=P(alpha, alpha + c2),
-                                        B=P(alpha, (alpha + c2) + G2), X2=X2_, A2=A2_, B2=B2_,
-                                        t=t, m=e2 * e2)
-    D = _v("lk2.D")
-    hyps.append(("D = X0 - h, h = (1 - lam) A' + lam B' (named)",
-                 _veq(D, _sub(X0, _comb(_comb(Ks[0], Ks[1], mu), _comb(Ks[2], Ks[3], nu), lam)))))
-    # The two joints' bounds add (combine2_norm) and the corners' weights (combine2_weights).
-    cb2 = dict(X0=X0, X1=X1, X2=X2, A=A, B=B, K00=Ks[0], K01=Ks[1], K10=Ks[2], K11=Ks[3],
-               lam=lam, mu=mu, nu=nu, s1=s1, s2=s2, e1=e1, e2=e2, Delta=dl, D=D)
-    hyps += k["combine2_norm"].at("the link's points", **cb2)
-    hyps += k["combine2_weights"].at("the link's points", **cb2)
-    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
-        hyps += k["grow"].at(f"corner {i}", phi=phi, u=u, v=v, r=r, ell=l2, delta=dl,
-                             J=_elbow(b, l1, alpha), d=D)
-    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
-    Qs = [_add(_elbow(b, l1, a), _rot(e(ph), grown_coords(ph, u, v, D)))
-          for a, ph in zip(alphas, phis)]
-    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
-        hyps += k["shift_eq"].at(f"corner {i}", K=Ks[i], M=P(alpha, phi), d=D, Q=Qs[i])
-    sub: dict[str, object] = dict(X=X0)
-    for i in range(4):
-        sub.update({f"P{i}": _add(Ks[i], D), f"Q{i}": Qs[i], f"w{i}": ws[i]})
-    hyps += k["sum_subst4"].at("the corners' grown rectangles", **sub)
+    chain = _snapped_to_corners(
+        kit, k, "lk2", (b, l1, u, v), (th1, th2, g1, g2), (L1, L2), (rb, re, r1, r2, dl),
+        (X0, X1, X2, A, B, Ks), alphas, phis, "the link's points", "the corners' grown rectangles",
+        lambda i, alpha, phi, D: k["grow"].at(f"corner {i}", phi=phi, u=u, v=v, r=r, ell=l2,
+                                              delta=dl, J=_elbow(b, l1, alpha), d=D))
+    hyps += chain.hyps
+    ws, Qs, D = chain.ws, chain.Qs, chain.D
     goal = z3.And(
         L1.i_lo <= L1.j, L1.j + L1.step <= L1.i_hi, L2.i_lo <= L2.j, L2.j + L2.step <= L2.i_hi,
         c1e == A1 + z3.ToReal(L1.j + L1.step) * g1, c2 + G2 == A2 + z3.ToReal(L2.j + L2.step) * g2,

@@ -51,7 +51,6 @@ from ._obl_safety import (
     _SIN,
     G_MAX,
     N2,
-    SNAP_Q,
     ArcChord,
     Hyp,
     Kit,
@@ -63,6 +62,7 @@ from ._obl_safety import (
     _pins,
     _point2,
     _rot,
+    _snapped_to_corners,
     _sub,
     _v,
     _veq,
@@ -1035,63 +1035,13 @@ def _grown_in_region(kit: Kit, k: dict[str, Lemma], reading: ToolReading) -> Lem
     hyps.append((_REACH, z3.And(re >= 0, N2((u, v)) <= re * re,
                                 N2(_wvec(l1, th2, u, v)) <= (l1 + re) * (l1 + re),
                                 N2(_wvec(l1, t2c, u, v)) <= (l1 + re) * (l1 + re))))
-    for alpha, beta, where in ((th1, th2, "theta"), (t1c, th2, "(theta1', theta2)"),
-                               (t1c, t2c, "theta'"), (c1, t2c, "(c1, theta2')"),
-                               (c1e, t2c, "(c1 + G1, theta2')")):
-        hyps.append(a3_sum(alpha + beta, alpha, beta, where))
-        hyps += k["kin"].at(where, A=e(alpha), B=e(beta), AB=e(alpha + beta), l1=l1, u=u, v=v,
-                            b=b)
-    hyps += k["chord"].at("snapping theta1", alpha=th1, beta=t1c, o=b, w=_wvec(l1, th2, u, v),
-                          R=rb, s=SNAP_Q * g1)
-
-    def nested(alpha: z3.ArithRef, beta: z3.ArithRef) -> Vec:
-        return _add(b, _rot(e(alpha), _wvec(l1, beta, u, v)))
-    s1, s2, e1, e2 = margin_parts(kit.arc, (g1, g2), (rb, re), (G1, G2))
-    hyps += k["transport"].at("snapping theta1, in docs/model.md §2's form", X=nested(th1, th2),
-                              Y=nested(t1c, th2), X2=X0, Y2=X1, m=s1 * s1)
-    hyps += k["chord"].at("snapping theta2", alpha=t1c + th2, beta=t1c + t2c,
-                          o=_elbow(b, l1, t1c), w=(u, v), R=re, s=SNAP_Q * g2)
-    aip = k["arc_in_place"]
-    arcs = (("the base arc", dict(theta=t1c, a0=c1, G=G1, o=b, w=_wvec(l1, t2c, u, v), r=r1,
-                                  R=rb)),
-            ("the elbow arc at c1", dict(theta=c1 + t2c, a0=c1 + c2, G=G2, o=_elbow(b, l1, c1),
-                                         w=(u, v), r=r2, R=re)),
-            ("the elbow arc at c1 + G1", dict(theta=c1e + t2c, a0=c1e + c2, G=G2,
-                                              o=_elbow(b, l1, c1e), w=(u, v), r=r2, R=re)))
-    lam, mu, nu = z3.Reals("tir.lam tir.mu tir.nu")
-    for w_, (where, arc_at) in zip((lam, mu, nu), arcs):
-        hyps.append((f"{w_} = Margin.arc_chord's chord weight on {where}",
-                     w_ == aip.term(kit.arc_t, **arc_at)))
-        hyps += aip.at(where, t=w_, **arc_at)
-    hyps += k["transport_chord"].at("the base arc, in docs/model.md §2's form",
-                                    X=nested(t1c, t2c), A=nested(c1, t2c), B=nested(c1e, t2c),
-                                    X2=X2, A2=A, B2=B, t=lam, m=e1 * e1)
-    for where, X2_, A2_, B2_, alpha, w_ in (("the elbow arc at c1", A, Ks[0], Ks[1], c1, mu),
-                                            ("the elbow arc at c1 + G1", B, Ks[2], Ks[3], c1e,
-                                             nu)):
-        hyps += k["transport_chord"].at(f"{where}, in docs/model.md §2's form",
-                                        X=Pt(alpha, alpha + t2c), A=Pt(alpha, alpha + c2),
-                                        B=Pt(alpha, (alpha + c2) + G2), X2=X2_, A2=A2_, B2=B2_,
-                                        t=w_, m=e2 * e2)
-    D = _v("tir.D")
-    hyps.append(("D = X0 - h, h = (1 - lam) A' + lam B' (named)",
-                 _veq(D, _sub(X0, _comb(_comb(Ks[0], Ks[1], mu), _comb(Ks[2], Ks[3], nu), lam)))))
-    cb2 = dict(X0=X0, X1=X1, X2=X2, A=A, B=B, K00=Ks[0], K01=Ks[1], K10=Ks[2], K11=Ks[3],
-               lam=lam, mu=mu, nu=nu, s1=s1, s2=s2, e1=e1, e2=e2, Delta=dl, D=D)
-    hyps += k["combine2_norm"].at("the tool's points", **cb2)
-    hyps += k["combine2_weights"].at("the tool's points", **cb2)
-    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
-        hyps += k["grow_square"].at(f"corner {i}", phi=phi, u=u, v=v, delta=dl,
-                                    J=_elbow(b, l1, alpha), d=D)
-    ws = ((1 - lam) * (1 - mu), (1 - lam) * mu, lam * (1 - nu), lam * nu)
-    Qs = [_add(_elbow(b, l1, a), _rot(e(ph), grown_coords(ph, u, v, D)))
-          for a, ph in zip(alphas, phis)]
-    for i, (alpha, phi) in enumerate(zip(alphas, phis)):
-        hyps += k["shift_eq"].at(f"corner {i}", K=Ks[i], M=Pt(alpha, phi), d=D, Q=Qs[i])
-    sub: dict[str, object] = dict(X=X0)
-    for i in range(4):
-        sub.update({f"P{i}": _add(Ks[i], D), f"Q{i}": Qs[i], f"w{i}": ws[i]})
-    hyps += k["sum_subst4"].at("the corners' grown tools", **sub)
+    chain = _snapped_to_corners(
+        kit, k, "tir", (b, l1, u, v), (th1, th2, g1, g2), (L1, L2), (rb, re, r1, r2, dl),
+        (X0, X1, X2, A, B, Ks), alphas, phis, "the tool's points", "the corners' grown tools",
+        lambda i, alpha, phi, D: k["grow_square"].at(f"corner {i}", phi=phi, u=u, v=v, delta=dl,
+                                                     J=_elbow(b, l1, alpha), d=D))
+    hyps += chain.hyps
+    ws, Qs, D = chain.ws, chain.Qs, chain.D
     goal = z3.And(
         L1.i_lo <= L1.j, L1.j + L1.step <= L1.i_hi, L2.i_lo <= L2.j, L2.j + L2.step <= L2.i_hi,
         c1e == A1 + z3.ToReal(L1.j + L1.step) * g1, c2 + G2 == A2 + z3.ToReal(L2.j + L2.step) * g2,
