@@ -154,12 +154,13 @@ def cmd_prove(args: argparse.Namespace) -> int:
         from .proofs import run_prove
 
         return run_prove(out_dir=args.out, scenarios_dir=args.scenarios, only=args.only,
-                         repin=args.repin, workers=args.workers)
+                         repin=args.repin, workers=args.workers,
+                         recheck_undecided=args.recheck_undecided)
     from .report import run_prove_audit
 
     return run_prove_audit(args.audit, out_dir=args.out, scenarios_dir=args.scenarios,
                            only=args.only, repin=args.repin, workers=args.workers,
-                           argv=["cfmpa", *args.argv])
+                           recheck_undecided=args.recheck_undecided, argv=["cfmpa", *args.argv])
 
 
 def cmd_audit(args: argparse.Namespace) -> int:
@@ -385,6 +386,9 @@ def _parser() -> argparse.ArgumentParser:
     pr.add_argument("--repin", action="store_true",
                     help="rewrite proofs/obligations.lock with the statements run and print "
                          "what changed (review the diff), instead of failing on a change")
+    pr.add_argument("--recheck-undecided", action="store_true",
+                    help="replay in cvc5 the VCs it did not decide when pinned too (by default "
+                         "their answer is taken from proofs/obligations.lock, and said so)")
     opt.number(pr, "--jobs", b["prove_workers"], type=int, default=None, metavar="K",
                aliases=("--workers",), dest="workers",
                help="processes discharging obligations side by side (default 2 on a machine with "

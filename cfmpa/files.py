@@ -70,8 +70,9 @@ LIMITS = {
     "trajectory": Limit("CFMPA_MAX_TRAJECTORY_BYTES", 32 * 1024 * 1024, "a trajectory file"),
     # A plan.json holds the path and its cells' details: a few MB at the cell budget.
     "plan": Limit("CFMPA_MAX_PLAN_BYTES", 64 * 1024 * 1024, "a plan.json"),
-    # Read a layer at a time in place (spec._layers), so the limit is no memory bound: 36 bytes
-    # a cell at the 400 M cell budget is 14.4 GB (docs/model.md §3, §11).
+    # Read a layer at a time in place (spec._layers), so the limit is no memory bound: at 36
+    # bytes a cell it covers 0.95 G cells; a larger witness needs the variable raised (the cell
+    # budget is 2 G cells: docs/model.md §3, §11).
     "witness": Limit("CFMPA_MAX_WITNESS_BYTES", 32 * 1024 * 1024 * 1024,
                      "a witness file and its arrays unpacked"),
 }

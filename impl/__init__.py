@@ -24,7 +24,8 @@ if TYPE_CHECKING:     # the public names, one list: the type checker's and __all
     # searchoptpath (docs/model.md §5)
     from ._search import search_opt_path as search_opt_path
     # the kernels a run picks by name, the fast ones and their compile cache, threads, progress
-    from ._kernels import KERNELS as KERNELS, kernel_name as kernel_name, kernels as kernels
+    from ._kernels import (KERNELS as KERNELS, kernel_name as kernel_name, kernels as kernels,
+                           resolved as resolved)
     from ._fast_regions import (left_regions_fast as left_regions_fast,
                                 right_regions_fast as right_regions_fast)
     from ._fast_builtdr import (build_dr_fast as build_dr_fast,

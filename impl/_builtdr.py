@@ -258,15 +258,17 @@ _PART = {0: "link 1", 1: "link 2", 2: "tool"}
 
 
 def check_containment(s: Scenario, grid: Grid | None = None) -> ContainmentReport:
-    """Check region_tight within region_modified within region_original at every layer and R."""
+    """Check each variant's region within its rule's ``within`` (``Variant.nesting``: tight
+    within modified within original) at every layer and R."""
     g = grid or make_grid(s)
     regs = {v: left_regions(s, v, g) for v in Variant}
+    pairs = Variant.nesting()
     worst = np.inf
     where = ""
     outside = []
     for k in range(g.N + 1):
         for link in parts(s.left):
-            for inner, outer in ((Variant.TIGHT, Variant.MODIFIED), (Variant.MODIFIED, Variant.ORIGINAL)):
+            for inner, outer in pairs:
                 a, b = regs[inner].links[k][link], regs[outer].links[k][link]
                 sl = containment_slack(a, b)
                 if sl < worst:

@@ -26,10 +26,12 @@ from ._collide import PolygonSet, blocked_against
 __all__ = ["build_dr_loops", "builtdr_loop_nest"]
 
 
-def builtdr_loop_nest(N: int, m: int, n: int, P: Any, SL: Any, SR: Any, variant: str,
+def builtdr_loop_nest(N: int, m: int, n: int, P: Any, SL: Any, SR: Any, rule: Any,
                       region_left: Callable[[int], Any], region_right: Callable[[int, int], Any],
                       region_rest: Callable[[], Any], inter: Callable[[Any, Any], bool]) -> None:
-    """Algorithm 1, step 3: fill P[0..N, 0..m-1, 0..n-1] (1 = blocked), layer N the rest layer."""
+    """Algorithm 1, step 3: fill P[0..N, 0..m-1, 0..n-1] (1 = blocked), layer N the rest layer:
+    the principal at rest (``region_rest()``) when the variant's rule (``Variant.rule``) says
+    its rest layer is the goal, else layer N - 1's region, as in the paper (docs/model.md §4)."""
     for k in range(0, N):
         SL[k] = region_left(k)
     for i in range(0, m):
@@ -44,7 +46,7 @@ def builtdr_loop_nest(N: int, m: int, n: int, P: Any, SL: Any, SR: Any, variant:
                     P[k, i, j] = 0
     for i in range(0, m):
         for j in range(0, n):
-            if inter(region_rest() if variant == "tight" else SL[N - 1], SR[i, j]):
+            if inter(region_rest() if rule.rest_at_goal else SL[N - 1], SR[i, j]):
                 P[N, i, j] = 1
             else:
                 P[N, i, j] = 0
@@ -81,6 +83,6 @@ def build_dr_loops(s: Scenario, variant: Variant | str, grid: Grid | None = None
     P = np.full(g.shape, 2, dtype=np.uint8)        # 2: never stored (the tests look for it)
     SL: dict[int, Any] = {}
     SR: dict[tuple[int, int], Any] = {}
-    (nest or builtdr_loop_nest)(g.N, m, n, P, SL, SR, v.value, region_left, region_right,
+    (nest or builtdr_loop_nest)(g.N, m, n, P, SL, SR, v.rule, region_left, region_right,
                                 region_rest, inter)
     return P

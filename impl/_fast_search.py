@@ -73,11 +73,12 @@ def search_opt_path_fast(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *
                                   goal_flat, _DI, _DJ, _NORM, _GAP, SHIFT, INF, WAIT,
                                   labels is not None)
         bar.advance()
-    if key < 0:
-        result = SearchResult.no_path(reason or REASON_UNREACHABLE)
-    else:
-        path = _unwind(goal, int(last), start, pred, from_static, dag_pred)
-        result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+    with dag_pred:                  # its temporary file closed once the path is walked back
+        if key < 0:
+            result = SearchResult.no_path(reason or REASON_UNREACHABLE)
+        else:
+            path = _unwind(goal, int(last), start, pred, from_static, dag_pred)
+            result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
     if labels is None:
         return result
     labels.put(N, hold_waits(keys))

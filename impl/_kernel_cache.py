@@ -30,7 +30,13 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-__all__ = ["GROUPS", "WARM_UP", "cold_groups", "ensure_compiled", "load_fast_kernels"]
+__all__ = ["COMPILE_ENV", "GROUPS", "WARM_UP", "cold_groups", "ensure_compiled",
+           "load_fast_kernels", "numpy_while_cold", "wait_compiled"]
+
+#: The environment variable choosing what a cold cache does: "background" (the default: the
+#: groups compile in detached low-priority processes and the run uses the numpy kernels) or
+#: "wait" (compile now, all groups at once, and wait; the behaviour before §7.5's change).
+COMPILE_ENV = "CFMPA_KERNEL_COMPILE"
 
 #: The groups of kernels compiled apart, and their modules (none calls another's kernels).
 GROUPS: dict[str, str] = {"regions": "._fast_regions", "builtdr": "._fast_builtdr",
@@ -52,6 +58,7 @@ _STAMP_FORMAT = "cfmpa kernel stamp 1"
 _READY = [False]          # this process has made sure (or is a compile process itself)
 _LOCK = threading.Lock()
 _LOADED: list[float] = []
+_NUMPY: list[bool] = []   # decided once per process: the fast kernels were cold (numpy in use)
 
 
 def ensure_compiled() -> None:
@@ -69,14 +76,44 @@ def load_fast_kernels() -> float:
     """Seconds spent making the fast kernels ready in this process by this call: compiling
     any cold group, then loading every kernel from the cache by calling it on WARM_UP (0.0 if
     done before in this process)."""
-    if _LOADED:
-        return 0.0
+    if _LOADED or (_NUMPY and _NUMPY[0]):
+        return 0.0            # numpy in use: nothing to load, and never a compile here
     t0 = time.perf_counter()
     ensure_compiled()
     for name in GROUPS:
         _warm(name)
     _LOADED.append(time.perf_counter() - t0)
     return _LOADED[0]
+
+
+def numpy_while_cold() -> bool:
+    """Whether this process runs the numpy kernels for "fast" (decided at the first call): the
+    cache is cold and COMPILE_ENV is not "wait". Then the cold groups' compile is started in
+    the background (unless one is running already: the lock is held) and one line on stderr
+    says so, with a count; a later run uses the fast kernels once their stamps are warm."""
+    if not _NUMPY:
+        mode = os.environ.get(COMPILE_ENV, "background").strip().lower()
+        cold = [] if mode == "wait" or _READY[0] else cold_groups()
+        if cold:
+            started = _start_background(cold)
+            groups = f"{len(cold)} group{'s' if len(cold) > 1 else ''}"
+            print(f"cfmpa: fast kernels not compiled for this machine yet: {groups} "
+                  f"{'compiling' if started else 'being compiled'} in the background; this "
+                  "run uses the numpy kernels (bit-identical, slower)", file=sys.stderr,
+                  flush=True)
+        _NUMPY.append(bool(cold))
+    return _NUMPY[0]
+
+
+def wait_compiled(timeout: float = 600.0) -> bool:
+    """Wait until no group is cold (a background compile finished), at most ``timeout``
+    seconds; whether none is. Compiles nothing itself."""
+    deadline = time.monotonic() + timeout
+    while cold_groups():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.2)
+    return True
 
 
 def cold_groups() -> list[str]:
@@ -191,6 +228,54 @@ def _compile_cold() -> None:
             _write_stamp(name)
         print(f"cfmpa: fast kernels compiled in {time.perf_counter() - t0:.1f} s "
               "(cached for later runs)", file=sys.stderr, flush=True)
+
+
+def _lock_free(folder: Path | None) -> bool:
+    """Whether no process holds the compile lock now (it is released again at once)."""
+    try:
+        import fcntl
+    except ImportError:   # pragma: no cover - not on Linux
+        return True
+    if folder is None:
+        return True
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with open(folder / "cfmpa-kernels.lock", "a") as fh:
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                return False
+            fcntl.flock(fh, fcntl.LOCK_UN)
+    except OSError:
+        return True
+    return True
+
+
+def _start_background(cold: list[str]) -> bool:
+    """Start a detached process (its own session, lowest priority) that takes the compile lock
+    and compiles the groups still cold then, as ``_compile_cold`` does (a process per group,
+    the stamps written); False when another holds the lock (a compile is under way) or the
+    process could not start (the next run tries again)."""
+    if not _lock_free(_cache_dir(_module(cold[0]))):
+        return False
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)   # this process's cfmpa
+    try:
+        # Lowest priority from its first line, before its imports (its compile processes
+        # inherit it).
+        code = ("import os, contextlib\nwith contextlib.suppress(OSError): os.nice(19)\n"
+                f"import {__name__} as k; k._background()")
+        subprocess.Popen([sys.executable, "-c", code],
+                         env=env, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, start_new_session=True)
+    except OSError:
+        return False
+    return True
+
+
+def _background() -> None:
+    """The detached compile process's work (it runs at the lowest priority)."""
+    _compile_cold()
 
 
 def _compile_in_processes(names: list[str]) -> list[str]:

@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["KERNELS", "REGISTRY", "Kernel", "kernel_name", "kernels", "registry"]
+__all__ = ["KERNELS", "REGISTRY", "Kernel", "kernel_name", "kernels", "registry", "resolved"]
 
 
 @dataclass(frozen=True)
@@ -48,28 +48,46 @@ def registry(entries: Iterable[Kernel]) -> dict[str, Kernel]:
     return out
 
 
-#: The kernels a user can pick, the default first; "fast" is bit-identical to "reference"
-#: (tested).
+#: The kernels a user can pick, the default first; "fast" and "numpy" are bit-identical to
+#: "reference" (tested). "numpy" (no compile) is what "fast" gives while the fast kernels'
+#: machine code is compiled in the background (docs/model.md §7.5).
 REGISTRY: Mapping[str, Kernel] = registry((
     Kernel("fast", "._fast_builtdr:build_dr_fast", "._fast_search:search_opt_path_fast"),
     Kernel("reference", "._builtdr:build_dr", "._search:search_opt_path"),
+    Kernel("numpy", "._numpy_builtdr:build_dr_numpy", "._numpy_search:search_opt_path_numpy"),
 ))
 
 #: The kernel names, the default first (the command line's --kernel choices).
 KERNELS: tuple[str, ...] = tuple(REGISTRY)
 
 
-def kernels(name: str = "fast") -> tuple[Callable[..., Any], Callable[..., Any]]:
-    """(build, search) of the kernel called ``name``; ValueError for another name."""
-    kernel = REGISTRY.get(name)
-    if kernel is None:
+def kernels(name: str = "fast", *, wait: bool = False
+            ) -> tuple[Callable[..., Any], Callable[..., Any]]:
+    """(build, search) of the kernel called ``name``; ValueError for another name.
+
+    "fast" while its machine code is not compiled yet (numba's cache cold): the compile starts
+    in the background and this gives the "numpy" pair, unless CFMPA_KERNEL_COMPILE=wait
+    (``_kernel_cache.numpy_while_cold``, docs/model.md §7.5) or ``wait`` (the kernel named,
+    compiled in the foreground at its first call: what a check of that kernel needs)."""
+    return REGISTRY[name if wait and name in REGISTRY else resolved(name)].load()
+
+
+def resolved(name: str = "fast") -> str:
+    """The kernel ``kernels(name)`` gives: ``name``, or "numpy" for "fast" while the fast
+    kernels' machine code is compiled in the background (what a run records and prints, so that
+    plan.json names the kernel that ran); ValueError for a name not in KERNELS."""
+    if name not in REGISTRY:
         raise ValueError(f"kernel={name!r} is not one of {', '.join(KERNELS)}")
-    return kernel.load()
+    if name == "fast":
+        from ._kernel_cache import numpy_while_cold
+        if numpy_while_cold():
+            return "numpy"
+    return name
 
 
 def kernel_name(build: Callable[..., Any], search: Callable[..., Any]) -> str:
     """The name of the pair ``(build, search)``, "custom" for anything not in KERNELS."""
     for name in KERNELS:
-        if kernels(name) == (build, search):
+        if REGISTRY[name].load() == (build, search):
             return name
     return "custom"

@@ -104,13 +104,14 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
         return early
     N, m, n, start, goal, free, reason, labels = setup
     keys, dag_pred = _dag_phase(free, start, labels)
-    found = _static_phase(free[N], keys, goal, labels)
-    if found is None:
-        result = SearchResult.no_path(reason or REASON_UNREACHABLE)
-    else:
-        key, last, static_pred, static_from = found
-        path = _unwind(goal, last, start, static_pred, static_from, dag_pred)
-        result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
+    with dag_pred:                  # its temporary file closed once the path is walked back
+        found = _static_phase(free[N], keys, goal, labels)
+        if found is None:
+            result = SearchResult.no_path(reason or REASON_UNREACHABLE)
+        else:
+            key, last, static_pred, static_from = found
+            path = _unwind(goal, last, start, static_pred, static_from, dag_pred)
+            result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
     if labels is None:
         return result
     return replace(result, witness=labels.witness(found=found is not None))
@@ -158,6 +159,17 @@ class BackPointers:
     def spilled(self) -> int:
         """The steps whose pointers are in the temporary file."""
         return len(self._offsets)
+
+    def close(self) -> None:
+        """Close (and so remove) the temporary file, once the path is walked back; idempotent."""
+        if self._file is not None:
+            self._file.close()
+
+    def __enter__(self) -> BackPointers:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def _settle(self) -> None:
         """Every step made so far is finished: past ``spill_bytes`` held, to the file."""
@@ -252,8 +264,10 @@ class WitnessLabels:
             # Widened, "no label" stays "no label" in the steps already put (the old type's
             # largest value is a label value in uint32).
             if self.spills is not None:
-                self.spills = (self.spills[0].widened(np.uint32),
-                               self.spills[1].widened(np.uint32))
+                old = self.spills
+                self.spills = (old[0].widened(np.uint32), old[1].widened(np.uint32))
+                for spill in old:
+                    spill.close()
             else:
                 self.j1, self.j2 = (np.where(a == none, np.iinfo(np.uint32).max,
                                              a.astype(np.uint32)) for a in (self.j1, self.j2))

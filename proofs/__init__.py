@@ -38,6 +38,7 @@ from ._runner import (
     ProveRun,
     collect_obligations,
     compare_ids,
+    cvc5_tally,
     default_workers,
     expected_ids,
     is_bundled,
@@ -57,7 +58,8 @@ __all__ = [
     "SCENARIO_CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations",
     "CheckQuery", "DEFINITIONAL", "EXPECTED_VERDICTS", "FIXED_IDS", "Method", "Obligation",
     "Proof", "ProveRun",
-    "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "default_workers",
+    "VC", "VCResult", "Verdict", "Z3Query", "collect_obligations", "compare_ids", "cvc5_tally",
+    "default_workers",
     "discharge", "expected_ids", "is_bundled", "kind_of", "obligation_summary", "pinned_verdict",
     "render_report", "summary_problems",
     "run_obligations", "run_prove", "run_record", "scenarios_note", "selected",
@@ -66,13 +68,15 @@ __all__ = [
 
 def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path | None = None,
               only: Iterable[str] | None = None, stream: TextIO | None = None,
-              repin: bool = False, workers: int | None = None) -> int:
+              repin: bool = False, workers: int | None = None,
+              recheck_undecided: bool = False) -> int:
     """Discharge the obligations (all, or those ``only`` selects), print the summary (a line per
     group on stderr as it ends, before), write ``out_dir/results.json``; 0 iff every verdict
     is the pinned one and no id is missing, extra or repeated, 1 otherwise. Raises InputError
     (exit 2) for a ``--scenarios`` that is not a folder, a folder other than the bundled one
     with no scenario file, or an ``--only`` pattern that selects no expected obligation, or
-    ``workers`` below 1 (``--workers``)."""
+    ``workers`` below 1 (``--workers``). ``recheck_undecided``: replay in cvc5 the statements it
+    did not decide when pinned too (else their answer is the lock's, said so)."""
     picks = None if only is None else list(only)
     if workers is not None and workers < 1:
         raise InputError("--workers", str(workers), "must be at least 1 (1: one process)")
@@ -94,7 +98,8 @@ def run_prove(*, out_dir: str | Path = "build/proofs", scenarios_dir: str | Path
     run = run_obligations(obligations, out_dir, expected, note=scenarios_note(sdir),
                           record=run_record(sdir), repin=repin,
                           workers=default_workers() if workers is None else workers,
-                          controls=controls, progress=sys.stderr)
+                          controls=controls, progress=sys.stderr,
+                          recheck_undecided=recheck_undecided)
     (stream or sys.stdout).write(render_report(run))
     return 0 if run.ok else 1
 

@@ -181,14 +181,17 @@ def _rejected(failures: list[Any], want: Sequence[str] = ()) -> tuple[str, str]:
 
 def _forged_witness() -> tuple[str, str]:
     c = _case()
-    j1, j2 = c.best.witness.j1.copy(), c.best.witness.j2.copy()
+    w = c.best.witness
+    if w is None or not isinstance(w.j1, np.ndarray) or not isinstance(w.j2, np.ndarray):
+        raise ControlNotMade("the small workcell's search gave no labels in memory")
+    j1, j2 = w.j1.copy(), w.j2.copy()
     N, (gi, gj) = c.dr.shape[0] - 1, c.goal
     # Claim a better optimum: the goal's settled labels one below the path's cost.
     settled = j1[N, :, gi, gj] == c.best.J1
-    _require(bool(settled.any()) and c.best.J1 > 0, "no goal label carries the path's J1")
+    _require(bool(settled.any()) and (c.best.J1 or 0) > 0, "no goal label carries the path's J1")
     j1[N, settled, gi, gj] -= 1
     forged = Witness.of_labels(j1, j2)
-    _require(not np.array_equal(forged.j1, c.best.witness.j1), "the forgery changed nothing")
+    _require(not np.array_equal(j1, w.j1), "the forgery changed nothing")
     # A lowered goal label breaks the edge into that goal state (or, reached otherwise, the goal).
     return _rejected(check_witness(c.dr, c.start, c.goal, c.best, forged),
                      ("witness.edge", "witness.goal"))
@@ -408,7 +411,7 @@ def premise_controls() -> list[Control]:
             out.append(Control(f"Control.Safety.{v}.composition.without[{i}]",
                                f"Safety.{v}.composition", f"without: {name}",
                                ("refuted", "unknown"),
-                               lambda v=v, i=i: _without(v, i)))
+                               functools.partial(_without, v, i)))
     return out
 
 
@@ -416,7 +419,7 @@ def collect_controls(only: Sequence[str] | None = None) -> list[Control]:
     """The controls of ``cfmpa prove``, checkers' wrong inputs first, then their right inputs,
     the harness's, the compositions': all, or (``only``, as ``--only``) those whose id or whose
     composition is selected."""
-    from ._runner import selected
+    from ._select import selected
 
     return [c for c in checker_controls() + positive_controls() + harness_controls()
             + premise_controls() if selected(c.id, only) or selected(c.checker, only)]

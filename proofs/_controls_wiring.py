@@ -28,7 +28,7 @@ which pieces or which label the checker reads, run by every ``cfmpa prove``.
 
 - loader.spacing_above_bound: the workcell ``small`` with the principal's first joint fast enough
   that omega dt is the double 3.14, just above the lattice spacing the safety proofs assume
-  (their G_MAX, 157/50, read from proofs/_obl_safety.py); the loader must refuse it, naming
+  (their G_MAX, 157/50, read from proofs/_z3vec.py); the loader must refuse it, naming
   that joint's omega. A loader admitting it would build regions outside the proved lemma.
 
 And their right inputs: ``Control.accept.monitor.gap`` (a gap inside one piece, within the tube:
@@ -196,7 +196,10 @@ def _raised_start() -> tuple[str, str]:
     c = _case()
     wait = MOVES.index((0, 0))
     at = (0, wait, c.start[0], c.start[1])
-    j1, j2 = c.best.witness.j1.copy(), c.best.witness.j2.copy()
+    w = c.best.witness
+    if w is None or not isinstance(w.j1, np.ndarray) or not isinstance(w.j2, np.ndarray):
+        raise ControlNotMade("the small workcell's search gave no labels in memory")
+    j1, j2 = w.j1.copy(), w.j2.copy()
     _require(int(j1[at]) == 0 and int(j2[at]) == 0, "the genuine start label is not (0, 0)")
     j2[at] = 1
     out, detail = _rejected(check_witness(c.dr, c.start, c.goal, c.best,
@@ -300,7 +303,7 @@ def _accept_kinds() -> tuple[str, str]:
 
 def _proofs_bound() -> Fraction:
     """The lattice spacing bound the safety proofs assume (Safety.region_statement's g_q)."""
-    from ._obl_safety import G_MAX
+    from ._z3vec import G_MAX
 
     return Fraction(G_MAX.numerator_as_long(), G_MAX.denominator_as_long())
 

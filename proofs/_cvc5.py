@@ -25,11 +25,9 @@ from dataclasses import dataclass
 __all__ = ["CVC5_TIMEOUT_MS", "Cvc5Answer", "Cvc5Pool", "Cvc5Worker", "cvc5_version"]
 
 #: cvc5's time limit per query. A run replays only the statements cvc5 decided when they were
-#: pinned (``_pins.cvc5_skips``), so a query that runs into it is rare; ``--repin`` tries all.
+#: pinned (``_pins.cvc5_skips``: the others' answer is the pinned one), so a query that runs
+#: into it is rare; ``--repin`` and ``--recheck-undecided`` replay every one on this budget.
 CVC5_TIMEOUT_MS = 5_000
-#: cvc5's limit on a statement it did not decide when pinned: re-run every time (it may decide
-#: it now, with another version or machine), on a shorter budget than a new statement's.
-CVC5_RECHECK_MS = 1_500
 #: How long past its own limit a query may run before the worker is killed.
 _GRACE_S = 1.0
 #: The worker's start-up (importing cvc5), allowed on top on a query that starts it.

@@ -5,8 +5,9 @@ an ``ExtractionError`` naming the line):
 
 - the function's parameters are known names: sizes (``N``, ``m``, ``n`` -> ``Z3Dims``), arrays
   (``P``, ``SL``, ``SR``), helpers (``region_left`` -> ``regionL_<variant>``, ``region_right`` ->
-  ``regionR``, ``region_rest`` -> ``regionRest_tight``, ``inter`` -> ``Inter``: the uninterpreted
-  symbols of Theorems 1 and 3) and ``variant``; no decorators; a docstring may come first;
+  ``regionR``, ``region_rest`` -> ``regionRest_<variant>``, ``inter`` -> ``Inter``: the uninterpreted
+  symbols of Theorems 1 and 3) and ``rule`` (the variant's ``spec.Variant.rule``); no
+  decorators; a docstring may come first;
 - the body is a sequence of *phases*, each a perfect nest ``for v in range(lo, hi):`` (two
   arguments, no ``else``, one statement per body) whose innermost statement stores one cell,
   ``A[idx] = e``, or ``if c: A[idx] = e1`` ``else: A[idx] = e2`` with the same cell in both;
@@ -14,7 +15,8 @@ an ``ExtractionError`` naming the line):
   not mention a counter (``P[N, i, j]``);
 - expressions: integer literals, sizes, counters, ``+`` and ``-``, calls of the helpers, reads
   ``A[idx]`` of an array whose nest has finished (written by one phase, indexed by its counters),
-  and ``x if variant == "..." else y``, decided at extraction; loop bounds use no counter.
+  and ``x if rule.<field> else y``, a Boolean field of the variant's rule, decided at
+  extraction (the code asks the rule, never the variant's name); loop bounds use no counter.
 
 The loop invariants are generated, in the shape the hand-written ones had. For a phase with
 counters v_1 .. v_d storing f (the stored value with every read of an earlier array replaced by
@@ -36,6 +38,7 @@ from typing import Any
 
 import z3
 
+from ..spec import Variant
 from ..spec.z3defs import REGION, Z3Dims, inter
 from ._while import Cmd, For, If, Seq, Store
 
@@ -84,7 +87,7 @@ def _helpers(variant: str) -> dict[str, tuple[int, Callable[..., z3.ExprRef]]]:
     ints = z3.IntSort()
     region_l = z3.Function(f"regionL_{variant}", ints, REGION)
     region_r = z3.Function("regionR", ints, ints, REGION)
-    rest = z3.Const("regionRest_tight", REGION)
+    rest = z3.Const(f"regionRest_{variant}", REGION)
     return {"region_left": (1, region_l), "region_right": (2, region_r),
             "region_rest": (0, lambda: rest), "inter": (2, inter)}
 
@@ -153,13 +156,17 @@ class _Extractor:
         raise self.fail(e, f"expression {type(e).__name__} outside the subset")
 
     def decide(self, test: ast.expr) -> bool:
-        if (isinstance(test, ast.Compare) and isinstance(test.left, ast.Name)
-                and test.left.id == "variant" and len(test.ops) == 1
-                and isinstance(test.ops[0], ast.Eq)
-                and isinstance(test.comparators[0], ast.Constant)
-                and isinstance(test.comparators[0].value, str)):
-            return self.variant == test.comparators[0].value
-        raise self.fail(test, 'a conditional expression needs the test variant == "..."')
+        if (isinstance(test, ast.Attribute) and isinstance(test.value, ast.Name)
+                and test.value.id == "rule"):
+            try:
+                value = getattr(Variant(self.variant).rule, test.attr)
+            except (ValueError, AttributeError) as exc:
+                raise self.fail(test, f"rule.{test.attr}: {exc}") from None
+            if isinstance(value, bool):
+                return value
+            raise self.fail(test, f"rule.{test.attr} is not a Boolean field of the rule")
+        raise self.fail(test, "a conditional expression needs the test rule.<field>, a "
+                              "Boolean field of the variant's rule")
 
     def index_nodes(self, e: ast.Subscript) -> list[ast.expr]:
         sl = e.slice
@@ -191,7 +198,7 @@ class _Extractor:
         fn = self.tree
         if fn.decorator_list:
             raise self.fail(fn, "decorators")
-        known = set(self.sizes) | set(ARRAYS) | set(self.helpers) | {"variant"}
+        known = set(self.sizes) | set(ARRAYS) | set(self.helpers) | {"rule"}
         for a in fn.args.posonlyargs + fn.args.args + fn.args.kwonlyargs:
             if a.arg not in known:
                 raise self.fail(fn, f"parameter {a.arg!r} is not a known name")
@@ -217,7 +224,7 @@ class _Extractor:
             raise self.fail(node, "the loop target is not a name")
         name = node.target.id
         if name in counters or name in self.sizes or name in ARRAYS or name in self.helpers \
-                or name == "variant":
+                or name == "rule":
             raise self.fail(node, f"counter {name!r} shadows a name in scope")
         it = node.iter
         if not (isinstance(it, ast.Call) and isinstance(it.func, ast.Name)
@@ -259,7 +266,7 @@ class _Extractor:
             inner = If(c_raw, Store(array, idx, then_raw[0]), Store(array, idx, else_raw))
         # Invariants from the inside out.
         earlier = [p.fact() for p in self.phases]
-        cmd = inner
+        cmd: Cmd = inner
         for t in range(len(headers) - 1, -1, -1):
             name, lo, hi = headers[t]
             label = f"{letter}.{name}"
@@ -304,9 +311,11 @@ class _Extractor:
             if len(node.body) != 1 or len(node.orelse) != 1:
                 raise self.fail(node, "an if whose branches are not one store each "
                                       "(both branches must store the cell)")
-            n1, idx1, v1 = self.target(node.body[0], counters)
-            n2, idx2, v2 = self.target(node.orelse[0], counters)
-            if n1 != n2 or ast.dump(node.body[0].targets[0]) != ast.dump(node.orelse[0].targets[0]):
+            b, e = node.body[0], node.orelse[0]
+            n1, idx1, v1 = self.target(b, counters)
+            n2, idx2, v2 = self.target(e, counters)
+            assert isinstance(b, ast.Assign) and isinstance(e, ast.Assign)   # target() said so
+            if n1 != n2 or ast.dump(b.targets[0]) != ast.dump(e.targets[0]):
                 raise self.fail(node, "the branches store different cells")
             c_raw, c_spec = self.expr(node.test, counters)
             if not z3.is_bool(c_raw):
@@ -336,7 +345,11 @@ def extract(fn: Callable[..., Any] | None = None, variant: str = "original", *,
     """The program of ``fn`` (or of ``source``, a function's text) for ``variant``, with generated
     invariants over ``pre``. ``forget`` names loops whose invariant omits the outermost loop's
     fact (a deliberately weak invariant, for the negative tests)."""
-    text = textwrap.dedent(source if source is not None else inspect.getsource(fn))
+    if source is None:
+        if fn is None:
+            raise ExtractionError("line 1: neither a function nor its source to extract")
+        source = inspect.getsource(fn)
+    text = textwrap.dedent(source)
     lines = text.splitlines()
     try:
         module = ast.parse(text)

@@ -188,7 +188,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         "polygon grown by the square is the hull of the vertices moved by the square's corners "
         "('hull of sums stated', Safety.tool_region); (2) a tool of fewer than 16 vertices is "
         "the 16-vertex one with a vertex repeated; (3) the numpy stand-in that runs impl's "
-        "functions on terms (proofs/_obl_tools.py, _Numpy) computes what numpy computes; (4) "
+        "functions on terms (proofs/_onterms.py, _Numpy) computes what numpy computes; (4) "
         "the pairs BuiltDR tests, spec.pairs_to_test, are the pairs of spec.parts whose "
         "intervals (spec.part_height) spec.heights_overlap calls overlapping, as the "
         "compositions read them (an arm's tool present or not, each part's interval or None).",

@@ -39,111 +39,36 @@ import functools
 import inspect
 import textwrap
 import types
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import z3
 
 from .. import spec
+from ._obl_groups import GROUP_CERTIFICATE, GROUP_EXACT, GROUP_TUBE
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
+from ._onterms import ExtractionError, sqrt_free
+from ._onterms import term as _term
+from ._z3vec import Hyp
+from ._z3vec import add as _add
+from ._z3vec import dot as _dot
+from ._z3vec import j as _j
+from ._z3vec import norm as _norm
+from ._z3vec import scale as _scale
+from ._z3vec import sub as _sub
+from ._z3vec import unit_poly as _unit
+from ._z3vec import vec as _vec
+from ._z3vec import veq as _eq
+from ._z3vec import within as _within
 
 __all__ = ["GROUP_CERTIFICATE", "GROUP_EXACT", "GROUP_TUBE",
            "ExtractionError", "ToleranceParts", "certificate_vcs", "constants_obligations",
            "exact_vcs", "on_terms", "sqrt_free", "tolerance_parts", "tube_factor_vcs"]
 
-GROUP_CERTIFICATE = "Continuous-time certificate (docs/model.md §7.2)"
-GROUP_TUBE = "Trajectories (docs/model.md §12)"
-GROUP_EXACT = "Exact re-decision (docs/model.md §7.2)"
-
-Vec = tuple[z3.ArithRef, z3.ArithRef]
-Hyp = tuple[str, z3.BoolRef]
-
-
-class ExtractionError(ValueError):
-    """The code has a shape the reading of ``tolerance_rad`` does not know (names the line)."""
-
 
 # --- small helpers ------------------------------------------------------------------------------
-
-def _vec(name: str) -> Vec:
-    return z3.Real(f"{name}.x"), z3.Real(f"{name}.y")
-
-
-def _sub(a: Vec, b: Vec) -> Vec:
-    return a[0] - b[0], a[1] - b[1]
-
-
-def _add(a: Vec, b: Vec) -> Vec:
-    return a[0] + b[0], a[1] + b[1]
-
-
-def _scale(k: Any, a: Vec) -> Vec:
-    return k * a[0], k * a[1]
-
-
-def _j(a: Vec) -> Vec:
-    """The quarter turn J(x, y) = (-y, x)."""
-    return -a[1], a[0]
-
-
-def _eq(a: Vec, b: Vec) -> z3.BoolRef:
-    return z3.And(a[0] == b[0], a[1] == b[1])
-
-
-def _dot(a: Vec, b: Vec) -> z3.ArithRef:
-    return a[0] * b[0] + a[1] * b[1]
-
-
-def _norm(n: z3.ArithRef, v: Vec) -> z3.BoolRef:
-    """n is the length of v: n >= 0 and n^2 = |v|^2."""
-    return z3.And(n >= 0, n * n == v[0] * v[0] + v[1] * v[1])
-
-
-def _unit(u: Vec) -> z3.BoolRef:
-    return u[0] * u[0] + u[1] * u[1] == 1
-
-
-def _within(x: z3.ArithRef, b: Any) -> z3.BoolRef:
-    """|x| <= b as -b <= x <= b."""
-    return z3.And(x <= b, -x <= b)
-
-
-def _is_sqrt(e: z3.ExprRef) -> bool:
-    if not (z3.is_app_of(e, z3.Z3_OP_POWER) and e.num_args() == 2):
-        return False
-    k = e.arg(1)
-    return z3.is_rational_value(k) and (k.numerator_as_long(), k.denominator_as_long()) == (1, 2)
-
-
-def sqrt_free(terms: Sequence[z3.ExprRef]) -> tuple[list[z3.ExprRef], list[Hyp]]:
-    """``terms`` with every square root x ** (1/2) (what ``hypot_of`` / ``sqrt_of`` build on
-    terms) replaced by a real ``sqrt(x)``, and for each the hypothesis of its exact meaning,
-    sqrt(x) >= 0 and sqrt(x)^2 = x (the code's square roots are of sums of squares, x >= 0)."""
-    found: dict[int, tuple[z3.ExprRef, z3.ArithRef]] = {}
-    order: list[int] = []
-
-    def walk(e: z3.ExprRef) -> None:
-        for k in range(e.num_args()):
-            walk(e.arg(k))
-        if _is_sqrt(e) and e.get_id() not in found:
-            found[e.get_id()] = (e, z3.Real("sqrt(" + " ".join(str(e.arg(0)).split()) + ")"))
-            order.append(e.get_id())
-
-    for t in terms:
-        walk(t)
-    pairs = [found[i] for i in order]
-    # Innermost first (walk is post-order), so each root's own argument is already free of roots.
-    hyps: list[Hyp] = []
-    subst: list[tuple[z3.ExprRef, z3.ExprRef]] = []
-    for e, s in pairs:
-        arg = z3.substitute(e.arg(0), *subst) if subst else e.arg(0)
-        hyps.append((f"{s} >= 0 and its square is its argument", z3.And(s >= 0, s * s == arg)))
-        subst.append((e, s))
-    out = [z3.substitute(t, *subst) if subst else t for t in terms]
-    return out, hyps
-
 
 @dataclass(frozen=True)
 class _SymArm:
@@ -169,10 +94,6 @@ def _arm(prefix: str = "") -> tuple[_SymArm, list[Hyp]]:
                                    z3.And(l1 > 0, l2 > 0, w > 0))]
 
 
-def _term(x: Any) -> z3.ArithRef:
-    return x if isinstance(x, z3.ExprRef) else z3.RealVal(x)
-
-
 # --- Certificate.lipschitz ----------------------------------------------------------------------
 
 def _rectangle(arm: _SymArm, link: int, a: z3.ArithRef, b: z3.ArithRef) -> Hyp:
@@ -191,7 +112,7 @@ def _reach_vc(link: int, of: str) -> VC:
     u1, u2 = _vec("u1"), _vec("u2")
     base = (z3.RealVal(0), z3.RealVal(0))
     elbow = _scale(arm.links[0], u1)
-    rb, re_ = spec.reach(arm, link)
+    rb, re_ = spec.reach(cast(Any, arm), link)     # a _SymArm: the fields reach reads
     (rb, re_), roots = sqrt_free([_term(rb), _term(re_)])
     nb, ne, nl = z3.Reals("|p-base| |p-elbow| |elbow-base|")
     one, zero = z3.RealVal(1), z3.RealVal(0)
@@ -255,8 +176,8 @@ def _speed_vc(link: int) -> VC:
     w1, w2 = z3.Reals("w1 w2")
     p, elbow = _vec("p"), _vec("elbow")
     base = (z3.RealVal(0), z3.RealVal(0))
-    rb, re_ = spec.reach(arm, link)
-    bound = spec.link_speeds(arm, np.array([[w1, w2]], dtype=object))[0, link]
+    rb, re_ = spec.reach(cast(Any, arm), link)     # a _SymArm: the fields they read
+    bound = spec.link_speeds(cast(Any, arm), np.array([[w1, w2]], dtype=object))[0, link]
     (rb, re_, bound), roots = sqrt_free([_term(rb), _term(re_), _term(bound)])
     nb, ne, nv = z3.Reals("|p-base| |p-elbow| |v|")
     if link == 0:
@@ -391,10 +312,11 @@ def _eval(node: ast.AST, env: dict[str, Any], glb: dict[str, Any]) -> Any:
         return z3.And(*vals) if isinstance(node.op, ast.And) else z3.Or(*vals)
     if isinstance(node, ast.Compare) and len(node.ops) == 1:
         x, y = ev(node.left), ev(node.comparators[0])
-        ops = {ast.Lt: lambda: x < y, ast.LtE: lambda: x <= y, ast.Gt: lambda: x > y,
-               ast.GtE: lambda: x >= y}
-        if type(node.ops[0]) in ops:
-            return ops[type(node.ops[0])]()
+        cmps: dict[type[ast.cmpop], Callable[[], Any]] = {
+            ast.Lt: lambda: x < y, ast.LtE: lambda: x <= y, ast.Gt: lambda: x > y,
+            ast.GtE: lambda: x >= y}
+        if type(node.ops[0]) in cmps:
+            return cmps[type(node.ops[0])]()
     raise ExtractionError(f"line {getattr(node, 'lineno', '?')}: {ast.dump(node)[:80]} is "
                           "outside the subset")
 
@@ -499,7 +421,7 @@ def _lipschitz_vc() -> VC:
     names = []
     for side, arm in (("left", left), ("right", right)):
         for link in (0, 1):
-            terms += [_term(x) for x in spec.reach(arm, link)]
+            terms += [_term(x) for x in spec.reach(cast(Any, arm), link)]
             names.append(f"{side} link {link + 1}")
     # The roots' meaning (s >= 0, s^2 = x) is not needed: L bounds the four sums whatever the
     # roots are, and without it the VC is linear (with it, nlsat ran out of its 20 s).

@@ -23,15 +23,12 @@ from ..spec.z3defs import (
     subset,
 )
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
+from ._z3vec import vec as _vec
 
 __all__ = ["geometry_obligations"]
 
 GROUP_DEFS = "Definitions 1-3, Lemmas 1-2"
 GROUP_SEP = "Separation and distance"
-
-
-def _vec(name: str) -> tuple[z3.ArithRef, z3.ArithRef]:
-    return z3.Real(f"{name}.x"), z3.Real(f"{name}.y")
 
 
 def _set(name: str) -> z3.ArrayRef:

@@ -18,7 +18,6 @@ from fractions import Fraction
 import sympy as sp
 import z3
 
-from ..spec import MAX_SPACING
 from ._obligation import (
     VC,
     CheckOutcome,
@@ -30,37 +29,21 @@ from ._obligation import (
     check_source,
 )
 from ._sos import Certificate, Square
+from ._z3vec import G_MAX, Vec
+from ._z3vec import add as _add
+from ._z3vec import comb as _comb
+from ._z3vec import n2 as _n2
+from ._z3vec import rot as _rot
+from ._z3vec import sub as _sub
+from ._z3vec import vec as _vec
 
 __all__ = ["margin_obligations"]
 
 GROUP = "Swept regions (docs/model.md §4)"
 
-#: A rational below pi: the lemma is stated for turns g <= the loader's spacing bound
-#: (spec.MAX_SPACING, 157/50 = 3.14 rad, read; below pi: Safety.*.composition's spacing_below_pi);
-#: lattice spacings are of the order of omega dt, a few hundredths.
-G_MAX = z3.Q(MAX_SPACING.numerator, MAX_SPACING.denominator)
-
-Vec = tuple[z3.ArithRef, z3.ArithRef]
-
-
-def _n2(v: Vec) -> z3.ArithRef:
-    return v[0] * v[0] + v[1] * v[1]
-
-
-def _sub(a: Vec, b: Vec) -> Vec:
-    return (a[0] - b[0], a[1] - b[1])
-
-
-def _add(a: Vec, b: Vec) -> Vec:
-    return (a[0] + b[0], a[1] + b[1])
-
-
-def _comb(a: Vec, b: Vec, lam: z3.ArithRef) -> Vec:
-    return ((1 - lam) * a[0] + lam * b[0], (1 - lam) * a[1] + lam * b[1])
-
-
-def _vec(name: str) -> Vec:
-    return z3.Real(f"{name}.x"), z3.Real(f"{name}.y")
+# The lemma is stated for turns g <= G_MAX, the loader's spacing bound (spec.MAX_SPACING,
+# 157/50 = 3.14 rad, read; below pi: Safety.*.composition's spacing_below_pi); lattice spacings
+# are of the order of omega dt, a few hundredths.
 
 
 @dataclass(frozen=True)
@@ -107,11 +90,6 @@ def _arc() -> _Arc:
 
 def _arc_chord() -> Z3Query:
     return Z3Query((_arc().vc,))
-
-
-def _rot(cs: Vec, v: Vec) -> Vec:
-    """v turned by the angle whose (cos, sin) is cs."""
-    return (cs[0] * v[0] - cs[1] * v[1], cs[1] * v[0] + cs[0] * v[1])
 
 
 def _place(o: Vec, cs: Vec, v: Vec) -> Vec:
@@ -200,7 +178,8 @@ def _sweep_margin() -> Z3Query:
         body = z3.Implies(z3.And([f for _, f in vc.hypotheses]), vc.goal)
         return _abstract_norms(z3.substitute(body, *pairs), sq)
 
-    def pairs(*groups: tuple[object, object]) -> list[tuple[z3.ExprRef, z3.ExprRef]]:
+    def pairs(*groups: tuple[z3.ExprRef | tuple[z3.ExprRef, ...], z3.ExprRef | tuple[z3.ExprRef, ...]]
+              ) -> list[tuple[z3.ExprRef, z3.ExprRef]]:
         out: list[tuple[z3.ExprRef, z3.ExprRef]] = []
         for name, term in groups:
             out += list(zip(name, term)) if isinstance(name, tuple) else [(name, term)]

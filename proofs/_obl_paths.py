@@ -9,11 +9,13 @@ program that calls the search through its contract (null iff no valid path, else
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import z3
 
+from ..spec import Variant
 from ..spec.z3defs import (
     REGION,
     Blocked,
@@ -72,16 +74,23 @@ def _setting(array: str = "P") -> _Setting:
                     (z3.Int("start.i"), z3.Int("start.j")), (z3.Int("goal.i"), z3.Int("goal.j")))
 
 
-#: Variants whose rest layer is an independent region (not layer N-1's): the tight variant's
-#: principal at rest at its goal, and the generic family X of Prop8.prestrength_thm4.
-_OWN_REST = ("tight", "X")
+#: The generic region family of Prop8.prestrength_thm4: not a variant, its rest layer an
+#: independent region.
+GENERIC = "X"
+
+
+def _own_rest(variant: str) -> bool:
+    """Whether the rest layer is an independent region (not layer N-1's): the generic family,
+    or a variant whose rule puts the principal at rest at its goal (spec.Variant.rest_at_goal;
+    the tight variant)."""
+    return variant == GENERIC or Variant(variant).rest_at_goal
 
 
 def rest_region(variant: str) -> z3.ExprRef:
     """The principal's region in the rest layer: ``regionRest_<variant>`` (the name
-    Thm3.builtdr_tight's postcondition uses) for the variants in ``_OWN_REST``, else layer
-    N-1's, as in the paper."""
-    if variant in _OWN_REST:
+    Thm3.builtdr_tight's postcondition uses) when ``_own_rest``, else layer N-1's, as in the
+    paper."""
+    if _own_rest(variant):
         return z3.Const(f"regionRest_{variant}", REGION)
     region_l = z3.Function(f"regionL_{variant}", z3.IntSort(), REGION)
     return region_l(Z3Dims.named().N - 1)
@@ -391,7 +400,7 @@ def path_obligations() -> list[Obligation]:
 
 # --- searchoptpath's top level: Theorems 2 and 4 ----------------------------------------------
 
-def search_top_level(st: _Setting, found: z3.BoolRef, R: Z3PathVar):
+def search_top_level(st: _Setting, found: z3.BoolRef, R: Z3PathVar) -> tuple[If, z3.BoolRef]:
     """searchoptpath: report no path when the start is blocked at step 0 or the goal in the rest
     layer, else call the search, which returns null iff no path is valid, else an optimal one."""
     L = bound_path("none!L")
@@ -420,7 +429,7 @@ def _search_post(st: _Setting, found: z3.BoolRef, R: Z3PathVar, no_path: z3.Bool
         held = z3.And(pos[0] == i, pos[1] == j, in_grid(st.d, (i, j)))
         parts.append(z3.Implies(found, z3.ForAll([k, i, j], z3.Implies(
             z3.And(0 <= k, k < st.d.N, held), st.P[k, i, j] == 0))))
-        if variant in _OWN_REST:
+        if _own_rest(variant):
             # No layer N-1 reading here: the rest layer P[N] is free wherever the path waits.
             parts.append(z3.Implies(found, z3.ForAll([k, i, j], z3.Implies(
                 z3.And(st.d.N <= k, held), st.P[st.d.N, i, j] == 0))))
@@ -480,36 +489,31 @@ def theorem_obligations() -> list[Obligation]:
             "P[N-1] = 0 for N <= k < LENGTH}}: WP of the top level, the search by its contract. "
             "Only the wrapper is proved: the search itself is assumed to meet its contract "
             "(ledger A6) until it is certified.")
-    tight = ("{P = Thm3.builtdr_tight's postcondition (tight regions regionL_tight(k) for k < N; "
-             "the rest layer P[N] from regionRest_tight, the principal at rest at its goal, an "
-             "opaque region independent of layer N-1)} searchoptpath {no path reported iff no "
+    tight = ("{{P = {bid}'s postcondition ({v} regions regionL_{v}(k) for k < N; "
+             "the rest layer P[N] from regionRest_{v}, the principal at rest at its goal, an "
+             "opaque region independent of layer N-1)}} searchoptpath {{no path reported iff no "
              "valid path; else the result is an optimal valid path, collision-free at every "
-             "step k >= 0 against regionL_tight(k) for k < N and regionRest_tight from N on, "
-             "with P[k] = 0 along it for k < N and P[N] = 0 for every k >= N}: WP of the top "
-             "level, the search by its contract. The tight variant's search safety. Only the "
+             "step k >= 0 against regionL_{v}(k) for k < N and regionRest_{v} from N on, "
+             "with P[k] = 0 along it for k < N and P[N] = 0 for every k >= N}}: WP of the top "
+             "level, the search by its contract. The {v} variant's search safety. Only the "
              "wrapper is proved: the search itself is assumed to meet its contract (ledger A6).")
-    return [
-        Obligation("Thm2.searchoptpath", GROUP_THM, "Theorem 2",
-                   text.format(n=1, v="original"), Z, P, lambda: _thm("original"),
-                   label=SEARCH_ASSUMED,
-                   summary=("Theorem 2: searchoptpath (original) reports no path only when none "
-                            "exists, and otherwise returns a least-cost path that is "
-                            "collision-free at every step; the search inside it is taken at its "
-                            "contract unless its witness is checked.")),
-        Obligation("Thm4.searchoptpath", GROUP_THM, "Theorem 4",
-                   text.format(n=3, v="modified"), Z, P, lambda: _thm("modified"),
-                   label=SEARCH_ASSUMED,
-                   summary=("Theorem 4: searchoptpath (modified) reports no path only when none "
-                            "exists, and otherwise returns a least-cost path that is "
-                            "collision-free at every step; the search inside it is taken at its "
-                            "contract unless its witness is checked.")),
-        Obligation("Thm4.searchoptpath_tight", GROUP_THM, "Theorem 4, tight variant (docs/model.md §4)",
-                   tight, Z, P, lambda: _thm("tight"), label=SEARCH_ASSUMED,
-                   summary=("Theorem 4, tight: searchoptpath (tight) reports no path only when "
-                            "none exists, and otherwise returns a least-cost path that is "
-                            "collision-free at every step; the search inside it is taken at its "
-                            "contract unless its witness is checked.")),
-    ]
+    out = []
+    for v in Variant:
+        r = v.rule
+        bdr, thm = r.theorems
+        ident = f"Thm{thm}.searchoptpath" + ("" if r.in_paper else f"_{v}")
+        ref = f"Theorem {thm}" + ("" if r.in_paper else f", {v} variant ({r.source})")
+        bid = f"Thm{bdr}.builtdr" + ("" if r.in_paper else f"_{v}")
+        statement = (tight.format(v=v, bid=bid) if r.rest_at_goal
+                     else text.format(n=bdr, v=v))
+        out.append(Obligation(
+            ident, GROUP_THM, ref, statement, Z, P, functools.partial(_thm, v.value),
+            label=SEARCH_ASSUMED,
+            summary=(f"Theorem {thm}{'' if r.in_paper else f', {v}'}: searchoptpath ({v}) "
+                     "reports no path only when none exists, and otherwise returns a least-cost "
+                     "path that is collision-free at every step; the search inside it is taken "
+                     "at its contract unless its witness is checked.")))
+    return out
 
 
 # --- Property 8 and the corrected chain ---------------------------------------------------------
@@ -631,7 +635,7 @@ def _all_blocked() -> z3.ExprRef:
 def _prestrength() -> Z3Query:
     """Theorem 4 from Theorem 2 by precondition strengthening, with the right premise."""
     st = _setting()
-    generic, generic_smoke = _search("X", conservative=True, printed=False)
+    generic, generic_smoke = _search(GENERIC, conservative=True, printed=False)
     main_x = generic[0]
     m_m, r_m, _ = _regions("modified")
     exact = blocked_exact(st.P, st.d, motion=m_m, rest=r_m)

@@ -20,6 +20,7 @@ contracts check.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from fractions import Fraction
@@ -152,6 +153,20 @@ def _containment(s: Scenario) -> CheckOutcome:
     return CheckOutcome(rep.ok, detail, None if rep.ok else detail)
 
 
+def _chains() -> list[list[Variant]]:
+    """The variants' containment chains by their rules' ``within`` (``Variant.nesting``), each
+    from its innermost variant out: [[tight, modified, original]]."""
+    pairs = Variant.nesting()
+    outers = {o for _, o in pairs}
+    chains = []
+    for v in (i for i, _ in pairs if i not in outers):
+        chain = [v]
+        while (w := chain[-1].within) is not None:
+            chain.append(w)
+        chains.append(chain)
+    return chains
+
+
 def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
     """The fast kernels' D_R and answer, as cfmpa plan computes them, against Theorems 1-4's
     postconditions, decided by the spec alone: every cell, the path, and the search's witness;
@@ -163,7 +178,7 @@ def _translation(s: Scenario, variant: Variant) -> CheckOutcome:
     from ..impl import kernels
     from ..spec import check_witness, dr_cell_failures, dr_shape_failures, search_failures
 
-    build, search = kernels("fast")
+    build, search = kernels("fast", wait=True)   # the fast kernels themselves, never numpy's
     g = make_grid(s)
     start, goal = s.right.start_cell, s.right.goal_cell
     dr = build(s, variant, g, progress=False)
@@ -228,7 +243,8 @@ def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
                            spacing_conditions)
     if check is _containment:
         from ..impl import check_containment, contained_exactly, containment_slack
-        src += "\n" + check_source(check_containment, contained_exactly, containment_slack)
+        src += "\n" + check_source(check_containment, contained_exactly, containment_slack,
+                                  Variant.nesting)
     content = f"scenario {path.name} sha256 {s.sha256}\ncheck {what}\n\n{src}\n"
     return CheckQuery(lambda: check(s), content)
 
@@ -254,7 +270,7 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
     given (the workcells a report is about, in the order given)."""
     files = (scenario_files(scenarios) if isinstance(scenarios, (str, Path))
              else [Path(f) for f in scenarios])
-    out = []
+    out: list[Obligation] = []
     P, D = Verdict.PROVED, Method.DATA
     for f in files:
         first = len(out)
@@ -266,7 +282,7 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "readings can differ on a boundary: default's Tf = 1.2 = 60 * 0.02 and "
                        "limited-joints' Tf = 1.625 = 65 * 0.025 are exact multiples of dt in "
                        "decimal.",
-                       D, P, lambda f=f: _query(f, _time_grid, "time_grid"),
+                       D, P, functools.partial(_query, f, _time_grid, "time_grid"),
                        summary=(f"{f.stem}: the time steps cover the whole of the principal arm's "
                                 "motion, for the numbers as written in the file and as the computer "
                                 "stores them.")),
@@ -275,7 +291,7 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        f"exactly in the decimal reading (the speed limit as the file states it), "
                        f"and the float h the planner uses within rounding (1e-10 relative) of "
                        f"omega_q dt in both readings and <= 3.14 rad ({_READINGS}).",
-                       D, P, lambda f=f: _query(f, _cspace_grid, "cspace_grid"),
+                       D, P, functools.partial(_query, f, _cspace_grid, "cspace_grid"),
                        summary=(f"{f.stem}: the subordinate arm's grid of joint angles is no coarser "
                                 "than the angle its joints turn in one time step, as written and as "
                                 "stored.")),
@@ -287,21 +303,26 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                        "for every link of both arms at those spacings, is at least the lemma's "
                        "delta plus the snap slack SNAP g R per joint (ledger A10), exactly up "
                        "to 2^-48 relative float rounding (ledger A2).",
-                       D, P, lambda f=f: _query(f, _margin_side, "margin_side"),
+                       D, P, functools.partial(_query, f, _margin_side, "margin_side"),
                        summary=(f"{f.stem}: every angle step the swept regions use is at most 3.14 "
                                 "rad, and the margin the planner adds to each link is at least the "
                                 "margin lemma's bound.")),
             Obligation(scenario_check_id(f.stem, "containment"), group,
                        "docs/model.md §4 (containment chain)",
-                       f"{f.name}: region_tight ⊆ region_modified ⊆ region_original on the computed "
-                       "polygons, every layer and the rest layer, both links: every vertex of the "
+                       f"{f.name}: "
+                       + "; ".join(" ⊆ ".join(f"region_{v}" for v in c) for c in _chains())
+                       + " on the computed polygons, "
+                       "every layer and the rest layer, both links: every vertex of the "
                        "inner polygon on the inner side of every edge of the outer one, decided "
                        "exactly on the doubles (a filtered cross product, Fractions where the "
                        "float sign is not certain); the least float slack and a digest of the "
                        "polygons are reported.",
-                       D, P, lambda f=f: _query(f, _containment, "containment"),
-                       summary=(f"{f.stem}: the tight swept region lies inside the modified one, "
-                                "which lies inside the original one, in every layer and for both "
+                       D, P, functools.partial(_query, f, _containment, "containment"),
+                       summary=(f"{f.stem}: " + "; ".join(
+                                    f"the {c[0]} swept region lies inside the {c[1]} one"
+                                    + "".join(f", which lies inside the {x} one" for x in c[2:])
+                                    for c in _chains())
+                                + ", in every layer and for both "
                                 "links, decided exactly.")),
         ]
         for v in Variant:
@@ -310,21 +331,21 @@ def scenario_obligations(scenarios: str | Path | Sequence[str | Path]) -> list[O
                 scenario_check_id(f.stem, what), group,
                 "docs/model.md §7 (translation validation)",
                 f"{f.name}, {v.value}: the D_R that cfmpa plan uses (impl's fast BuiltDR) meets "
-                f"Theorem {1 if v is Variant.ORIGINAL else 3}'s postcondition at every cell "
+                f"Theorem {v.rule.theorems[0]}'s postcondition at every cell "
                 "(its shape, and each cell's value against the spec's own regions and "
                 "distances), and the fast searchoptpath's answer on it meets Theorem "
-                f"{2 if v is Variant.ORIGINAL else 4}'s (a found path valid under the fixed "
+                f"{v.rule.theorems[1]}'s (a found path valid under the fixed "
                 "is_path, its costs its own) with a witness that spec.check_witness accepts "
                 "(the path optimal, or no valid path at all); a found path's exact re-decision "
                 "(spec.exact_path_gaps, its loop run with the geometry replaced) visits every "
                 "(layer, cell) the fixed is_path reads, the rest layer included, and no other. A "
                 "check of the code that runs, on this workcell's data: not a proof for other "
                 "workcells.",
-                D, P, lambda f=f, v=v, what=what: _query(
-                    f, lambda s: _translation(s, v), what),
+                D, P, functools.partial(_query, f, functools.partial(_translation, variant=v),
+                                        what),
                 summary=(f"{f.stem}, {v.value}: the fast code's D_R and path meet Theorem "
-                         f"{1 if v is Variant.ORIGINAL else 3}'s and Theorem "
-                         f"{2 if v is Variant.ORIGINAL else 4}'s postconditions at every cell; "
+                         f"{v.rule.theorems[0]}'s and Theorem "
+                         f"{v.rule.theorems[1]}'s postconditions at every cell; "
                          "the search's answer is checked by its witness; the exact re-decision "
                          "visits every cell of the path."),
                 label=EVERY_CELL, timeout_ms=TRANSLATION_TIMEOUT_MS))

@@ -15,32 +15,18 @@ from __future__ import annotations
 
 import z3
 
+from ._obl_groups import GROUP_TUBE
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
+from ._z3vec import abs_ as _abs
+from ._z3vec import norm as _norm
+from ._z3vec import sub as _sub
+from ._z3vec import vec as _vec
 
 __all__ = ["GROUP", "KEY_PREMISE", "tolerance_obligations"]
 
-GROUP = "Trajectories (docs/model.md §12)"
+GROUP = GROUP_TUBE
 #: The tube lemma's key premise (the negative test drops or weakens it).
 KEY_PREMISE = "c > 2 L delta"
-
-Vec = tuple[z3.ArithRef, z3.ArithRef]
-
-
-def _vec(name: str) -> Vec:
-    return z3.Real(f"{name}.x"), z3.Real(f"{name}.y")
-
-
-def _norm(n: z3.ArithRef, v: tuple[z3.ArithRef, z3.ArithRef]) -> z3.BoolRef:
-    """n is the length of v: n >= 0 and n^2 = |v|^2."""
-    return z3.And(n >= 0, n * n == v[0] * v[0] + v[1] * v[1])
-
-
-def _sub(a: Vec, b: Vec) -> tuple[z3.ArithRef, z3.ArithRef]:
-    return a[0] - b[0], a[1] - b[1]
-
-
-def _abs(x: z3.ArithRef) -> z3.ArithRef:
-    return z3.If(x >= 0, x, -x)
 
 
 def _triangle() -> VC:

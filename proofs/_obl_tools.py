@@ -30,12 +30,7 @@ spec.tube_lipschitz run on terms with a tool on the arm.
 
 from __future__ import annotations
 
-import ast
-import builtins
-import functools
-import inspect
 import math
-import textwrap
 import types
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -45,39 +40,39 @@ import numpy as np
 import z3
 
 from .. import spec
-from ._obl_constants import GROUP_CERTIFICATE, ExtractionError, _is_sqrt, _term, sqrt_free
-from ._obl_safety import (
-    _COS,
-    _SIN,
-    G_MAX,
-    N2,
-    ArcChord,
-    Hyp,
+from ._lemmas import Lemma, dedupe, lemma
+from ._obl_arc_chord import ArcChord
+from ._obl_groups import GROUP_CERTIFICATE
+from ._obl_safety_region import (
     Kit,
-    Lemma,
-    Vec,
-    _add,
-    _comb,
     _elbow,
     _pins,
     _point2,
-    _rot,
     _snapped_to_corners,
-    _sub,
-    _v,
-    _veq,
     _weighted,
     _wvec,
-    a3_sum,
-    a3_unit,
-    e,
     grown_coords,
     lattice,
-    lemma,
     margin_parts,
     region_kit,
 )
 from ._obligation import VC, Method, Obligation, Verdict, Z3Query
+from ._onterms import ExtractionError, module_on_terms, run_on_terms, sqrt_free
+from ._onterms import as_bool as _bool
+from ._onterms import is_sqrt as _is_sqrt
+from ._onterms import term as _term
+from ._z3vec import COS as _COS
+from ._z3vec import G_MAX, N2, Hyp, Vec, a3_sum, a3_unit, concrete, e
+from ._z3vec import SIN as _SIN
+from ._z3vec import add as _add
+from ._z3vec import comb as _comb
+from ._z3vec import j as _j
+from ._z3vec import occurs as _occurs
+from ._z3vec import rot as _rot
+from ._z3vec import scale as _scale2
+from ._z3vec import sub as _sub
+from ._z3vec import vec as _v
+from ._z3vec import veq as _veq
 
 __all__ = ["GROUP", "V", "ReachReading", "SymTool", "ToolKit", "ToolReading", "check_none_reading",
            "check_pairs_reading", "check_tool_reading", "height_gap_vcs", "height_rule_vcs",
@@ -88,199 +83,6 @@ __all__ = ["GROUP", "V", "ReachReading", "SymTool", "ToolKit", "ToolReading", "c
 GROUP = "End-to-end safety (docs/model.md §10)"
 
 _R = z3.RealSort()
-
-
-# --- reading a small pure function off its syntax tree ------------------------------------------
-
-class _Return(Exception):
-    """A ``return`` reached on the path being read (carries the value)."""
-
-    def __init__(self, value: Any) -> None:
-        super().__init__()
-        self.value = value
-
-
-def _is_term(x: Any) -> bool:
-    return isinstance(x, z3.ExprRef)
-
-
-def _bool(x: Any, line: int) -> z3.BoolRef:
-    if isinstance(x, z3.BoolRef):
-        return x
-    if isinstance(x, bool):
-        return z3.BoolVal(x)
-    raise ExtractionError(f"line {line}: {x!r} is not a Boolean")
-
-
-def _max_terms(*args: Any) -> Any:
-    """Python's ``max`` of arguments (or of one iterable), folded with ``spec.max_of``: the
-    same value on floats, an If on terms."""
-    items = list(args[0]) if len(args) == 1 else list(args)
-    return functools.reduce(spec.max_of, items)
-
-
-def _min_terms(*args: Any) -> Any:
-    items = list(args[0]) if len(args) == 1 else list(args)
-    return functools.reduce(spec.min_of, items)
-
-
-#: Builtins a read function may call, as they run on terms.
-_BUILTINS = {"max": _max_terms, "min": _min_terms}
-
-
-class _Reader:
-    """Evaluates one function's body on the given arguments: the subset ``heights_overlap`` and
-    ``height_gap`` are written in (a docstring, ``if``/``else`` whose branches return, ``return``;
-    names, constants, tuples, constant subscripts, comparisons including ``is``/``is not``,
-    ``and``/``or``/``not``, ``+``/``-``/``*``/``/``, calls of the module's names and ``max``/``min``).
-    A condition on terms joins both branches by If; ``and``/``or`` on terms is And/Or; anything
-    else is refused, naming the line."""
-
-    def __init__(self, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
-        src = textwrap.dedent(inspect.getsource(fn))
-        tree = ast.parse(src)
-        node = tree.body[0]
-        if not isinstance(node, ast.FunctionDef) or node.decorator_list:
-            raise ExtractionError(f"{fn.__name__} is not a plain function")
-        params = [a.arg for a in node.args.args]
-        if len(params) != len(args) or node.args.vararg or node.args.kwarg:
-            raise ExtractionError(f"{fn.__name__} takes {params}, read with {len(args)} arguments")
-        self.fn = fn
-        self.node = node
-        self.env: dict[str, Any] = dict(zip(params, args))
-
-    def run(self) -> Any:
-        try:
-            self._block(self.node.body)
-        except _Return as r:
-            return r.value
-        raise ExtractionError(f"{self.fn.__name__}: no return reached")
-
-    # statements
-    def _block(self, body: list[ast.stmt]) -> None:
-        for i, st in enumerate(body):
-            if i == 0 and isinstance(st, ast.Expr) and isinstance(st.value, ast.Constant) \
-                    and isinstance(st.value.value, str):
-                continue                                        # the docstring
-            if isinstance(st, ast.Return):
-                if st.value is None:
-                    raise ExtractionError(f"line {st.lineno}: a bare return")
-                raise _Return(self._expr(st.value))
-            if isinstance(st, ast.If):
-                cond = self._expr(st.test)
-                if not _is_term(cond):
-                    self._block(st.body if cond else st.orelse)
-                    continue
-                then = self._branch(st.body)
-                rest = self._branch(st.orelse if st.orelse else body[i + 1:])
-                raise _Return(spec.if_then(_bool(cond, st.lineno), then, rest))
-            raise ExtractionError(f"line {st.lineno}: {type(st).__name__} is outside the subset")
-
-    def _branch(self, body: list[ast.stmt]) -> Any:
-        try:
-            self._block(body)
-        except _Return as r:
-            return r.value
-        raise ExtractionError(f"line {self.node.lineno}: a branch on terms that does not return")
-
-    # expressions
-    def _name(self, node: ast.Name) -> Any:
-        if node.id in self.env:
-            return self.env[node.id]
-        if node.id in self.fn.__globals__:
-            return self.fn.__globals__[node.id]
-        if node.id in _BUILTINS:
-            return _BUILTINS[node.id]
-        if node.id in ("None", "True", "False"):
-            return getattr(builtins, node.id)
-        raise ExtractionError(f"line {node.lineno}: the name {node.id!r} is outside the subset")
-
-    def _expr(self, node: ast.expr) -> Any:
-        line = getattr(node, "lineno", "?")
-        if isinstance(node, ast.Constant):
-            return node.value
-        if isinstance(node, ast.Name):
-            return self._name(node)
-        if isinstance(node, ast.Tuple):
-            return tuple(self._expr(e) for e in node.elts)
-        if isinstance(node, ast.Subscript) and isinstance(node.slice, ast.Constant) \
-                and isinstance(node.slice.value, int):
-            return self._expr(node.value)[node.slice.value]
-        if isinstance(node, ast.Compare):
-            out = []
-            left = self._expr(node.left)
-            for op, right_node in zip(node.ops, node.comparators):
-                right = self._expr(right_node)
-                out.append(self._compare(op, left, right, line))
-                left = right
-            if len(out) == 1:
-                return out[0]
-            if any(_is_term(x) for x in out):
-                return z3.And(*[_bool(x, line) for x in out])
-            return all(out)
-        if isinstance(node, ast.BoolOp):
-            return self._boolop(node, line)
-        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
-            x = self._expr(node.operand)
-            return z3.Not(x) if _is_term(x) else not x
-        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
-            return -self._expr(node.operand)
-        if isinstance(node, ast.BinOp) and type(node.op) in _ARITH:
-            return _ARITH[type(node.op)](self._expr(node.left), self._expr(node.right))
-        if isinstance(node, ast.Call) and not node.keywords:
-            f = self._expr(node.func)
-            return f(*[self._expr(a) for a in node.args])
-        raise ExtractionError(f"line {line}: {ast.dump(node)[:80]} is outside the subset")
-
-    @staticmethod
-    def _compare(op: ast.cmpop, x: Any, y: Any, line: Any) -> Any:
-        if isinstance(op, ast.Is):
-            if _is_term(x) or _is_term(y):
-                return False                   # a term is never None
-            return x is y
-        if isinstance(op, ast.IsNot):
-            if _is_term(x) or _is_term(y):
-                return True
-            return x is not y
-        ops: dict[type, Callable[[Any, Any], Any]] = {
-            ast.Lt: lambda a, b: a < b, ast.LtE: lambda a, b: a <= b,
-            ast.Gt: lambda a, b: a > b, ast.GtE: lambda a, b: a >= b,
-            ast.Eq: lambda a, b: a == b, ast.NotEq: lambda a, b: a != b}
-        if type(op) not in ops:
-            raise ExtractionError(f"line {line}: the comparison {type(op).__name__} is outside "
-                                  "the subset")
-        return ops[type(op)](x, y)
-
-    def _boolop(self, node: ast.BoolOp, line: Any) -> Any:
-        """Python's short circuit while the values are concrete; And/Or of the rest once a
-        term appears (the operands must then be Booleans)."""
-        is_and = isinstance(node.op, ast.And)
-        terms: list[z3.BoolRef] = []
-        value: Any = None
-        for v in node.values:
-            value = self._expr(v)
-            if _is_term(value):
-                terms.append(_bool(value, line))
-                continue
-            if terms:
-                terms.append(_bool(value, line))
-                continue
-            if (not value) if is_and else value:
-                return value                  # the short circuit, before any term
-        if not terms:
-            return value
-        return z3.And(*terms) if is_and else z3.Or(*terms)
-
-
-_ARITH: dict[type, Callable[[Any, Any], Any]] = {
-    ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
-    ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b}
-
-
-def run_on_terms(fn: Callable[..., Any], *args: Any) -> Any:
-    """``fn``'s own body, read off its syntax tree, evaluated on ``args`` (Z3 terms or Python
-    values): what it returns, a term where the arguments are terms (``_Reader``'s subset)."""
-    return _Reader(fn, args).run()
 
 
 # --- the height rule ----------------------------------------------------------------------------
@@ -421,46 +223,6 @@ def height_gap_vcs(gap: Callable[..., Any] | None = None) -> tuple[VC, ...]:
 V = 16
 
 
-def _ident(x: Any) -> Any:
-    return x
-
-
-def _each(f: Callable[[Any], Any]) -> Callable[[Any], Any]:
-    return lambda a: np.vectorize(f, otypes=[object])(np.asarray(a, dtype=object))
-
-
-class _Numpy:
-    """numpy, for code run on terms: cos and sin are the proofs' uninterpreted Cos and Sin
-    (ledger A3), elementwise on object arrays; ``asarray(..., dtype=float)`` keeps the terms (an
-    object array); ``hypot`` is spec.hypot_of (an exact root); the rest is numpy's own."""
-
-    cos = staticmethod(_each(lambda t: _COS(t)))
-    sin = staticmethod(_each(lambda t: _SIN(t)))
-    hypot = staticmethod(spec.hypot_of)
-
-    @staticmethod
-    def asarray(a: Any, dtype: Any = None) -> Any:
-        return np.asarray(a, dtype=object if dtype in (float, _ident) else dtype)
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(np, name)
-
-
-def module_on_terms(fn: Callable[..., Any], **names: Any) -> dict[str, Any]:
-    """The globals of ``fn``'s module, copied, where numpy is ``_Numpy``, ``float`` the identity,
-    ``max``/``min`` fold with spec.max_of/min_of, ``names`` replace what they name (another
-    module's functions read so), and every function of the module is rebound to the copy: the
-    module's own bytecode, calling itself, on terms."""
-    g = dict(fn.__globals__)
-    mod = g["__name__"]
-    g.update(np=_Numpy(), float=_ident, max=_max_terms, min=_min_terms, **names)
-    for key, val in list(g.items()):
-        if isinstance(val, types.FunctionType) and val.__module__ == mod and key not in names:
-            g[key] = types.FunctionType(val.__code__, g, val.__name__, val.__defaults__,
-                                        val.__closure__)
-    return g
-
-
 class _Positive:
     """The margin as impl receives it, a term known to be > 0 (the lemma's premise: the margin
     covers SNAP g1 R_base > 0): ``grow > 0`` is true, a product is the term's."""
@@ -530,7 +292,7 @@ class SymTool:
     def arm(self, arrays: bool = False) -> Any:
         """What impl reads of an Arm (its width is never read for the tool); ``arrays``: the
         lengths as 0-d object arrays, so that numpy broadcasts a length times an array."""
-        wrap = (lambda t: np.asarray(t, dtype=object)) if arrays else _ident
+        wrap = (lambda t: np.asarray(t, dtype=object)) if arrays else (lambda t: t)
         tool = types.SimpleNamespace(polygon=self.verts, z=None)
         return types.SimpleNamespace(base=self.b, links=(wrap(self.l1), wrap(self.l2)),
                                      width=wrap(z3.RealVal(0)), tool=tool, z=None)
@@ -769,14 +531,14 @@ class ToolPoint:
     vertices (c_1 the first vertex, c_k = (1 - t_k) c_{k-1} + t_k (the k-th), (u, v) = c_V;
     every convex combination of the vertices is such a chain)."""
 
-    reading: ToolReading
+    reading: ToolReading | ReachReading   # its tool is all a point reads
     t: tuple[z3.ArithRef, ...]            # t_2 .. t_V
     c: tuple[Vec, ...]                    # c_2 .. c_V (named)
     u: z3.ArithRef
     v: z3.ArithRef
 
     @classmethod
-    def named(cls, reading: ToolReading, prefix: str = "tp") -> ToolPoint:
+    def named(cls, reading: ToolReading | ReachReading, prefix: str = "tp") -> ToolPoint:
         n = len(reading.tool.verts)
         return cls(reading, tuple(z3.Real(f"{prefix}.t{k}") for k in range(2, n + 1)),
                    tuple(_v(f"{prefix}.c{k}") for k in range(2, n + 1)),
@@ -1055,7 +817,8 @@ def _grown_in_region(kit: Kit, k: dict[str, Lemma], reading: ToolReading) -> Lem
                  counter_witness=wit + [(dl, z3.RealVal(-1))])
 
 
-def _tool_pins(reading: ToolReading, P: ToolPoint) -> list[tuple[z3.ExprRef, int | z3.ArithRef]]:
+def _tool_pins(reading: ToolReading | ReachReading, P: ToolPoint
+               ) -> list[tuple[z3.ExprRef, int | z3.ArithRef]]:
     """A small arm, base at the origin, l1 = l2 = 1/10, every vertex at (1/5, 0) in the
     forearm's frame (each 3/10 from the elbow), the point at a vertex: for vacuity checks."""
     t, q = reading.tool, z3.Q
@@ -1175,7 +938,7 @@ class ToolModel:
         2's frame (origin at the elbow, x along the forearm) at (u, v) = (l2, 0) + a point of
         the polygon, a chain of two-point convex combinations of its vertices (weights t_k in
         [0, 1], points c_k), all functions of theta and p."""
-        from ._obl_safety import link_l, link_r
+        from ._obl_safety_separation import link_l, link_r
         t = self.tool
         link = link_l if self.tag == "L" else link_r
 
@@ -1202,7 +965,9 @@ class ToolModel:
         (l2, 0) + a point of the polygon moved by a point of the square [-Delta, Delta]^2 in
         that configuration's frame (the grown tool: tool_points), is a member of the region.
         Stated at the corners the proof combines; returns its bound names and its body."""
-        from ._obl_safety import _SWEPT_L, _SWEPT_R, _swept, lattice_range, member
+        from ..impl import lattice_range
+        from ..spec.z3defs import member
+        from ._obl_safety import _SWEPT_L, _SWEPT_R, _swept
         t = self.tool
         pre = f"{self.tag}.td!"
         lat = [lattice_range(box[q][0], box[q][1], anchor[q], g[q]) for q in range(2)]
@@ -1254,7 +1019,6 @@ def tool_statement_vc(tag: str, tk: ToolKit, *, hull: Callable[..., Any] | None 
     tool_in_region exhibits, and tool_in_region (proved in Safety.tool_region) instantiated by
     substitution at the arm's tool, the box, theta and the point's local quantities. ``hull``
     replaces ToolModel.hull_definition (the tests' mutants)."""
-    from ._obl_safety import concrete
     lem = tk["tool_in_region"]
     reading = tk.reading
     src, m = reading.tool, ToolModel.named(tag)
@@ -1329,8 +1093,7 @@ def tool_statement_vc(tag: str, tk: ToolKit, *, hull: Callable[..., Any] | None 
     hyps += defs
     hyps += [(n, concrete(h)) for n, h in lem.use(pairs, f"{tag}, the tool")]
     wit = tuple((sub(c), v) for c, v in lem.vc.witness)
-    from ._obl_safety import _dedupe
-    return VC(f"tool_statement_{tag}", _dedupe(hyps), goal, key_premise=key, witness=wit,
+    return VC(f"tool_statement_{tag}", dedupe(hyps), goal, key_premise=key, witness=wit,
               counter_witness=wit)
 
 
@@ -1512,32 +1275,6 @@ def speed_tool_lemma(k: dict[str, Lemma], reading: ReachReading,
                  witness=tuple((q, zero) for q in (w1, w2, *p, *elbow, *base)))
 
 
-def _scale2(c: Any, a: Vec) -> Vec:
-    return (c * a[0], c * a[1])
-
-
-def _j(a: Vec) -> Vec:
-    return (-a[1], a[0])
-
-
-def _n2(a: Vec) -> z3.ArithRef:
-    return a[0] * a[0] + a[1] * a[1]
-
-
-def _occurs(term: z3.ExprRef, inside: z3.ExprRef) -> bool:
-    seen: set[int] = set()
-    todo = [inside]
-    while todo:
-        x = todo.pop()
-        if x.get_id() in seen:
-            continue
-        seen.add(x.get_id())
-        if z3.eq(x, term):
-            return True
-        todo += x.children()
-    return False
-
-
 def tool_certificate_vcs() -> tuple[VC, ...]:
     """What Certificate.lipschitz adds for a tool: its reach (tool_far_vertex, tool_reach_frame,
     reach_tool; comb_id, hull_step, root_norm and sqrt_le with them) and its speed bound."""
@@ -1566,7 +1303,7 @@ def tube_tool_vc(tube: Callable[..., Any] | None = None,
     reach_fn = reach or spec.reach
     on_reach = module_on_terms(reach_fn)[reach_fn.__name__]
     g = module_on_terms(fn, reach=on_reach)
-    arms = {}
+    arms: dict[str, Any] = {}             # _SymArmTool: what spec.parts and reach read
     hyps: list[Hyp] = []
     for side in ("left", "right"):
         t = SymTool.named(f"{side}.tool")

@@ -207,8 +207,8 @@ def grid_motion_vcs(motion_class: Any = None) -> tuple[VC, ...]:
             k = seg
             return z3.If(seg >= 0, P[q](k) + (x - k * dt) / dt * (P[q](k + 1) - P[q](k)),
                          P[q](n - 1))
-        motion = [*[z3.And(r_t[0][q] == executed(t, q), r_tp[0][q] == executed(tp, q))
-                    for q in range(2)], _combine(lip)]
+        moved = [*[z3.And(r_t[0][q] == executed(t, q), r_tp[0][q] == executed(tp, q))
+                   for q in range(2)], _combine(lip)]
         right = z3.And(*[_rate(r_t[0][q], r_tp[0][q], wr[0][q], t, tp) for q in range(2)])
         left = z3.And(*[_rate(left_t[q], left_tp[q], wl[0][q], t, tp) for q in range(2)])
         name = f"grid_path{p.index + 1}"
@@ -218,7 +218,7 @@ def grid_motion_vcs(motion_class: Any = None) -> tuple[VC, ...]:
         # motion's VC: 0 <= 0, true whatever the premises. Each other rate is a VC of its own:
         # Z3 decides each in a fraction of a second, their conjunction in seconds or not at all.
         out.append(_path_vc(f"{name}.motion", p, base, z3.And(
-            *motion, *([right] if one_cell else []), *([] if left_moves else [left])),
+            *moved, *([right] if one_cell else []), *([] if left_moves else [left])),
             KEY_SEGMENT))
         if not one_cell:
             out.append(VC(f"{name}.right_rate", _path_hyps(p, base), right, key_premise=KEY_STEP))
@@ -345,7 +345,7 @@ def pieces_failures(motion_class: Any = None,
     seg dt <= t0, t1 <= (seg + 1) dt (the same float products); a piece at rest (seg = -1)
     starts at or after (n - 1) dt; moving = (t0 < Tf); none straddles Tf; sorted by t0, the
     pieces tile [0, max((n - 1) dt, Tf)] end to end (an all-static motion: the instant 0)."""
-    cls = spec.GridMotion if motion_class is None else motion_class
+    cls: Any = spec.GridMotion if motion_class is None else motion_class   # built on no scenario
     bad: list[str] = []
     for n, dt, tf in cases:
         m = cls(None, dt, tf, np.zeros((n, 2)), np.zeros((n, 2), dtype=np.int64))

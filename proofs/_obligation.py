@@ -230,6 +230,8 @@ class VCResult:
     solvers: tuple[str, ...] = ()
     note: str = ""                 # why a second solver does not confirm it, if it does not
     nonlinear: bool = False        # nonlinear real or integer arithmetic (_depth.is_nonlinear)
+    #: cvc5's answer taken from proofs/obligations.lock (undecided when pinned), not re-run.
+    cvc5_from_pin: bool = False
 
 
 @dataclass(frozen=True)
@@ -354,13 +356,14 @@ class _Pending:
                      label=self.ob.label, cvc5_seconds=round(cvc5_s, 3), **f)
 
 
-def discharge_pending(ob: Obligation, pool: Any,
-                      skip: dict[str, str] | None = None) -> _Pending:
+def discharge_pending(ob: Obligation, pool: Any, skip: dict[str, str] | None = None,
+                      recheck: bool = False) -> _Pending:
     """Run one obligation with Z3 (or sympy, or the data check), handing each VC's standard
     SMT-LIB to ``pool`` (a ``_cvc5.Cvc5Pool``) for the replay; the statements in ``skip`` (hash
-    -> why: cvc5 did not decide them when they were pinned) are replayed too, on the shorter
-    ``_cvc5.CVC5_RECHECK_MS``; ``settle()`` gives the Proof. Any exception is a FAILED verdict
-    that says why."""
+    -> why: cvc5 did not decide them when they were pinned) are not replayed: their answer is
+    the pinned one (``VCResult.cvc5_from_pin``), unless ``recheck`` (``--recheck-undecided``)
+    replays them too (docs/model.md §6). Z3 decides every VC either way. ``settle()`` gives
+    the Proof. Any exception is a FAILED verdict that says why."""
     t0 = time.perf_counter()
     text = ""
     futures: list[Any] = []
@@ -369,7 +372,7 @@ def discharge_pending(ob: Obligation, pool: Any,
         query = ob.build()
         text = render_query(ob, query)
         if isinstance(query, Z3Query):
-            fields, futures, certs = _run_z3(ob, query, pool, skip or {})
+            fields, futures, certs = _run_z3(ob, query, pool, skip or {}, recheck)
         else:
             outcome = _guarded(query.run, ob.timeout_ms)
             fields = _check_fields(ob, outcome)
@@ -453,11 +456,10 @@ def _text_of(formulas: Sequence[z3.BoolRef]) -> str:
 
 
 def _stats(s: z3.Solver, into: dict[str, float]) -> None:
-    st = s.statistics()
-    for key in st.keys():
+    for key, value in s.statistics():   # z3.Statistics yields (key, value) pairs
         if key in _VOLATILE_STATS:
             continue
-        into[key] = into.get(key, 0) + st.get_key_value(key)
+        into[key] = into.get(key, 0) + value
 
 
 def _smoke(sm: Smoke, stats: dict[str, float], ctx: z3.Context | None = None) -> SmokeResult:
@@ -537,9 +539,9 @@ def _short_text(f: z3.ExprRef, width: int = 50) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
-def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
+def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck: bool = False
             ) -> tuple[dict[str, Any], list[Any], list[Any]]:
-    from ._cvc5 import CVC5_RECHECK_MS
+    from ._cvc5 import CVC5_TIMEOUT_MS
     from ._depth import deepest, is_nonlinear, vc_depth
 
     if not q.vcs:
@@ -586,21 +588,22 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str]
         if ans == z3.unsat and ob.expected is Verdict.PROVED:
             depth = vc_depth(hyps, vc.goal)
         replay = std is not None and ans != z3.unknown
-        # A statement cvc5 did not decide when pinned is re-run too, on a shorter budget.
-        if not replay:
-            futures.append(None)
-        elif sha in skip:
-            futures.append(pool.submit(std, CVC5_RECHECK_MS))
-        else:
-            futures.append(pool.submit(std))
+        # A statement cvc5 did not decide when pinned: its pinned answer (the same text gets
+        # the same answer), re-run only when asked; a decided one is re-run every time.
+        pinned = replay and sha in skip and not recheck
+        futures.append(pool.submit(std) if replay and not pinned else None)
         certs.append(vc if vc.certificate is not None else None)
         cvc5 = why = ""
-        if sha in skip:
-            note = f"cvc5 undecided when pinned ({skip[sha]}); re-run for {CVC5_RECHECK_MS} ms"
+        if pinned:
+            cvc5, why = "unknown", skip[sha]
+            note = (f"cvc5 undecided when pinned ({skip[sha]}); taken from the lock, not re-run "
+                    "(cfmpa prove --recheck-undecided re-runs it)")
+        elif replay and sha in skip:
+            note = f"cvc5 undecided when pinned ({skip[sha]}); re-run for {CVC5_TIMEOUT_MS} ms"
         results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
                                 cvc5=cvc5, cvc5_reason=why,
                                 solvers=("z3",) if str(ans) == want else (), note=note,
-                                nonlinear=is_nonlinear(hyps + [vc.goal])))
+                                nonlinear=is_nonlinear(hyps + [vc.goal]), cvc5_from_pin=pinned))
     smoke = [_smoke(sm, stats) for sm in q.smoke]      # each in a context of its own
     dead = [r.name for r in smoke if r.answer == "unsat"]
     undecided = [r.name for r in smoke if r.answer == "unknown"]

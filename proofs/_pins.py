@@ -25,8 +25,9 @@ reason of an unchanged kind): a theorem moved into the definitional list, or the
 fails every run (``check_kinds``) until the lock is edited by hand, as an expected verdict
 (pinned in the code) cannot be re-pinned either. An entry also records what cvc5
 answered on each VC when it was pinned (``cvc5``; not part of the comparison): a run replays
-in cvc5 only the statements cvc5 decided then (``cvc5_skips``), since the same text gets the
-same answer, and ``--repin`` replays every one again.
+in cvc5 only the statements cvc5 decided then (``cvc5_skips``: a decided one is a check, re-run
+every time), since the same text gets the same answer; the others' answer is taken from the lock
+and said so per VC; ``--repin`` and ``--recheck-undecided`` replay every one again.
 """
 
 from __future__ import annotations
@@ -94,8 +95,8 @@ def _statement(entry: dict[str, Any]) -> dict[str, Any]:
 
 
 def cvc5_skips(lock: dict[str, dict[str, Any]]) -> dict[str, str]:
-    """Statement hash -> why cvc5 did not decide it when pinned (it is re-run on a shorter
-    budget, _cvc5.CVC5_RECHECK_MS)."""
+    """Statement hash -> why cvc5 did not decide it when pinned (a run takes that answer from
+    the lock instead of replaying it, unless ``--recheck-undecided`` or ``--repin``)."""
     out: dict[str, str] = {}
     for entry in lock.values():
         answers = entry.get("cvc5") or {}

@@ -15,7 +15,6 @@ the same since last time.
 from __future__ import annotations
 
 import datetime as _dt
-import fnmatch
 import hashlib
 import json
 import os
@@ -49,6 +48,7 @@ from ._obl_witness import witness_obligations
 from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
 from ._pins import LOCK, Mismatch, check_kinds, check_pins, cvc5_skips, load_lock
 from ._pins import repin as repin_lock
+from ._select import selected
 
 __all__ = [
     "BUNDLED_DIR",
@@ -211,17 +211,6 @@ def scenarios_note(scenarios_dir: str | Path) -> str:
     return f"scenarios: the {len(stems)} workcell(s) in {scenarios_dir}, expecting {ids(stems)}"
 
 
-def selected(ident: str, only: Iterable[str] | None) -> bool:
-    """Whether ``ident`` is picked by ``only``: an exact id, a prefix ending at a dot (``Prop8``
-    picks ``Prop8.printed``), or a glob (``Thm*``). None picks everything."""
-    if only is None:
-        return True
-    for pat in only:
-        if ident == pat or ident.startswith(pat.rstrip(".") + ".") or fnmatch.fnmatchcase(ident, pat):
-            return True
-    return False
-
-
 @dataclass(frozen=True)
 class ProveRun:
     """One run: the proofs, how each compares with the previous run, and the id check."""
@@ -280,33 +269,44 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
                     record: dict[str, Any] | None = None, lock: str | Path | None = None,
                     repin: bool = False, workers: int = 1,
                     controls: Sequence[Control] = (),
-                    progress: TextIO | None = None) -> ProveRun:
+                    progress: TextIO | None = None,
+                    recheck_undecided: bool = False) -> ProveRun:
     """Discharge each obligation (in ``workers`` forked processes side by side; the results do
     not depend on how many), save its query and the results, compare with the last run;
     every verdict is checked against ``pinned_verdict`` as well as ``Obligation.expected``,
     and every statement against the lock (``lock``, default proofs/obligations.lock), which
     ``repin`` rewrites first (for the obligations run; after a whole run, dropping the rest).
-    cvc5 replays each VC in the background while Z3 goes on (``_cvc5.Cvc5Pool``). Then the
-    negative ``controls`` run (side by side too); the run is OK only if each ends as it
-    expects. ``repin`` never touches what a control expects. ``progress``: a line per group of
-    obligations as its last one ends, and one for the controls (``GroupProgress``); the results
-    do not depend on it."""
+    cvc5 replays each VC in the background while Z3 goes on (``_cvc5.Cvc5Pool``), except a
+    statement it did not decide when pinned, whose answer is the lock's (said per VC and per
+    obligation, ``cvc5_tally``) unless ``recheck_undecided`` or ``repin``. The negative
+    ``controls`` run too (in the same processes, from the same queue, longest first); the run
+    is OK only if each ends as it expects. ``repin`` never touches what a control expects.
+    ``progress``: a line per group of obligations as its last one ends, and one for the
+    controls (``GroupProgress``); the results do not depend on it."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     previous = _load_previous(out / "results.json")
     lock_path = Path(lock) if lock is not None else LOCK
-    # cvc5 replays the statements it decided when they were pinned (--repin: every one).
+    # cvc5 replays the statements it decided when they were pinned; the undecided ones' answer
+    # is the pinned one (--repin: every one replayed; --recheck-undecided: those too).
     skip = {} if repin else cvc5_skips(load_lock(lock_path))
     t0 = time.perf_counter()
     told = GroupProgress(obligations, progress)
-    if workers > 1 and len(obligations) > 1:
-        cost = {i: float(o.get("seconds") or 0.0) for i, o in previous.items()}
-        proofs = _discharge_side_by_side(obligations, skip, workers, cost, told)
+    if workers > 1 and len(obligations) + len(controls) > 1:
+        # One pool for the obligations and the controls, the longest first (by the last run's
+        # seconds), so that no process idles at a barrier between the two. With no last run
+        # (the audit's fresh one), an obligation's time limit stands in: the per-scenario D_R
+        # checks (600 s) first, the controls (short, unknown) last.
+        cost = {o.id: o.timeout_ms / 1000 for o in obligations}
+        cost.update((i, float(o.get("seconds") or 0.0)) for i, o in previous.items())
+        cost.update(_previous_control_seconds(out / "results.json"))
+        proofs, checked = _discharge_side_by_side(obligations, skip, workers, cost, told,
+                                                  recheck=recheck_undecided, controls=controls)
     else:
-        proofs = _discharge_in_turn(obligations, skip, told)
-    checked = _controls_side_by_side(controls, workers)
-    if controls:
-        told.line("negative controls", len(checked), sum(c.seconds for c in checked))
+        proofs = _discharge_in_turn(obligations, skip, told, recheck=recheck_undecided)
+        checked = tuple(run_control(c) for c in controls)
+        if controls:
+            told.line("negative controls", len(checked), sum(c.seconds for c in checked))
     seconds = time.perf_counter() - t0
     repinned = None
     if repin:
@@ -379,7 +379,7 @@ class GroupProgress:
 
 
 def _discharge_in_turn(obligations: Sequence[Obligation], skip: dict[str, str],
-                       told: GroupProgress) -> tuple[Proof, ...]:
+                       told: GroupProgress, recheck: bool = False) -> tuple[Proof, ...]:
     """Each obligation discharged in this process, one after another, cvc5 replaying behind Z3;
     each settled (``_Pending.settle``, the same Proof whenever it is called) as soon as its
     replays are done, so that a group's line comes when the group is, not at the end."""
@@ -389,12 +389,13 @@ def _discharge_in_turn(obligations: Sequence[Obligation], skip: dict[str, str],
     pending: dict[int, Any] = {}
 
     def settle(i: int) -> None:
-        out[i] = pending.pop(i).settle()
-        told.done(obligations[i], out[i])
+        p = pending.pop(i).settle()
+        out[i] = p
+        told.done(obligations[i], p)
 
     with Cvc5Pool() as pool:
         for i, o in enumerate(obligations):
-            pending[i] = discharge_pending(o, pool, skip)
+            pending[i] = discharge_pending(o, pool, skip, recheck)
             for j in [j for j, p in pending.items()
                       if all(f is None or f.done() for f in p.futures)]:
                 settle(j)
@@ -423,77 +424,74 @@ def _worker_start() -> None:
 
 def _worker_discharge(index: int) -> Proof:
     ob = _SHARED["obligations"][index]
-    return discharge_pending(ob, _SHARED["pool"], _SHARED["skip"]).settle()
+    return discharge_pending(ob, _SHARED["pool"], _SHARED["skip"], _SHARED["recheck"]).settle()
 
 
 def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, str], jobs: int,
-                            cost: dict[str, float], told: GroupProgress | None = None
-                            ) -> tuple[Proof, ...]:
-    """Each obligation discharged in one of ``jobs`` forked processes, the longest (by the last
-    run's seconds) first so that the two finish together; returned in the given order. An
-    obligation whose process dies is FAILED with that reason, never lost or waited for. Each is
-    told to ``told`` as it ends."""
+                            cost: dict[str, float], told: GroupProgress | None = None,
+                            recheck: bool = False, controls: Sequence[Control] = ()
+                            ) -> tuple[tuple[Proof, ...], tuple[ControlResult, ...]]:
+    """Each obligation discharged, and each control run, in one of ``jobs`` forked processes,
+    the longest (by the last run's seconds, ``cost`` by id) first so that they finish
+    together; returned in the given orders. An obligation whose process dies is FAILED with
+    that reason, a control ``error`` (which no control expects), never lost or waited for.
+    Each obligation is told to ``told`` as it ends, the controls once all have."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    order = sorted(range(len(obligations)), key=lambda i: -cost.get(obligations[i].id, 0.0))
-    _SHARED.update(obligations=obligations, skip=skip)
+    tasks = [("ob", i, obligations[i].id) for i in range(len(obligations))]
+    tasks += [("control", j, controls[j].id) for j in range(len(controls))]
+    tasks.sort(key=lambda t: -cost.get(t[2], 0.0))        # stable: the given order on ties
+    _SHARED.update(obligations=obligations, skip=skip, recheck=recheck, controls=controls)
     out: list[Proof | None] = [None] * len(obligations)
+    checked: list[ControlResult | None] = [None] * len(controls)
     try:
-        with ProcessPoolExecutor(max_workers=min(jobs, len(obligations)),
+        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)),
                                  mp_context=multiprocessing.get_context("fork"),
                                  initializer=_worker_start) as ex:
-            futures = {ex.submit(_worker_discharge, i): i for i in order}
+            futures = {ex.submit(_worker_discharge if kind == "ob" else _control_worker, i):
+                       (kind, i) for kind, i, _ in tasks}
             for fut in as_completed(futures):
-                i = futures[fut]
+                kind, i = futures[fut]
+                got: Any                # a ControlResult or a Proof, by kind
                 try:
-                    out[i] = fut.result()
+                    got = fut.result()
                 except Exception as exc:  # noqa: BLE001 - a dead worker is a verdict, not a crash
                     why = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
-                    out[i] = failed_proof(obligations[i], f"its worker process ended ({why})")
+                    if kind == "control":
+                        c = controls[i]
+                        got = ControlResult(c.id, c.checker, c.what, c.expected, "error",
+                                            f"its worker process ended ({why})", 0.0)
+                    else:
+                        got = failed_proof(obligations[i], f"its worker process ended ({why})")
+                if kind == "control":
+                    checked[i] = got
+                    if told is not None and all(c is not None for c in checked):
+                        told.line("negative controls", len(checked),
+                                  sum(c.seconds for c in checked if c is not None))
+                    continue
+                out[i] = got
                 if told is not None:
-                    told.done(obligations[i], out[i])  # type: ignore[arg-type]
+                    told.done(obligations[i], got)
     finally:
         _SHARED.clear()
     assert all(p is not None for p in out)      # every future ended in a Proof, above
-    return tuple(out)  # type: ignore[arg-type]
-
-
-def _control_worker_start() -> None:
-    from ..impl import set_kernel_threads
-
-    set_kernel_threads(1)
+    assert all(c is not None for c in checked)
+    return tuple(out), tuple(checked)  # type: ignore[arg-type]
 
 
 def _control_worker(index: int) -> ControlResult:
     return run_control(_SHARED["controls"][index])
 
 
-def _controls_side_by_side(controls: Sequence[Control], jobs: int) -> tuple[ControlResult, ...]:
-    """Each control run (in ``jobs`` forked processes when more than one); a control whose
-    process dies ends ``error``, which no control expects."""
-    if jobs <= 1 or len(controls) <= 1:
-        return tuple(run_control(c) for c in controls)
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    _SHARED.update(controls=controls)
-    out: list[ControlResult] = []
+def _previous_control_seconds(path: Path) -> dict[str, float]:
+    """Each control's seconds in the last run's results.json (the order of the next run)."""
     try:
-        with ProcessPoolExecutor(max_workers=min(jobs, len(controls)),
-                                 mp_context=multiprocessing.get_context("fork"),
-                                 initializer=_control_worker_start) as ex:
-            futures = [ex.submit(_control_worker, i) for i in range(len(controls))]
-            for c, fut in zip(controls, futures):
-                try:
-                    out.append(fut.result())
-                except Exception as exc:  # noqa: BLE001 - a dead worker is a result, not a crash
-                    out.append(ControlResult(c.id, c.checker, c.what, c.expected, "error",
-                                             f"its worker process ended ({type(exc).__name__})",
-                                             0.0))
-    finally:
-        _SHARED.clear()
-    return tuple(out)
+        doc = json.loads(path.read_text())
+        return {str(c["id"]): float(c.get("seconds") or 0.0) for c in doc.get("controls", [])
+                if isinstance(c, dict) and "id" in c}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}
 
 
 def _query_file(p: Proof) -> str:
@@ -547,8 +545,10 @@ def _proof_json(p: Proof, ob: Obligation, change: str) -> dict[str, Any]:
         "reason_unknown": p.reason_unknown,
         "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer, "depth": v.depth,
                  "sha256": v.sha256, "solvers": list(v.solvers), "cvc5": v.cvc5,
-                 "cvc5_reason": v.cvc5_reason, "note": v.note, "nonlinear": v.nonlinear}
+                 "cvc5_reason": v.cvc5_reason, "note": v.note, "nonlinear": v.nonlinear,
+                 "cvc5_from_pin": v.cvc5_from_pin}
                 for v in p.vcs],
+        "cvc5_tally": cvc5_tally(p),
         "depth": p.depth, "label": p.label, "solvers": list(p.solvers),
         "kind": kind_of(p.id), "kind_why": DEFINITIONAL.get(p.id, ""),
         "smoke": [{"name": s.name, "answer": s.answer, "how": s.how} for s in p.smoke],
@@ -584,6 +584,25 @@ def _results_json(run: ProveRun, previous: dict[str, dict[str, Any]]) -> str:
         "seconds": round(run.seconds, 3),
     }
     return dumps_json(doc, ascii_only=False, allow_nan=True)
+
+
+def cvc5_tally(p: Proof) -> str:
+    """Per obligation, what cvc5 did with its VCs: how many it decided this run, how many it
+    left undecided this run, and how many undecided answers were taken from the lock (not
+    re-run; docs/model.md §6). "" for an obligation without VCs."""
+    if not p.vcs:
+        return ""
+    pinned = sum(v.cvc5_from_pin for v in p.vcs)
+    decided = sum(v.cvc5 in ("sat", "unsat") for v in p.vcs)
+    ran = sum(bool(v.cvc5) and not v.cvc5_from_pin for v in p.vcs)
+    text = f"cvc5 decided {decided} of {len(p.vcs)} VCs"
+    if ran - decided:
+        text += f", {ran - decided} undecided this run"
+    if pinned:
+        text += f", {pinned} undecided when pinned (taken from the lock, not re-run)"
+    if len(p.vcs) - ran - pinned:
+        text += f", {len(p.vcs) - ran - pinned} not replayed"
+    return text
 
 
 def kind_counts(proofs: Iterable[Proof]) -> dict[str, int]:
@@ -633,10 +652,11 @@ def solver_table(proofs: Iterable[Proof]) -> dict[str, Any]:
     SOS certificate, Z3 only (each with its reason)."""
     from ._cvc5 import cvc5_version
 
-    both = sos = 0
+    both = sos = pinned = 0
     only: list[dict[str, str]] = []
     for p in proofs:
         for v in p.vcs:
+            pinned += v.cvc5_from_pin
             if "z3" not in v.solvers:
                 continue
             if "cvc5" in v.solvers:
@@ -646,7 +666,7 @@ def solver_table(proofs: Iterable[Proof]) -> dict[str, Any]:
             else:
                 only.append({"id": p.id, "vc": v.name, "why": v.note or "not replayed"})
     return {"cvc5": cvc5_version(), "z3_and_cvc5": both, "z3_and_sos": sos,
-            "z3_only": len(only), "z3_only_vcs": only}
+            "z3_only": len(only), "z3_only_vcs": only, "cvc5_from_pin": pinned}
 
 
 def render_report(run: ProveRun) -> str:
@@ -676,7 +696,10 @@ def render_report(run: ProveRun) -> str:
     st = solver_table(run.proofs)
     lines += [f"Second solver (cvc5 {st['cvc5'] or 'not installed'}) on the standard SMT-LIB: "
               f"{st['z3_and_cvc5']} VCs confirmed by Z3 and cvc5, {st['z3_and_sos']} by Z3 and "
-              f"an SOS certificate (sympy), {st['z3_only']} by Z3 only"]
+              f"an SOS certificate (sympy), {st['z3_only']} by Z3 only"
+              + (f"; {st['cvc5_from_pin']} VCs cvc5 did not decide when pinned were not "
+                 "re-run, their answer taken from the lock (--recheck-undecided re-runs them)"
+                 if st["cvc5_from_pin"] else "")]
     lines += [f"    Z3 only: {o['id']} / {o['vc']}: {o['why']}" for o in st["z3_only_vcs"]]
     lines += ["", "Obligations", ""]
     idw = max([len(p.id) for p in run.proofs] + [10])
@@ -695,6 +718,8 @@ def render_report(run: ProveRun) -> str:
             how = f"  {p.label}"
         lines.append(f"{p.id:<{idw}}  {shown:<20} {p.seconds:7.2f}s  "
                      f"[{run.changes[p.id]}]{how}{flag}")
+        if any(v.cvc5_from_pin for v in p.vcs):
+            lines.append(f"{'':<{idw}}  {cvc5_tally(p)}")
         if p.verdict in (Verdict.UNKNOWN, Verdict.FAILED) or not p.as_expected:
             lines.append(f"{'':<{idw}}  reason: {p.reason}"
                          + (f" ({p.reason_unknown})" if p.reason_unknown else ""))

@@ -125,23 +125,23 @@ def _truth(self: z3.AstRef) -> bool:
 @contextlib.contextmanager
 def _paused() -> Iterator[None]:
     """Z3's own truth of terms while the explorer asks the solver (no branching there)."""
-    z3.AstRef.__bool__ = _ORIGINAL_BOOL            # type: ignore[method-assign]
+    z3.AstRef.__bool__ = _ORIGINAL_BOOL
     try:
         yield
     finally:
-        z3.AstRef.__bool__ = _truth                # type: ignore[method-assign]
+        z3.AstRef.__bool__ = _truth
 
 
 @contextlib.contextmanager
 def _running(run: _Run) -> Iterator[None]:
     _ACTIVE.append(run)
-    z3.AstRef.__bool__ = _truth                    # type: ignore[method-assign]
+    z3.AstRef.__bool__ = _truth
     try:
         yield
     finally:
         _ACTIVE.pop()
         if not _ACTIVE:
-            z3.AstRef.__bool__ = _ORIGINAL_BOOL    # type: ignore[method-assign]
+            z3.AstRef.__bool__ = _ORIGINAL_BOOL
 
 
 @dataclass(frozen=True)
@@ -268,7 +268,7 @@ def obj(x: Any) -> Any:
     """``x`` as an ``ObjArray`` (a scalar stays a scalar)."""
     if isinstance(x, (SymArray, ObjArray)):
         return x
-    if isinstance(x, np.ndarray) or isinstance(x, (list, tuple)):
+    if isinstance(x, (np.ndarray, list, tuple)):
         return np.asarray(x, dtype=object).view(ObjArray)
     return x
 
@@ -293,9 +293,9 @@ class ObjArray(np.ndarray):
     __le__ = _cmp(operator.le)
     __gt__ = _cmp(operator.gt)
     __ge__ = _cmp(operator.ge)
-    __eq__ = _cmp(operator.eq)          # type: ignore[assignment]
-    __ne__ = _cmp(operator.ne)          # type: ignore[assignment]
-    __hash__ = None                     # type: ignore[assignment]
+    __eq__ = _cmp(operator.eq)
+    __ne__ = _cmp(operator.ne)
+    __hash__ = None
 
     def __getitem__(self, key: Any) -> Any:
         if _is_term(key) or (isinstance(key, np.ndarray) and key.dtype == object):

@@ -30,7 +30,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, TextIO, cast
 
 import jinja2
 import markupsafe
@@ -38,7 +38,6 @@ import numpy as np
 
 from ..errors import CfmpaError, InputError
 from ..files import jsonable, write_bytes_atomic, write_json
-from ..impl import left_regions
 from ..runs import Campaign, load_campaign, run_campaign
 from ..scenarios import BUNDLED_DIR
 from ..spec import (
@@ -342,7 +341,7 @@ class _FreshProofs:
         import os
         import signal
 
-        if self._proc.is_alive():
+        if self._proc.is_alive() and self._proc.pid is not None:
             try:
                 os.killpg(self._proc.pid, signal.SIGTERM)
             except OSError:
@@ -391,7 +390,8 @@ def _fresh_child(run: Callable[[TextIO | None], ProofData], send: Any,
     set_kernel_threads(1)          # beside this audit's own process
     code = 0
     try:
-        told = None if silent else (direct if direct is not None else _Lines(send))
+        lines = cast(TextIO, _Lines(send))  # an io.TextIOBase: a text stream, TextIO but by name
+        told = None if silent else (direct if direct is not None else lines)
         send.send(("done", run(told)))
     except BaseException as exc:   # noqa: BLE001 - handed to the parent, raised there
         try:
@@ -728,7 +728,7 @@ def _rows_item(doc: Mapping[str, Any]) -> dict[str, Any]:
     rows = doc["summary"]
     failed = [f"{r['scenario']}/{r['variant']}" for r in rows if r["ok"] is False]
     short = [f"{r['scenario']}/{r['variant']}" for r in rows if r["verdict"] == "incomplete"]
-    counts = {}
+    counts: dict[str, int] = {}
     for r in rows:
         counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
     detail = ", ".join(f"{n} {k}" for k, n in counts.items())
@@ -825,7 +825,7 @@ def _scenario_entry(s: Scenario, plans: _Plans, figures: dict[str, F.Figure],
 
     results = {v: plans.get(s, v) for v in Variant}
     ok = {v: p for v, p in results.items() if not isinstance(p, Exception)}
-    variants = []
+    variants: list[dict[str, Any]] = []
     for v, p in results.items():
         if isinstance(p, Exception):
             variants.append({"variant": v.value, "status": "contract_violation",
@@ -949,6 +949,8 @@ def _same_paths(ok: dict[Variant, Any], found: Sequence[Variant]) -> dict[Varian
 
 def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.Figure],
                       clearance: Mapping[Variant, tuple[Any, Any]]) -> list[dict[str, str]]:
+    from ..impl import left_regions_fast  # the plans have loaded the compiled kernels
+
     slug = _anchor(s.name)
     v0 = _primary(ok)
     p0 = ok[v0]
@@ -962,7 +964,8 @@ def _scenario_figures(s: Scenario, ok: dict[Variant, Any], figures: dict[str, F.
     layer = g.N // 2
     made.append(F.variants_figure(
         f"fig-{slug}-variants", s, g, {v: p.dr for v, p in ok.items()},
-        {v: left_regions(s, v, g).links[layer] for v in ok}, layer))
+        # impl's compiled twin: the same polygons (tested), 20x quicker than left_regions.
+        {v: left_regions_fast(s, v, g).links[layer] for v in ok}, layer))
     series, minima, bounds = {}, {}, {}
     # Identical paths are drawn once, and said so.
     same = _same_paths(ok, list(clearance))
@@ -1113,7 +1116,7 @@ def monitor_settings(s: Scenario, traj: Any, tol: float
         return (f"the tube of {tol!r} rad would need a log of {samples} samples "
                 f"(a sample every {sim['period_s']:.3g} s) to stay inside it, more than the "
                 f"report's {MONITOR_MAX_SAMPLES}")
-    exc = dict(MONITOR_EXCURSION)
+    exc: dict[str, Any] = dict(MONITOR_EXCURSION)
     if not t0 <= exc["t_s"] <= t1 - exc["duration_s"]:
         exc["t_s"] = t0 + max(t1 - t0 - exc["duration_s"], 0.0) / 2
     exc["rad"] = max(exc["rad"], 2 * tol)

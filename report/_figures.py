@@ -23,6 +23,7 @@ import numpy as np  # noqa: E402
 import numpy.typing as npt  # noqa: E402
 import shapely  # noqa: E402
 import shapely.ops  # noqa: E402
+from matplotlib.artist import Artist  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
@@ -134,8 +135,9 @@ def legend_overlaps(fig: Any) -> list[str]:
 
 # --- drawing helpers ----------------------------------------------------------------------------
 
-def _draw_arm(ax: Any, arm: Any, theta: Sequence[float], color: str, *, alpha: float = 0.55,
-              lw: float = 1.0, ls: str = "-", fill: bool = True, label: str | None = None) -> None:
+def _draw_arm(ax: Any, arm: Any, theta: Sequence[float] | npt.NDArray[np.float64], color: str,
+              *, alpha: float = 0.55, lw: float = 1.0, ls: str = "-", fill: bool = True,
+              label: str | None = None) -> None:
     for k, rect in enumerate(arm_parts(arm, (float(theta[0]), float(theta[1])))):
         # The tool (part 3) hatched, so that it reads apart from the forearm it is fixed to.
         ax.add_patch(MplPolygon(rect, closed=True, facecolor=color if fill else "none",
@@ -432,8 +434,9 @@ def variants_figure(fid: str, s: Scenario, g: Grid, drs: Mapping[Variant, npt.ND
         b.set_ylabel("y (m)" if col == 0 else "")
         b.set_title(f"{v.value}: layer {layer}, area {area * 1e4:.1f} cm²")
     # One legend under the three panels: inside them it covered the arm's base.
-    handles = [Patch(facecolor=VARIANT_COLORS[v], alpha=0.4, edgecolor=VARIANT_COLORS[v],
-                     label=f"{v.value} region") for v in order]
+    handles: list[Artist] = [Patch(facecolor=VARIANT_COLORS[v], alpha=0.4,
+                                   edgecolor=VARIANT_COLORS[v], label=f"{v.value} region")
+                             for v in order]
     handles += [Line2D([], [], color=LEFT_COLOR, lw=1.0,
                        label=f"principal at t = {layer * s.dt:.2f} s (layer start)"),
                 Line2D([], [], color=LEFT_COLOR, lw=1.0, ls="--",

@@ -165,7 +165,7 @@ class InconsistencyData:
     grid: Grid
     layer: int
     boxes: dict[Variant, Any]
-    regions: dict[Variant, tuple[Polygon, Polygon]]
+    regions: dict[Variant, tuple[Polygon, ...]]     # link 1, link 2[, tool] (spec.parts)
     theta_now: tuple[float, float]
     theta_next: tuple[float, float]
     right_goal: tuple[float, float]
@@ -229,8 +229,8 @@ class Prop8Data:
     grid: Grid
     layer: int
     cell: Cell
-    region_s: tuple[Polygon, Polygon]
-    region_s_prime: tuple[Polygon, Polygon]
+    region_s: tuple[Polygon, ...]           # link 1, link 2[, tool] (spec.parts)
+    region_s_prime: tuple[Polygon, ...]
     right_region: tuple[Polygon, Polygon]
     theta_left: tuple[float, float]
     theta_right: tuple[float, float]
@@ -285,7 +285,7 @@ def prop8_finding(s: Scenario, plan: PlanFn) -> Finding:
         drawing=drawing)
 
 
-def _gap(left: tuple[Polygon, Polygon], right: tuple[Polygon, Polygon]) -> float:
+def _gap(left: tuple[Polygon, ...], right: tuple[Polygon, Polygon]) -> float:
     return min(polygon_distance(a, b) for a in left for b in right)
 
 

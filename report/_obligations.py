@@ -120,6 +120,8 @@ class ObligationRow:
     kind: str = "theorem"          # theorem | definitional (cfmpa.proofs.kind_of)
     kind_why: str = ""             # why a definitional one is (results.json's kind_why)
     vcs: tuple[VCRow, ...] = ()
+    #: What cvc5 did with its VCs, undecided ones taken from the lock said (proofs.cvc5_tally).
+    cvc5: str = ""
 
     @property
     def as_expected(self) -> bool:
@@ -139,7 +141,8 @@ class ObligationRow:
                 "reason": self.reason, "sha256": self.sha256, "change": self.change,
                 "depth": self.depth, "solvers": list(self.solvers), "label": self.label,
                 "z3_only": list(self.z3_only), "summary": self.summary, "kind": self.kind,
-                "kind_why": self.kind_why, "vcs": [v.as_json() for v in self.vcs]}
+                "kind_why": self.kind_why, "vcs": [v.as_json() for v in self.vcs],
+                "cvc5": self.cvc5}
 
 
 @dataclass(frozen=True)
@@ -379,7 +382,9 @@ def _from_file(path: Path, expected: Sequence[str], keep: set[str] | None = None
     missing, unexpected = check_ids([r.id for r in rows], expected)
     run = doc.get("run") if isinstance(doc.get("run"), dict) else None
     controls, controls_note, missing_controls = _controls_from_json(doc, path, expected)
-    depth = doc.get("depth") if isinstance(doc.get("depth"), dict) else {}
+    depth = doc.get("depth")
+    if not isinstance(depth, dict):
+        depth = {}
     return ProofData(available=True, source=f"read from {path}",
                      note="the results the prove run recorded, not re-run for this report"
                      + (f"; left out, as not the workcells reported on: the checks of "
@@ -455,7 +460,8 @@ def _row_from_json(item: Any, k: int, path: Path) -> ObligationRow:
         solvers=tuple(str(s) for s in item.get("solvers") or ()),
         label=str(item.get("label") or ""), z3_only=_z3_only(item.get("vcs")),
         summary=obligation_summary(item["id"]), kind=_kind(item, k, path),
-        kind_why=str(item.get("kind_why") or ""), vcs=_vc_rows(item.get("vcs")))
+        kind_why=str(item.get("kind_why") or ""), vcs=_vc_rows(item.get("vcs")),
+        cvc5=str(item.get("cvc5_tally") or ""))
 
 
 def _kind(item: dict[str, Any], k: int, path: Path) -> str:
@@ -497,6 +503,7 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str],
         DEFINITIONAL,
         FIXED_IDS,
         collect_controls,
+        cvc5_tally,
         default_workers,
         kind_of,
         obligation_summary,
@@ -529,7 +536,7 @@ def _fresh(obligations: Sequence[Any], expected: Sequence[str],
             summary=obligation_summary(ob.id), kind=kind_of(ob.id),
             kind_why=DEFINITIONAL.get(ob.id, ""),
             vcs=tuple(VCRow(v.name, v.depth, tuple(v.solvers), bool(v.nonlinear))
-                      for v in p.vcs)))
+                      for v in p.vcs), cvc5=cvc5_tally(p)))
     missing, unexpected = check_ids([r.id for r in rows], expected)
     checked = tuple(ControlRow(id=c.id, checker=c.checker, what=c.what, expected=c.expected,
                                outcome=c.outcome, detail=c.detail, seconds=float(c.seconds),

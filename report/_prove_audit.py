@@ -11,12 +11,13 @@ from __future__ import annotations
 import multiprocessing
 import os
 import sys
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TextIO
 
 from ..errors import InputError, handled
-from ..impl import progress_silenced, set_kernel_threads
+from ..impl import kernel_threads, progress_silenced, set_kernel_threads
 
 __all__ = ["run_prove_audit"]
 
@@ -24,8 +25,8 @@ __all__ = ["run_prove_audit"]
 def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
                     scenarios_dir: str | Path | None = None, only: Sequence[str] | None = None,
                     repin: bool = False, workers: int | None = None,
-                    argv: Sequence[str] | None = None, stdout: TextIO | None = None,
-                    progress: bool = True) -> int:
+                    recheck_undecided: bool = False, argv: Sequence[str] | None = None,
+                    stdout: TextIO | None = None, progress: bool = True) -> int:
     """Discharge every obligation into ``out_dir`` (``proofs.run_prove``) and write the audit
     report of that run to ``audit`` (``report.run_audit``); the exit code is the prove run's,
     else the report's. InputError (exit 2, nothing run) for ``only``: a report a reviewer trusts
@@ -58,7 +59,14 @@ def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
                              scenarios_dir=None if scenarios_dir is None else str(scenarios_dir)))
 
     def child() -> None:
+        wide = kernel_threads()
         set_kernel_threads(1)          # beside the prove run's processes
+
+        def widen() -> None:           # once the prove run has ended, its cores are the report's
+            gate.wait()                # (the kernels' results do not depend on their threads)
+            if not stopped.is_set():
+                set_kernel_threads(wide)
+        threading.Thread(target=widen, name="cfmpa-audit-widen", daemon=True).start()
         try:
             code = write_audit()
         except BaseException as exc:   # said after the proofs, or not at all if they stopped
@@ -78,7 +86,8 @@ def run_prove_audit(audit: str | Path, *, out_dir: str | Path = "build/proofs",
         worker.start()
         try:
             code = proofs.run_prove(out_dir=out_dir, scenarios_dir=scenarios_dir, only=only,
-                                    repin=repin, workers=workers, stream=so)
+                                    repin=repin, workers=workers, stream=so,
+                                    recheck_undecided=recheck_undecided)
         except BaseException:
             stopped.set()
             gate.set()

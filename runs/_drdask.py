@@ -179,14 +179,23 @@ def dr_block_task(s: Scenario, variant: str, k0: int, k1: int, layers_per_chunk:
 def blocks_of(shape: tuple[int, int, int], workers: int,
               layers_per_chunk: int | None = None) -> tuple[int, list[tuple[int, int]]]:
     """(L, the blocks (k0, k1)): whole chunks of L layers, at most TASK_BYTES cells each (at
-    least one chunk), about TASKS_PER_WORKER blocks a worker."""
+    least one chunk), TASKS_PER_WORKER blocks a worker (or more, a whole number a worker, for
+    the budget; fewer when there are fewer chunks), their sizes within one chunk."""
     K, m, n = shape
     L = layers_per_chunk or chunk_layers(m, n, K)
     chunks = -(-K // L)
     most = max(1, TASK_BYTES // max(1, L * m * n))          # chunks a task may hold
-    wanted = max(1, TASKS_PER_WORKER * max(1, workers))
-    per = max(1, min(most, -(-chunks // wanted)))
-    return L, [(c * L, min(K, (c + per) * L)) for c in range(0, chunks, per)]
+    w = max(1, workers)
+    # As many blocks as the budget needs and the workers want, a whole number a worker when
+    # the chunks allow, of sizes that differ by one chunk at most: no worker gets a block
+    # more than another, nor a larger one (an even share ends the build soonest).
+    count = min(chunks, max(-(-chunks // most), TASKS_PER_WORKER * w))
+    count = min(chunks, -(-count // w) * w)
+    if -(-chunks // count) > most:                          # the budget first
+        count = -(-chunks // most)
+    sizes = [chunks // count + (b < chunks % count) for b in range(count)]
+    starts = np.cumsum([0, *sizes])
+    return L, [(int(a) * L, min(K, int(b) * L)) for a, b in zip(starts[:-1], starts[1:])]
 
 
 @dataclass
@@ -255,8 +264,14 @@ def build_store(s: Scenario, variant: Variant | str, target: str | os.PathLike[s
             L, blocks = blocks_of(shape, n_workers, layers_per_chunk)
             tmp = temporary_store(target)
             create_store(tmp, shape, L)
-            blocked, done = _run_blocks(engine, s, v, tmp, L, blocks, faults, progress,
-                                        _after_block)
+            try:
+                blocked, done = _run_blocks(engine, s, v, tmp, L, blocks, faults, progress,
+                                            _after_block)
+            finally:
+                if engine.serial:
+                    # Built in this process: the regions the blocks shared (hundreds of MB on
+                    # large grids) go now, before the search and the contracts (§9).
+                    _KEPT.clear()
         t_read = time.perf_counter()
         _sync_tree(tmp)
         zarr = open_zarr(tmp, shape)

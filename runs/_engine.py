@@ -274,8 +274,9 @@ class Engine:
         # Ctrl-C reaches the workers too (one process group): the client alone handles it and
         # closes the cluster, so the workers ignore it (else each prints a traceback).
         self._client.run(_ignore_interrupt)
-        if self.workers > 1:
-            self._client.run(_one_kernel_thread)   # the workers share the cores already
+        # A local worker is one process of one thread, its kernels too, whatever the number of
+        # workers: K workers use K cores, as the info line says (docs/model.md §13).
+        self._client.run(_one_kernel_thread)
         self.dashboard = self._client.dashboard_link
         self.info = (f"local Dask cluster, {self.workers} worker process(es) x 1 thread; "
                      f"dashboard {self.dashboard}")

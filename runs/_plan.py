@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from ..errors import ContractViolation
+from ..errors import ContractViolation, InputError
 from ..files import dumps_json, write_atomic_with, write_bytes_atomic
 from ..impl import (
     build_dr_fast,
@@ -81,7 +81,8 @@ class PlanResult:
     scenario: Scenario
     variant: Variant
     grid: Grid
-    #: D_R: the array, or on Dask the store read a layer at a time (``ZarrDr.layers``).
+    #: D_R: the array, or with dr.zarr (the fast kernel) the store read a layer at a time
+    #: (``ZarrDr.layers``).
     dr: npt.NDArray[np.uint8]
     search: SearchResult
     certificate: Certificate | None
@@ -189,6 +190,7 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
         made = search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, with_witness=True)
         result = replace(result, witness=made.witness)
     elif not witness and result.witness is not None:
+        result.witness.close()                    # its temporary files, if spilled
         result = replace(result, witness=None)    # checked; not kept (it is N + 1 grids large)
     cert = None
     exact = None
@@ -374,8 +376,9 @@ def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *
     raises InputError). ``name``: the scenario as the user gave it. ``engine`` (--workers K >= 1
     or --scheduler): D_R built on Dask a block of layers a task into dr.zarr
     (runs/_drdask.py); the cluster losing its workers is WorkersLost naming the command that
-    runs it again."""
-    from ..impl import kernels
+    runs it again. Without one, dr.zarr with the fast kernel is built the same way in this
+    process (``_store_engine``), never whole."""
+    from ..impl import kernels, resolved
     from ..spec import load_scenario
     from ._drstore import _remove_other, default_store, write_dr
 
@@ -384,14 +387,16 @@ def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *
     s = load_scenario(scenario_path)
     g = make_grid(s)
     shape = (g.N + 1, g.m, g.n)
-    if engine is not None and engine.on_dask:
+    engine = _store_engine(s, kernel, store, engine)
+    if engine is not None:
         engine.check(kernel, store)
         from ._drdask import build_store
 
         t0 = time.perf_counter()
         with engine.rerun_on_lost(["dr", str(scenario_path if name is None else name),
                                    "--variant", v.value, "--out", str(out)]):
-            built = build_store(s, v, Path(out) / "dr.zarr", stream=so, **engine.kwargs())
+            built = build_store(s, v, Path(out) / "dr.zarr",
+                                stream=so if engine.on_dask else None, **engine.kwargs())
         try:
             path = built.publish()
         finally:
@@ -399,9 +404,10 @@ def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *
         _remove_other(out, "zarr")
         seconds, free = time.perf_counter() - t0, built.free_fraction
         parts = "  ".join(f"{key} {x:.3f} s" for key, x in built.timings_s.items()
-                          if key != "dr_store")
+                          if key != "dr_store") if engine.on_dask else ""
     else:
         store = default_store((g.N + 1) * g.m * g.n) if store is None else store
+        kernel = resolved(kernel)           # numpy's while fast's compile (§7.5): say which ran
         build, _ = kernels(kernel)
         t0 = time.perf_counter()
         dr = build(s, v.value, g)
@@ -419,6 +425,42 @@ def run_dr(scenario_path: str | Path, variant: Variant | str, out: str | Path, *
     return 0
 
 
+def _store_engine(s: Scenario, kernel: str, store: str | None,
+                  engine: EngineOptions | None) -> EngineOptions | None:
+    """Where D_R is built a block of layers at a time into dr.zarr (runs/_drdask.py
+    ``build_store``, docs/model.md §9): on Dask (``engine`` --workers K >= 1 or --scheduler),
+    or in this process (workers 0) whenever the store is zarr (``store``, or by default for
+    the grid's cells) and the kernel the fast one, so that D_R is never held whole; None for
+    the build of the whole array (dr.npy, or another kernel)."""
+    if engine is not None and engine.on_dask:
+        return engine
+    from ._drstore import default_store
+
+    g = make_grid(s)
+    cells = (g.N + 1) * g.m * g.n
+    chosen = default_store(cells) if store is None else store
+    if kernel != "fast" or chosen != "zarr":
+        _check_whole(cells, "--kernel" if kernel != "fast" else "--store",
+                     kernel if kernel != "fast" else chosen)
+        return None
+    from ._drdask import EngineOptions
+
+    return engine if engine is not None else EngineOptions()
+
+
+def _check_whole(cells: int, option: str, value: str) -> None:
+    """InputError naming ``option`` when D_R, built whole in memory (dr.npy, or a kernel other
+    than the fast one), has more cells than ``spec.whole_max_cells()`` (docs/model.md §3)."""
+    from ..spec import whole_max_cells
+
+    budget = whole_max_cells()
+    if cells > budget:
+        raise InputError(option, value, f"keeps D_R whole in memory, and its {cells:,} cells are "
+                                        f"over the budget of {budget:,} cells for a D_R held "
+                                        f"whole (CFMPA_MAX_WHOLE_CELLS); use --store zarr with "
+                                        f"the fast kernel, which streams it")
+
+
 def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path, *,
              contracts: Mode | str = "full", seed: int = 0, sample: int | None = None,
              kernel: str = "fast", witness: str | Path | None = None, name: str | None = None,
@@ -429,14 +471,15 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
     witness file); print the summary. ``engine`` (--workers K >= 1 or --scheduler): D_R built
     on Dask into dr.zarr as `cfmpa dr` does (runs/_drdask.py), then checked and searched here
     from the store a layer at a time (``ZarrDr.layers``, the searches' streamed input, §9),
-    never read back whole.
+    never read back whole; without one, a dr.zarr plan with the fast kernel goes the same way
+    with the blocks built in this process (``_store_engine``, workers 0).
 
     0 when nothing was violated; 1 when a contract failed or the certificate is not clear (a
     contact or an undecided interval is a violation in every contracts mode, off included); the
     files are written all the same, as the evidence, and the summary says so on ``stderr``.
     Bad input raises InputError. ``name``: the scenario as the user gave it.
     """
-    from ..impl import kernels
+    from ..impl import kernels, resolved
     from ..spec import load_scenario
 
     so = sys.stdout if stdout is None else stdout
@@ -446,9 +489,12 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
     s = load_scenario(scenario_path)
     zarr_threshold()                  # a bad CFMPA_ZARR_CELLS is exit 2 before any work
     build, search = kernels(kernel)
-    if engine is None or not engine.on_dask:
+    engine = _store_engine(s, kernel, store, engine)
+    if engine is None:
+        # plan.json names the kernel that ran: numpy's while fast's compile (§7.5)
         p = plan(s, variant, contracts=contracts, seed=seed, sample=sample, stop=False,
-                 build=build, search=search, kernel=kernel, witness=witness is not None)
+                 build=build, search=search, kernel=resolved(kernel),
+                 witness=witness is not None)
         dr_path, plan_path = write_plan(p, out, witness=witness, store=store)
     else:
         engine.check(kernel, store)
@@ -457,8 +503,8 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
         built: list[BuiltStore] = []
 
         def on_dask(s: Scenario, v: Variant, g: Grid) -> Any:
-            b = build_store(s, v, Path(out) / "dr.zarr", keep_layers=True, stream=so,
-                            **engine.kwargs())
+            b = build_store(s, v, Path(out) / "dr.zarr", keep_layers=True,
+                            stream=so if engine.on_dask else None, **engine.kwargs())
             built.append(b)
             assert b.layers is not None
             return b.layers
@@ -476,6 +522,8 @@ def run_plan(scenario_path: str | Path, variant: Variant | str, out: str | Path,
         finally:
             for b in built:
                 b.discard()
+    if p.search.witness is not None:
+        p.search.witness.close()                  # written: its temporary files go now
     violations = p.violations
     g, r, t = p.grid, p.search, p.timings_s
     print(f"scenario  {s.name} ({scenario_path if name is None else name})", file=so)

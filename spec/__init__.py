@@ -13,7 +13,8 @@ if TYPE_CHECKING:     # the public names, one list: the type checker's and __all
     # scenario, grids and motion (docs/model.md §2-§3)
     from ._scenario import (Arm as Arm, Scenario as Scenario, Tool as Tool,
                             load_scenario as load_scenario, max_cells as max_cells,
-                            parse_scenario as parse_scenario)
+                            parse_scenario as parse_scenario,
+                            whole_max_cells as whole_max_cells)
     from ._grid import (DISTANCE_ERROR_M as DISTANCE_ERROR_M, EPS as EPS,
                         MAX_COORD_M as MAX_COORD_M, Grid as Grid, Variant as Variant,
                         cell_box as cell_box, exact_n as exact_n, exact_tf as exact_tf,

@@ -21,6 +21,7 @@ import shapely
 
 from ._grid import EPS, Grid, Variant
 from ._kinematics import TOOL, pairs_to_test, part_points, parts
+from ._layers import take_cells
 from ._regions import left_region_polygons, margin, right_region_polygons
 from ._scenario import Scenario
 
@@ -85,7 +86,7 @@ def dr_postcondition(s: Scenario, variant: Variant | str, grid: Grid, dr: npt.ND
     dist = expected_cells(s, variant, grid, k, i, j)
     expected = (dist <= eps).astype(np.int8)
     near = np.abs(dist - eps) <= band
-    got = dr[k, i, j].astype(np.int8)
+    got = take_cells(dr, k, i, j).astype(np.int8)
     bad = np.flatnonzero((got != expected) & ~near)
     shown = bad[:limit]
     return _report(s, variant, grid, len(bad) == 0, len(k), int(((got != expected) & near).sum()),
@@ -121,7 +122,7 @@ def _all_cells(s: Scenario, variant: Variant | str, grid: Grid, dr: npt.NDArray[
         dist = expected_cells(s, variant, grid, kk, cc // n, cc % n)
         want = (dist <= eps).astype(np.int8)
         near = np.abs(dist - eps) <= band
-        got = np.asarray(dr)[kk, cc // n, cc % n].astype(np.int8)
+        got = take_cells(dr, kk, cc // n, cc % n).astype(np.int8)
         wrong = (got != want) & ~near
         bad_count += int(wrong.sum())
         indeterminate = int(((got != want) & near).sum())
@@ -129,7 +130,7 @@ def _all_cells(s: Scenario, variant: Variant | str, grid: Grid, dr: npt.NDArray[
     shown = sorted(shown)[:limit]
     flat = np.asarray([f for f, _ in shown], dtype=np.int64)
     at = np.unravel_index(flat, (N + 1, m, n))
-    got = np.asarray(dr)[at].astype(np.int8)
+    got = take_cells(dr, *at).astype(np.int8)
     expected = np.asarray([e for _, e in shown], dtype=np.int8)
     return _report(s, variant, grid, bad_count == 0, (N + 1) * m * n, indeterminate, at, got,
                    expected)
@@ -139,7 +140,8 @@ def _report(s: Scenario, variant: Variant | str, grid: Grid, ok: bool, checked: 
             indeterminate: int, at: tuple[npt.NDArray[np.int64], ...],
             got: npt.NDArray[np.int8], expected: npt.NDArray[np.int8]) -> PostReport:
     """The report, its mismatches at the cells ``at`` (k, i, j) with the definition's distance."""
-    dist_shown = expected_cells(s, variant, grid, *at)
+    # (No cell shown, no regions made: the definition builds every layer's left regions.)
+    dist_shown = expected_cells(s, variant, grid, *at) if len(got) else np.zeros(0)
     mismatches = tuple(
         CellMismatch(layer=int(kk), cell=(int(ii), int(jj)),
                      angles=grid.angles((int(ii), int(jj))), got=int(g), expected=int(e),
@@ -224,9 +226,12 @@ def _block_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, b
             d1[close] = np.minimum(d1[close], shapely.distance(a, r1[close]))   # exact
         link1.append(d1)
     step = max(1, BLOCK_CELLS // n)
+    row0 = {q: _row0(s, grid, q) for q in parts(s.right) if q > 0}     # once, not per block
+    left_edges: dict[int, _LeftEdges] = {}     # each left region's corners and edges, once
     for i0 in range(0, m, step):
         i1 = min(m, i0 + step)
-        per_cell = {q: _Link2(s, grid, i0, i1, part=q) for q in parts(s.right) if q > 0}
+        per_cell = {q: _Link2(s, grid, i0, i1, part=q, row0=row0[q], left=left_edges)
+                    for q in row0}
         for k, links in enumerate(left):
             d1 = link1[k][i0:i1]
             meets = np.repeat(d1 <= eps - band, n)
@@ -254,22 +259,19 @@ class _Link2:
     cells last, (corners, cells), so that the bounds reduce over the first axis."""
 
     def __init__(self, s: Scenario, grid: Grid, i0: int = 0, i1: int | None = None, *,
-                 part: int = 1) -> None:
+                 part: int = 1, row0: _Row0 | None = None,
+                 left: dict[int, _LeftEdges] | None = None) -> None:
         """Rows i0:i1 (all by default) of part ``part`` (1 link 2, TOOL the tool); cells are
-        numbered (i - i0) n + j."""
+        numbered (i - i0) n + j. ``row0``: ``_row0(s, grid, part)`` if already computed (the
+        blocks of one check share it); ``left``: where ``decide`` keeps the left regions'
+        corners and edges (``_left_edges``) for the blocks of one check."""
+        self.left = {} if left is None else left
         n, h = grid.n, grid.h
         i1 = grid.m if i1 is None else i1
         m = i1 - i0
-        steps = np.array([-1.0, 0.0, 1.0])
         ti = grid.lo[0] + np.arange(grid.m) * h[0]
         tj = grid.lo[1] + np.arange(n) * h[1]
-        t1 = ti[0] + steps[:, None] * h[0]
-        t2 = tj[:, None, None] + steps[None, :] * h[1]
-        t1, t2 = np.broadcast_arrays(t1, t2)            # (n, 3, 3): the first row's lattices
-        grow = margin(s.right, part, h, (3, 3))
-        pts = part_points(s.right, t1, t2, part, grow)
-        pts = pts.reshape(n, -1, 2)
-        order, self.flat = _hull_order(pts)             # (n, L): the first row's hull corners
+        grow, pts, order, self.flat = _row0(s, grid, part) if row0 is None else row0
         hull = np.take_along_axis(pts, order[:, :, None], axis=1)       # (n, L, 2)
         # Row i is row 0 turned about the base by t_i - t_0, and so are its hull corners, axis
         # and edge normals.
@@ -326,15 +328,16 @@ class _Link2:
             # A region that is not a polygon (of zero width: not with links of width > 0) is
             # left to the definition, cell by cell.
             return meets, ~skip
-        A = _ccw(shapely.get_coordinates(a)[:-1])
-        ax, ay = A[:, 0:1], A[:, 1:2]                                    # (V, 1)
+        held = self.left.get(id(a))
+        if held is None or held[0] is not a:
+            held = self.left[id(a)] = _left_edges(a)
+        _, ax, ay, (anx, any_, aoff) = held                               # (V, 1) each
         bx0, by0, bx1, by1 = self.box
         gap = np.maximum(np.maximum(ax.min() - bx1, bx0 - ax.max()),
                          np.maximum(ay.min() - by1, by0 - ay.max()))
         c = np.flatnonzero((gap <= free_at) & ~skip)                     # 1. boxes
         if c.size == 0:
             return meets, undecided
-        anx, any_, aoff = _edges(ax, ay)                                 # (V, 1) each
         if self.has_core:
             cross = _crosses(self.q0[0][c], self.q0[1][c], self.d[0][c], self.d[1][c],
                              anx, any_, aoff)                            # 2. the axis
@@ -369,6 +372,39 @@ class _Link2:
         meets[c[sep <= 0]] = True
         undecided[c[(sep > 0) & (sep <= free_at)]] = True
         return meets, undecided
+
+
+#: A left region (kept, so that its id is not reused), its corners' x and y (V, 1), counter-
+#: clockwise, and its edges' outward normals and offsets (``_edges``).
+_LeftEdges = tuple[shapely.Geometry, npt.NDArray[np.float64], npt.NDArray[np.float64],
+                   tuple[npt.NDArray[np.float64], npt.NDArray[np.float64],
+                         npt.NDArray[np.float64]]]
+
+
+def _left_edges(a: shapely.Geometry) -> _LeftEdges:
+    """``a``'s corners and edges as ``_Link2.decide`` reads them."""
+    A = _ccw(shapely.get_coordinates(a)[:-1])
+    ax, ay = A[:, 0:1], A[:, 1:2]
+    return a, ax, ay, _edges(ax, ay)
+
+
+#: The first row's lattice points of a part (grow, points (n, P, 2), hull order, flat): ``_row0``.
+_Row0 = tuple[float, npt.NDArray[np.float64], npt.NDArray[np.int64], bool]
+
+
+def _row0(s: Scenario, grid: Grid, part: int) -> _Row0:
+    """The first row's lattices of right part ``part`` (n cells of 3 x 3 lattice points, each
+    grown by the part's margin) and their hulls' corners (``_hull_order``): every other row is
+    this one turned about the base (``_Link2``)."""
+    n, h = grid.n, grid.h
+    steps = np.array([-1.0, 0.0, 1.0])
+    t1 = grid.lo[0] + steps[:, None] * h[0]
+    t2 = (grid.lo[1] + np.arange(n) * h[1])[:, None, None] + steps[None, :] * h[1]
+    t1, t2 = np.broadcast_arrays(t1, t2)                # (n, 3, 3): the first row's lattices
+    grow = margin(s.right, part, h, (3, 3))
+    pts = part_points(s.right, t1, t2, part, grow).reshape(n, -1, 2)
+    order, flat = _hull_order(pts)                      # (n, L): the first row's hull corners
+    return grow, pts, order, flat
 
 
 def _ccw(p: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

@@ -25,7 +25,7 @@ import numpy as np
 import shapely
 from flint import arb, ctx
 
-from ._arith import is_term, max_of, min_of, sqrt_of
+from ._arith import max_of, min_of, sqrt_of
 from ._grid import EPS, Grid, Variant, left_angles, left_box, rest_box
 from ._kinematics import TOOL, pairs_to_test, parts
 from ._regions import SNAP, lattice
@@ -39,6 +39,9 @@ EXACT_PREC_BITS = 128
 
 Cell = tuple[int, int]
 Points = list[tuple[arb, arb]]
+#: A region: its corner points in balls and the convex hull of their midpoints (shapely), the
+#: hull made once per region, not once per pair of regions compared (``_gap``).
+Region = tuple[Points, shapely.Geometry]
 
 
 @dataclass(frozen=True)
@@ -142,8 +145,9 @@ def _margin(arm: Arm, link: int, g: tuple[float, float], sizes: tuple[int, int])
 
 
 def _region_points(arm: Arm, link: int, axes: tuple[np.ndarray, np.ndarray],
-                   g: tuple[float, float]) -> tuple[Points, np.ndarray]:
-    """(ball corner points, float corner points) of a region over the lattice ``axes``."""
+                   g: tuple[float, float]) -> Region:
+    """(ball corner points, the float hull of their midpoints) of a region over the lattice
+    ``axes``."""
     grow = _margin(arm, link, g, (len(axes[0]), len(axes[1])))
     r = arb(arm.width) / 2 + grow
     balls: Points = []
@@ -152,15 +156,13 @@ def _region_points(arm: Arm, link: int, axes: tuple[np.ndarray, np.ndarray],
             balls += (_tool_points(arm, float(t1), float(t2), grow) if link == TOOL
                       else _corners(arm, float(t1), float(t2), link, r))
     floats = np.array([[float(x.mid()), float(y.mid())] for x, y in balls])
-    return balls, floats
+    return balls, shapely.convex_hull(shapely.multipoints(floats))
 
 
-def _gap(a: tuple[Points, np.ndarray], b: tuple[Points, np.ndarray]) -> arb:
+def _gap(a: Region, b: Region) -> arb:
     """A ball containing a lower bound on dist(hull A, hull B), by the float nearest direction;
     arb(0) when the float hulls already meet (no direction separates them)."""
-    ha = shapely.convex_hull(shapely.multipoints(a[1]))
-    hb = shapely.convex_hull(shapely.multipoints(b[1]))
-    line = shapely.shortest_line(ha, hb)
+    line = shapely.shortest_line(a[1], b[1])
     (x0, y0), (x1, y1) = line.coords[0], line.coords[1]
     dx, dy = x1 - x0, y1 - y0
     if dx == 0.0 and dy == 0.0:
@@ -172,12 +174,12 @@ def _gap(a: tuple[Points, np.ndarray], b: tuple[Points, np.ndarray]) -> arb:
 
 def _upper(x: Any) -> Any:
     """A value at or above every point of ``x``: the upper end of a ball; a Z3 term itself."""
-    return x if is_term(x) else x.upper()
+    return x.upper() if type(x) is arb else x        # (is_term's test costs more, per point)
 
 
 def _lower(x: Any) -> Any:
     """A value at or below every point of ``x``: the lower end of a ball; a Z3 term itself."""
-    return x if is_term(x) else x.lower()
+    return x.lower() if type(x) is arb else x
 
 
 def projection_bounds(nx: Any, ny: Any, a: Sequence[tuple[Any, Any]],
@@ -214,8 +216,8 @@ def exact_path_gaps(s: Scenario, variant: Variant | str, grid: Grid,
     old = ctx.prec
     ctx.prec = EXACT_PREC_BITS
     try:
-        left: dict[int, list[tuple[Points, np.ndarray]]] = {}
-        right: dict[Cell, list[tuple[Points, np.ndarray]]] = {}
+        left: dict[int, list[Region]] = {}
+        right: dict[Cell, list[Region]] = {}
         out = []
         for layer, cell in path_layer_cells(path, grid.N):
             if layer not in left:
@@ -236,7 +238,7 @@ def exact_path_gaps(s: Scenario, variant: Variant | str, grid: Grid,
 
 
 def _left_points(s: Scenario, v: Variant, grid: Grid, layer: int, g: tuple[float, float]
-                 ) -> list[tuple[Points, np.ndarray]]:
+                 ) -> list[Region]:
     """The principal's regions (one per part) of ``layer`` (the rest layer is N), as the spec builds them."""
     if layer == grid.N:
         if v.rest_at_goal:
@@ -253,7 +255,7 @@ def _left_points(s: Scenario, v: Variant, grid: Grid, layer: int, g: tuple[float
     return [_region_points(s.left, link, axes, g) for link in parts(s.left)]
 
 
-def _right_points(s: Scenario, grid: Grid, cell: Cell) -> list[tuple[Points, np.ndarray]]:
+def _right_points(s: Scenario, grid: Grid, cell: Cell) -> list[Region]:
     """The subordinate's regions (one per part) at ``cell``: the 3 x 3 lattice of its box."""
     h = grid.h
     ti = grid.lo[0] + cell[0] * h[0]

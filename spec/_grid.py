@@ -79,10 +79,11 @@ FloatArray = npt.NDArray[np.float64]
 
 class Variant(str, Enum):
     """How the principal's box per layer is taken (docs/model.md §4). Each member's rules are
-    its row of ``_RULES``: the box of one joint at layer k (``joint_box``) and whether the rest
-    layer is the principal at rest at its goal (``rest_at_goal``) or layer N-1's region. They
-    run on floats and on Z3 terms (``spec._arith``): spec, impl, the exact re-decision and the
-    proofs all read them here, and a member without a row raises."""
+    its row of ``_RULES``: the box of one joint at layer k (``joint_box``), whether the rest
+    layer is the principal at rest at its goal (``rest_at_goal``) or layer N-1's region, and
+    the variant whose box holds its own (``within``, ``nesting``). Code asks these, never the
+    member's name. They run on floats and on Z3 terms (``spec._arith``): spec, impl, the exact
+    re-decision and the proofs all read them here, and a member without a row raises."""
 
     ORIGINAL = "original"  # Algorithm 1: [a - w dt, a + w dt]
     MODIFIED = "modified"  # Section IV.A: [a, a + s w dt]
@@ -100,6 +101,28 @@ class Variant(str, Enum):
     def rest_at_goal(self) -> bool:
         """True when the rest layer is the principal at rest at its goal, else layer N-1."""
         return self.rule.rest_at_goal
+
+    @property
+    def within(self) -> Variant | None:
+        """The variant whose box holds this one's at every layer (None: the outermost)."""
+        outer = self.rule.within
+        return None if outer is None else Variant(outer)
+
+    @classmethod
+    def nesting(cls) -> tuple[tuple[Variant, Variant], ...]:
+        """Every (inner, outer) pair of the rules' ``within``, innermost first (the deepest in
+        the chain of ``within``, then the members' order): tight in modified, modified in
+        original."""
+        def depth(v: Variant) -> int:
+            d, seen = 0, {v}
+            while (w := v.within) is not None:
+                if w in seen:
+                    raise ValueError(f"variant rules: 'within' runs in a cycle through {w}")
+                seen.add(w)
+                v, d = w, d + 1
+            return d
+        inner = sorted((v for v in cls if v.within is not None), key=lambda v: -depth(v))
+        return tuple((v, cast(Variant, v.within)) for v in inner)
 
     def joint_box(self, a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
         """One joint's interval (lo, hi) at layer k: a = theta_q(k dt), b = theta_q((k+1) dt),
@@ -127,12 +150,22 @@ class Variant(str, Enum):
 @dataclass(frozen=True)
 class VariantRule:
     """A variant's rules: ``joint_box(a, b, step, up) -> (lo, hi)`` (see Variant.joint_box),
-    whether its rest layer is the goal, and the rule in words (docs/model.md §4.1)."""
+    whether its rest layer is the goal, the rule in words (docs/model.md §4.1), and what the
+    obligations read of it (docs/model.md §4, §6): ``within``, the variant whose box holds this
+    one's at every layer (None for the outermost; Thm3.box_nesting proves each such pair and
+    Scenario.*.containment checks it on the polygons); ``theorems``, the paper's theorems on
+    BuiltDR and on searchoptpath under this variant's regions; ``in_paper``, whether the paper
+    has the variant (its obligation ids then carry no variant suffix); ``source``, where the
+    rule is defined."""
 
     joint_box: Callable[[Any, Any, Any, Any], tuple[Any, Any]]
     rest_at_goal: bool
     words: str
     rest_words: str
+    within: str | None
+    theorems: tuple[int, int]
+    in_paper: bool
+    source: str
 
 
 def _original_box(a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
@@ -149,14 +182,18 @@ def _tight_box(a: Any, b: Any, step: Any, up: Any) -> tuple[Any, Any]:
 
 
 _RULES: dict[str, VariantRule] = {
-    "original": VariantRule(_original_box, False,
-                            "[a - omega_q dt, a + omega_q dt], a = theta_L(k dt) (Algorithm 1)",
-                            "layer N-1's box"),
-    "modified": VariantRule(_modified_box, False,
-                            "from a = theta_L(k dt) to a + s_q omega_q dt, s_q = +1 if goal_q > "
-                            "start_q else -1 (Section IV.A)", "layer N-1's box"),
-    "tight": VariantRule(_tight_box, True, "from theta_L(k dt) to theta_L((k+1) dt)",
-                         "the goal, a one-point box"),
+    "original": VariantRule(
+        _original_box, False,
+        "[a - omega_q dt, a + omega_q dt], a = theta_L(k dt) (Algorithm 1)", "layer N-1's box",
+        within=None, theorems=(1, 2), in_paper=True, source="Algorithm 1"),
+    "modified": VariantRule(
+        _modified_box, False,
+        "from a = theta_L(k dt) to a + s_q omega_q dt, s_q = +1 if goal_q > start_q else -1 "
+        "(Section IV.A)", "layer N-1's box",
+        within="original", theorems=(3, 4), in_paper=True, source="Section IV.A"),
+    "tight": VariantRule(
+        _tight_box, True, "from theta_L(k dt) to theta_L((k+1) dt)", "the goal, a one-point box",
+        within="modified", theorems=(3, 4), in_paper=False, source="docs/model.md §4"),
 }
 
 

@@ -35,8 +35,8 @@ from typing import IO, Any
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["SPILL_BYTES", "LayerSpill", "Layers", "npz_layers", "npz_member", "save_npz",
-           "spill_wanted"]
+__all__ = ["SPILL_BYTES", "LayerSpill", "Layers", "layered", "npz_layers", "npz_member",
+           "save_npz", "spill_wanted", "take_cells"]
 
 #: Label arrays larger than this (bytes, both together) go to a LayerSpill, and witness members
 #: larger than this are read in place (npz_layers); smaller ones are held whole.
@@ -54,11 +54,26 @@ class Layers:
     """A read-only array of shape ``(L, *layer)`` read one layer at a time by ``read(s)``."""
 
     def __init__(self, shape: tuple[int, ...], dtype: npt.DTypeLike,
-                 read: Callable[[int], Array]) -> None:
+                 read: Callable[[int], Array],
+                 close: Callable[[], None] | None = None) -> None:
         self.shape = tuple(int(x) for x in shape)
         self.dtype = np.dtype(dtype)
         self._read = read
+        self._close = close
         self._cache: list[tuple[int, Array]] = []     # the last two layers read, newest last
+
+    def close(self) -> None:
+        """Release what the layers are read from (a LayerSpill's temporary file); reading them
+        after that fails. Idempotent; nothing to do for most sources."""
+        self._cache = []
+        if self._close is not None:
+            self._close()
+
+    def __enter__(self) -> Layers:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     @property
     def ndim(self) -> int:
@@ -105,7 +120,34 @@ class Layers:
 
     def map(self, fn: Callable[[Array], Array], dtype: npt.DTypeLike) -> Layers:
         """The layers ``fn(a[s])`` (each of this layer shape), read when asked for."""
-        return Layers(self.shape, dtype, lambda s: fn(self.layer(s)))
+        return Layers(self.shape, dtype, lambda s: fn(self.layer(s)), close=self.close)
+
+
+def layered(a: Any) -> Array | Layers:
+    """``a`` as a checker reads D_R: a ``Layers`` (D_R in its store, docs/model.md §9) as it is,
+    read a layer at a time; anything else as an ndarray (``np.asarray``)."""
+    return a if isinstance(a, Layers) else np.asarray(a)
+
+
+def take_cells(a: Any, k: Any, i: Any, j: Any) -> Array:
+    """``a[k, i, j]`` for arrays of cells (k, i, j broadcast together): of an ndarray by
+    numpy's indexing; of a ``Layers`` a layer at a time (each layer the cells name read once),
+    so that D_R in its store is never read whole."""
+    if not isinstance(a, Layers):
+        return np.asarray(a)[k, i, j]
+    k, i, j = np.broadcast_arrays(*(np.asarray(x, dtype=np.int64) for x in (k, i, j)))
+    shape = k.shape
+    k, i, j = k.ravel(), i.ravel(), j.ravel()
+    out = np.empty(k.size, dtype=a.dtype)
+    if not k.size:
+        return out.reshape(shape)
+    order = np.argsort(k, kind="stable")       # the cells grouped by layer, each read once
+    ks = k[order]
+    cuts = np.flatnonzero(np.diff(ks)) + 1
+    for lo, hi in zip(np.r_[0, cuts], np.r_[cuts, ks.size]):
+        at = order[lo:hi]
+        out[at] = a.layer(int(ks[lo]))[i[at], j[at]]
+    return out.reshape(shape)
 
 
 def _pread(fd: int, nbytes: int, offset: int) -> bytes:
@@ -140,6 +182,17 @@ class LayerSpill:
     @property
     def written(self) -> int:
         return len(self._parts)
+
+    def close(self) -> None:
+        """Close (and so remove) the temporary file; the layers read from it fail after that.
+        Idempotent. The search closes its spills where they end, not the garbage collector."""
+        self._file.close()
+
+    def __enter__(self) -> LayerSpill:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def append(self, layer: Array, box: tuple[int, int, int, int] | None = None) -> None:
         """Write the next layer (converted to this type): the whole layer, or with ``box`` =
@@ -197,7 +250,7 @@ class LayerSpill:
         if self.written != self.shape[0]:
             raise ValueError(f"LayerSpill.layers: {self.written} of {self.shape[0]} written")
         self._file.flush()
-        return Layers(self.shape, self.dtype, self._layer)
+        return Layers(self.shape, self.dtype, self._layer, close=self.close)
 
 
 def npz_layers(path: str | Path, name: str) -> Layers | None:

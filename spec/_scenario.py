@@ -49,6 +49,7 @@ __all__ = [
     "load_scenario",
     "parse_scenario",
     "max_cells",
+    "whole_max_cells",
     "DEFAULT_MAX_CELLS",
     "ANGLE_TOLERANCE",
     "MAX_BASE_M",
@@ -59,11 +60,16 @@ __all__ = [
 ]
 
 #: Cells of D_R, (N + 1) * m * n, allowed before any work starts: what fits in 6 GiB at the
-#: peak of a fully checked `cfmpa plan` measured on the default workcell at dt = 0.01, 15.6
-#: bytes a cell (714 MiB for 48 M cells; D_R is 1 byte a cell, the search's back-pointers and
-#: the witness are per layer or spilled to a temporary file, docs/model.md §3), 6 GiB / 15.6 =
-#: 413 M, rounded down. Raise with CFMPA_MAX_CELLS.
-DEFAULT_MAX_CELLS = 400_000_000
+#: peak of a fully checked `cfmpa plan` with D_R in its store (dr.zarr, the default above 100 M
+#: cells: built a block of layers at a time, searched and checked a layer at a time), measured
+#: on the default workcell at dt = 0.0035: 2.1 bytes a cell (2,329 MiB for 1.11 G cells; 3.7 at
+#: dt = 0.005, the per-(m, n) arrays' share falling as N grows); 6 GiB / 3 bytes (the larger
+#: figure rounded up) = 2.1 G, rounded down. Raise with CFMPA_MAX_CELLS. docs/model.md §3.
+DEFAULT_MAX_CELLS = 2_000_000_000
+#: Cells allowed when D_R is held whole in memory (`--store npy`, or a kernel other than the
+#: fast one, which build the whole array): 15.6 bytes a cell measured for a fully checked plan
+#: at dt = 0.01, 6 GiB / 15.6 = 413 M, rounded down. Raise with CFMPA_MAX_WHOLE_CELLS.
+WHOLE_MAX_CELLS = 400_000_000
 #: An angle given for the right arm's start or goal must be this close to a grid point (rad).
 ANGLE_TOLERANCE = 1e-9
 #: Physical range: |base coordinate| <= MAX_BASE_M (m); 0 < link length, width <= MAX_LENGTH_M (m).
@@ -155,15 +161,25 @@ _RIGHT_KEYS = _ARM_KEYS | _ARM_OPTIONAL | {"limits", "start_cell", "goal_cell", 
 
 def max_cells() -> int:
     """The memory budget in cells: CFMPA_MAX_CELLS if set (a positive integer), else the default."""
-    raw = os.environ.get("CFMPA_MAX_CELLS")
+    return _env_cells("CFMPA_MAX_CELLS", DEFAULT_MAX_CELLS)
+
+
+def whole_max_cells() -> int:
+    """The budget in cells of a D_R held whole in memory (WHOLE_MAX_CELLS): CFMPA_MAX_WHOLE_CELLS
+    if set (a positive integer), else the default."""
+    return _env_cells("CFMPA_MAX_WHOLE_CELLS", WHOLE_MAX_CELLS)
+
+
+def _env_cells(name: str, default: int) -> int:
+    raw = os.environ.get(name)
     if raw is None:
-        return DEFAULT_MAX_CELLS
+        return default
     try:
         value = int(raw)
     except ValueError:
         value = -1
     if value <= 0:
-        raise InputError("CFMPA_MAX_CELLS", raw, "must be a positive integer")
+        raise InputError(name, raw, "must be a positive integer")
     return value
 
 

@@ -12,17 +12,20 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import Enum
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ..errors import ContractViolation
-from ._builtdr_post import CellMismatch, dr_postcondition
 from ._counts import SPAN_TOLERANCE, decimal, spacing_conditions
 from ._grid import Grid, Variant, exact_tf
+from ._layers import layered
 from ._paths import J1, J2, SearchResult, SearchStatus, path_violations
 from ._scenario import Scenario
+
+if TYPE_CHECKING:     # shapely's geometry, for the postcondition only (docs/model.md §7.5)
+    from ._builtdr_post import CellMismatch
 
 __all__ = [
     "Command",
@@ -300,7 +303,7 @@ def dr_shape_failures(grid: Grid, dr: Any, condition: str = "post.shape") -> lis
         return [Failure(condition, "D_R has the wrong shape or element type",
                         (("shape", list(shape)), ("expected shape", list(grid.shape)),
                          ("dtype", str(dtype)), ("expected dtype", "uint8")))]
-    a = np.asarray(dr)
+    a = layered(dr)                          # a Layers (a store) stays one (§9, §11)
     count = 0
     first: tuple[int, ...] | None = None
     for layer in range(a.shape[0]):          # a layer at a time: no D_R-sized temporary
@@ -323,6 +326,8 @@ def dr_cell_failures(s: Scenario, variant: Variant | str, grid: Grid,
 
     The count of failing cells is exact up to ``limit``, then a lower bound ("at least").
     """
+    from ._builtdr_post import dr_postcondition  # shapely: loaded by the check alone
+
     rep = dr_postcondition(s, variant, grid, dr, cells=cells, limit=limit)
     if rep.ok:
         return rep.checked, []

@@ -70,7 +70,7 @@ import numpy.typing as npt
 
 from ..errors import MISSING, InputError
 from ..files import LIMITS, check_file_size
-from ._layers import Layers, npz_member
+from ._layers import Layers, layered, npz_member
 from ._paths import J1, J2, MOVES, SearchResult, SearchStatus, path_violations
 from ._triples import Failure
 
@@ -185,6 +185,13 @@ class Witness:
             return {"j1": self.j1, "j2": self.j2}
         return {"reachable": self.reachable}
 
+    def close(self) -> None:
+        """Release the arrays read a layer at a time (their temporary files, spec.LayerSpill);
+        the witness cannot be read after that. Idempotent; nothing to do for ndarrays."""
+        for a in (self.j1, self.j2, self.reachable):
+            if isinstance(a, Layers):
+                a.close()
+
     def npz_members(self) -> dict[str, Any]:
         """The witness file's members: ``format``, ``kind`` and the arrays (``npz_bytes`` writes
         them whole, ``spec.save_npz`` layer by layer)."""
@@ -242,7 +249,7 @@ def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
                   result: SearchResult, witness: Witness | None) -> list[Failure]:
     """The first failing condition of the module docstring, or [] when the witness proves the
     answer: a found path optimal, or no path valid. ``dr`` is a 0/1 array (N + 1, m, n)."""
-    dr = np.asarray(dr)
+    dr = layered(dr)                     # a Layers (a store) is read a layer at a time too
     free = Layers(dr.shape, np.bool_, lambda s: dr[s] == 0)   # one layer at a time (§11)
     N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
     start, goal = (int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))

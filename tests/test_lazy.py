@@ -17,7 +17,8 @@ import cfmpa.lazy
 from cfmpa.lazy import face_exports
 
 ROOT = Path(__file__).resolve().parents[1]
-FACES = {"spec": "cfmpa.spec", "impl": "cfmpa.impl", "report": "cfmpa.report"}
+FACES = {"spec": "cfmpa.spec", "impl": "cfmpa.impl", "report": "cfmpa.report",
+         "runs": "cfmpa.runs"}
 
 HEAD = "from typing import TYPE_CHECKING\n\nif TYPE_CHECKING:\n"
 TAIL = "\nfrom cfmpa.lazy import lazy_face\n__getattr__, __dir__, __all__ = lazy_face(__name__, __file__)\n"

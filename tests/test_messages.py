@@ -128,7 +128,8 @@ def test_cfmpa_docs_prints_where_model_md_is_and_the_help_says_so(capsys):
 
 
 def test_the_speed_error_names_a_bag_message_once_without_a_line(cell, tmp_path, capsys):
-    from cfmpa.runs import BagOptions, write_bag
+    from cfmpa.runs import BagOptions
+    from cfmpa.runs._rosbag import write_bag
 
     s, scen, folder, p = cell
     t = np.array([0.0, 1.0, 1.5])

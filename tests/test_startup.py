@@ -63,6 +63,20 @@ def test_certify_loads_nothing_of_the_planner(tmp_path):
     assert _loaded(_certify(tmp_path)) == []
 
 
+#: What `cfmpa dr` imports of plan.py and the contracts (not plan.json's versions: shapely's).
+CONTRACTS = ("from cfmpa.cli import _parser\n_parser()\n"
+             "from cfmpa.runs import plan, run_dr, run_plan\n"
+             "import cfmpa.runs._contracts, cfmpa.spec._triples\n")
+
+
+def test_the_contracts_modules_load_no_shapely_until_a_check_runs():
+    # plan.py imports the contracts (runs._contracts, spec._triples) at its top, and `cfmpa dr`
+    # imports plan.py; the postcondition, which needs shapely, is imported by its check.
+    assert "shapely" not in _loaded(CONTRACTS)
+    # Seeded fault: spec._triples importing the postcondition at its top, as it did.
+    assert "shapely" in _loaded(CONTRACTS, "import cfmpa.spec._triples, cfmpa.spec._builtdr_post")
+
+
 def test_seeded_fault_an_eager_import_is_caught(tmp_path):
     # versions() as it was: it imported z3 for its version string
     planted = "import z3\n"
@@ -119,7 +133,8 @@ COMMANDS: dict[str, tuple[list[str], set[str], tuple[str, ...]]] = {
     "scenarios": (["scenarios"], set(), ("numba", "shapely")),
     # (numpy comes with every command: the shared parser reads spec's variant table.)
     "docs": (["docs"], set(), ("numba", "shapely")),
-    "dr": (["dr", "{small}", "--out", "{tmp}/dr"], set(), ()),
+    # dr checks nothing: shapely (the spec's geometry, for the contracts) stays out too.
+    "dr": (["dr", "{small}", "--out", "{tmp}/dr"], set(), ("shapely",)),
     "plan": (["plan", "{small}", "--out", "{tmp}/plan"], {"flint"}, ()),
     "check": (["check", "{small}", "--dr", "{tmp}/plan/dr.npy", "--plan",
                "{tmp}/plan/plan.json"], {"flint"}, ()),

@@ -93,9 +93,9 @@ def test_bench_quick_writes_results_with_every_section(tmp_path):
 
 
 #: The targets, in the table's order: full checking (check s, check MiB, full/off, BuiltDR s,
-#: the first run / a later one, peer/dr, plan s), monitoring (samples/s, its peak growth),
-#: proving (make prove s, obligations alone s).
-LIMITS = [5.0, 1024.0, 5.0, 0.10, 2.0, 10.0, 1.5, 100_000.0, 16.0, 120.0, 60.0,
+#: the first run / a later one), start-up (cfmpa dr s, peer/dr), plan s, monitoring
+#: (samples/s, its peak growth), proving (make prove s, obligations alone s, audit s).
+LIMITS = [5.0, 1024.0, 5.0, 0.10, 2.0, 0.6, 4.0, 1.5, 100_000.0, 16.0, 90.0, 60.0, 45.0,
           20.0, 300.0, 200.0, 300.0, 1.0, 300.0, 4096.0, 2048.0]
 
 
@@ -127,6 +127,7 @@ def made_up(default_mode: str = "full") -> dict[str, Any]:
         "dr_cli": t(2.0, variant="modified"),
         "check": t(3.3, peak_rss_mb=1500.0, plan_contracts=default_mode),
         "prove": t(90.0, obligations_s=70.0, ok=True, obligations=80),
+        "audit": t(50.0),
         "one_degree": {"plan_cli_sampled": t(5.0)},
         "monitor": {"log": {"samples": 10**6, "bytes": 96 * 10**6, "cli": t(4.0),
                             "cli_samples_per_s": 250_000.0, "samples_per_s": 300_000.0,
@@ -149,38 +150,41 @@ def test_targets_are_the_issues_with_their_limits_and_verdicts():
     cfg = run.Config.of(False, None)
     rows = run.targets(made_up("full"), cfg)
     assert [r["limit"] for r in rows] == LIMITS
-    assert [r["cmp"] for r in rows] == ["<=", "<=", "<=", "<=", "<=", ">=", "<=", ">=", "<=",
-                                        "<=", "<=", "<=", "<=", "<=", "<=", ">=", "<=", "<=",
-                                        "<="]
-    assert [r["measured"] for r in rows] == [3.3, 1500.0, 2.5, 0.55, 3.0, 2.0, 4.5, 250_000.0,
-                                             2.0, 90.0, 70.0, 12.0, 70.0, 230.0, 70.0, 1.4,
-                                             320.0, 3000.0, 2500.0]
-    assert [r["met"] for r in rows] == [True, False, True, False, False, False, False, True,
-                                        True, True, False, True, True, False, True, True, False,
-                                        True, False]
+    assert [r["cmp"] for r in rows] == ["<=", "<=", "<=", "<=", "<=", "<=", ">=", "<=", ">=",
+                                        "<=", "<=", "<=", "<=", "<=", "<=", "<=", "<=", ">=",
+                                        "<=", "<=", "<="]
+    assert [r["measured"] for r in rows] == [3.3, 1500.0, 2.5, 0.55, 3.0, 2.0, 2.0, 4.5,
+                                             250_000.0, 2.0, 90.0, 70.0, 50.0, 12.0, 70.0,
+                                             230.0, 70.0, 1.4, 320.0, 3000.0, 2500.0]
+    assert [r["met"] for r in rows] == [True, False, True, False, False, False, False, False,
+                                        True, True, True, False, False, True, True, False, True,
+                                        True, False, True, False]
     # D_R on Dask: the note names both medians and that the stores agree.
-    assert "1 worker 30.0 s, 2 workers 21.0 s" in rows[15]["note"]
-    assert "1,110,000,000 cells" in rows[16]["note"]
-    assert "10,000,000-row" in rows[13]["target"] and "default limits" in rows[13]["target"]
-    assert "full checking" in rows[0]["target"] and "monitoring" in rows[7]["target"]
-    assert "make prove" in rows[9]["target"] and "first run" in rows[4]["target"]
+    assert "1 worker 30.0 s, 2 workers 21.0 s" in rows[17]["note"]
+    assert "1,110,000,000 cells" in rows[18]["note"]
+    assert "10,000,000-row" in rows[15]["target"] and "default limits" in rows[15]["target"]
+    assert "full checking" in rows[0]["target"] and "monitoring" in rows[8]["target"]
+    assert "make prove" in rows[10]["target"] and "first run" in rows[4]["target"]
+    # The issue's start-up targets: cfmpa dr default's whole process, and the peer against it.
+    assert "start-up" in rows[5]["target"] and "whole process" in rows[5]["target"]
+    assert "peer" in rows[6]["target"] and "audit default --compare-n 0" in rows[12]["target"]
     # BuiltDR: warm (the median) and cold (the first call) apart; the first run: both runs.
     assert "warm" in rows[3]["target"] and "cold: original 0.700" in rows[3]["note"]
     assert "first 12.0 s" in rows[4]["note"] and "later 4.0 s" in rows[4]["note"]
     # The BuiltDR miss is explained by the profile; the slowest variant is the one measured.
     assert "modified" in rows[3]["note"] and "right regions 0.190 s" in rows[3]["note"]
     # The monitor row reports wall time and peak memory of the whole process.
-    assert rows[7]["wall_s"] == 4.0 and rows[7]["peak_rss_mb"] == 120.0
+    assert rows[8]["wall_s"] == 4.0 and rows[8]["peak_rss_mb"] == 120.0
     assert all("quick run" not in r["note"] for r in rows)
     lines = run.target_lines(rows)
-    assert sum(" MISSED" in line for line in lines) == 9
+    assert sum(" MISSED" in line for line in lines) == 11
 
 
 def test_plan_target_follows_the_cli_default_contract_mode():
     run = bench_module()
     cfg = run.Config.of(False, None)
-    full = run.targets(made_up("full"), cfg)[6]
-    sampled = run.targets(made_up("sampled"), cfg)[6]
+    full = run.targets(made_up("full"), cfg)[7]
+    sampled = run.targets(made_up("sampled"), cfg)[7]
     assert "--contracts full" in full["target"] and full["measured"] == 4.5
     assert "--contracts sampled" in sampled["target"] and sampled["measured"] == 3.0
     assert "build_dr 0.60" in full["note"]      # the miss with plan.json's stages
@@ -190,11 +194,14 @@ def test_unmeasured_targets_are_not_applicable():
     run = bench_module()
     res = made_up()
     res["prove"] = run.skipped("--prove not given (`make bench` passes it)")
+    res["audit"] = run.skipped("--prove not given (`make bench` passes it)")
     res["dr_cli"] = {"error": "exit 2: boom", "argv": ["dr"]}
     rows = {r["target"]: r for r in run.targets(res, run.Config.of(False, None))}
     for name in ("proving: make prove, whole process (s)",
                  "proving: make prove, obligations alone (s)",
-                 "full checking: shapely-vectorised peer / cfmpa dr (x)"):
+                 "proving: cfmpa audit default --compare-n 0, whole process (s)",
+                 "start-up: cfmpa dr default, whole process (s)",
+                 "start-up: shapely-vectorised peer / cfmpa dr (x)"):
         assert rows[name]["measured"] is None and rows[name]["met"] is None
         assert rows[name]["note"].startswith("not measured")
 

@@ -60,10 +60,10 @@ def test_an_edited_nest_is_what_runs():
     # The rest layer left unstored: the marker 2 shows through, so the comparison has teeth.
     calls = []
 
-    def nest(N, m, n, P, SL, SR, variant, region_left, region_right, region_rest, inter):
-        calls.append(variant)
-        builtdr_loop_nest(N - 1, m, n, P, SL, SR, variant, region_left, region_right,
+    def nest(N, m, n, P, SL, SR, rule, region_left, region_right, region_rest, inter):
+        calls.append(rule)
+        builtdr_loop_nest(N - 1, m, n, P, SL, SR, rule, region_left, region_right,
                           region_rest, inter)
     s = coarse(SCENARIOS[0])
     dr = build_dr_loops(s, "modified", nest=nest)
-    assert calls == ["modified"] and (dr == 2).any()
+    assert calls == [Variant.MODIFIED.rule] and (dr == 2).any()

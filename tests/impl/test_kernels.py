@@ -47,15 +47,15 @@ def _differences(build: Callable[..., Any], search: Callable[..., Any]) -> list[
 
 
 def test_the_names_are_the_registry_in_order():
-    assert KERNELS == tuple(REGISTRY) == ("fast", "reference")
+    assert KERNELS == tuple(REGISTRY) == ("fast", "reference", "numpy")
     assert kernels("fast") == (build_dr_fast, search_opt_path_fast)
     assert kernels() == kernels(KERNELS[0])
     assert kernels("reference") == (build_dr, search_opt_path)
     for name in KERNELS:
         assert kernel_name(*kernels(name)) == name
     assert kernel_name(build_dr, search_opt_path_fast) == "custom"
-    with pytest.raises(ValueError, match="kernel='numpy' is not one of fast, reference"):
-        kernels("numpy")
+    with pytest.raises(ValueError, match="kernel='nope' is not one of fast, reference, numpy"):
+        kernels("nope")
 
 
 @pytest.mark.parametrize("name", KERNELS)

@@ -20,7 +20,7 @@ from cfmpa.proofs._obl_constants import (
 )
 from cfmpa.proofs._obligation import VC, Obligation, Z3Query
 from cfmpa.proofs._summaries import SUMMARIES as ALL_SUMMARIES
-from cfmpa.runs import CODE_MUTANTS
+from cfmpa.runs._code_mutants import CODE_MUTANTS
 from mutant_module import mutated_module, source
 from z3answer import answer
 

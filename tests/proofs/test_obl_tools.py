@@ -19,7 +19,7 @@ from cfmpa.proofs import FIXED_IDS, Verdict, collect_obligations
 from cfmpa.proofs import _obl_tools as T
 from cfmpa.proofs._obl_constants import ExtractionError
 from cfmpa.proofs._obligation import VC
-from cfmpa.runs import CODE_MUTANTS
+from cfmpa.runs._code_mutants import CODE_MUTANTS
 from mutant_module import mutated_module
 from z3answer import answer
 
@@ -274,32 +274,33 @@ def test_tf_and_n_are_the_codes_on_floats():
     # counts_on_terms runs spec.exact_tf / exact_n's own code; on numbers it gives their values.
     from fractions import Fraction
 
-    from cfmpa.proofs import _obl_safety as S
+    from cfmpa.proofs import _obl_safety_principal as SA
     from cfmpa.spec import exact_n, exact_tf
     s = cfmpa.spec.load_scenario(Path(cfmpa.spec.__file__).parents[1] / "scenarios"
                                  / "default.toml")
     vals = [z3.RealVal(Fraction(x)) for x in (*s.left.start, *s.left.goal, *s.left.omega, s.dt)]
-    tf, n = S.counts_on_terms(tuple(vals[0:2]), tuple(vals[2:4]), tuple(vals[4:6]), vals[6])
+    tf, n = SA.counts_on_terms(tuple(vals[0:2]), tuple(vals[2:4]), tuple(vals[4:6]), vals[6])
     assert z3.simplify(tf).as_fraction() == exact_tf(s)
     assert z3.simplify(n).as_long() == exact_n(s)
 
 
 def test_tf_max_made_min_refutes_the_travel_lemma(monkeypatch):
     from cfmpa.proofs import _obl_safety as S
+    from cfmpa.proofs import _obl_safety_principal as SA
     mod = _planted("travel_time_min")
-    real = S.counts_on_terms
-    monkeypatch.setattr(S, "counts_on_terms",
+    real = SA.counts_on_terms
+    monkeypatch.setattr(SA, "counts_on_terms",
                         lambda *a, **k: real(*a, travel=mod.travel_time, **k))
     vcs = {v.name: v for v in S._principal_query("modified").vcs}
     assert _refuted(vcs[CAUGHT_BY["travel_time_min"][1]])
     # ... and the composition reads the same Tf: its hypothesis is the mutant's.
-    hyp = dict(S.composition_vc("modified").hypotheses)[S.Principal.named().tf_def()[0]]
-    assert z3.eq(hyp.arg(1), real(*_principal_args(S), travel=mod.travel_time)[0])
-    assert not z3.eq(hyp.arg(1), real(*_principal_args(S))[0])
+    hyp = dict(S.composition_vc("modified").hypotheses)[SA.Principal.named().tf_def()[0]]
+    assert z3.eq(hyp.arg(1), real(*_principal_args(SA), travel=mod.travel_time)[0])
+    assert not z3.eq(hyp.arg(1), real(*_principal_args(SA))[0])
 
 
-def _principal_args(S):
-    P = S.Principal.named()
+def _principal_args(SA):
+    P = SA.Principal.named()
     return P.start, P.goal, P.omega, P.dt
 
 

@@ -92,7 +92,7 @@ def test_scenario_checks_are_pinned_by_their_source_not_their_data(tmp_path: Pat
     assert not check_pins(run.proofs, load_lock())
 
 
-def test_cvc5_reruns_a_statement_it_did_not_decide_when_pinned(tmp_path: Path):
+def test_cvc5_takes_a_statement_it_did_not_decide_when_pinned_from_the_lock(tmp_path: Path):
     lock = tmp_path / "obligations.lock"
     run_obligations([_ob(1)], tmp_path, ["T.pin"], lock=lock, repin=True)
     doc = json.loads(lock.read_text())
@@ -103,11 +103,16 @@ def test_cvc5_reruns_a_statement_it_did_not_decide_when_pinned(tmp_path: Path):
     assert cvc5_skips(load_lock(lock)) == {sha: "timeout at 5000 ms"}
     run = run_obligations([_ob(1)], tmp_path, ["T.pin"], lock=lock)
     v = run.proofs[0].vcs[0]
-    # Re-run, not skipped: cvc5 decides this small VC now, and confirms it.
-    assert run.ok and v.cvc5 in ("unsat", "unknown")
+    # Not re-run: the pinned answer, said so; Z3 still proves it.
+    assert run.ok and v.cvc5 == "unknown" and v.cvc5_from_pin and v.solvers == ("z3",)
+    assert "taken from the lock" in v.note and "timeout at 5000 ms" in v.note
+    # --recheck-undecided re-runs it: cvc5 decides this small VC now, and confirms it.
+    run = run_obligations([_ob(1)], tmp_path, ["T.pin"], lock=lock, recheck_undecided=True)
+    v = run.proofs[0].vcs[0]
+    assert run.ok and not v.cvc5_from_pin and v.cvc5 in ("unsat", "unknown")
     if v.cvc5 == "unsat":
         assert v.solvers == ("z3", "cvc5")
-    assert "re-run for 1500 ms" in v.note and "timeout at 5000 ms" in v.note
+    assert "re-run for 5000 ms" in v.note and "timeout at 5000 ms" in v.note
 
 
 def test_the_words_of_a_statement_are_not_pinned(tmp_path: Path):

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from cfmpa.impl import lattice_range, link_reach, link_rectangles, sweep_margin
 from cfmpa.impl._regions import swept_points  # the points impl.swept_region hulls
 from cfmpa.proofs import _obl_safety as S
+from cfmpa.proofs import _obl_safety_region as SC
 from cfmpa.proofs._obligation import VC
 from cfmpa.spec import Arm
 from z3answer import answer
@@ -25,8 +26,8 @@ ARMS = ("L", "R")
 
 
 @pytest.fixture(scope="module")
-def kit() -> S.Kit:
-    return S.region_kit()
+def kit() -> SC.Kit:
+    return SC.region_kit()
 
 
 def _proves(vc: VC) -> bool:
@@ -172,7 +173,7 @@ def _model_points(model: S.ArmModel, x: int, arm: Arm, configs, grow: float) -> 
     out = []
     for a, b in configs:
         for u, v in _rect_corners(arm.width / 2 + grow, ell):
-            p = model.frame_point(x, S._q(a), S._q(a) + S._q(b), (S._q(u), S._q(v)))
+            p = model.frame_point(x, SC._q(a), SC._q(a) + SC._q(b), (SC._q(u), SC._q(v)))
             out.append((_num(p[0], env), _num(p[1], env)))
     return np.array(out)
 
@@ -229,8 +230,8 @@ def test_the_hull_definition_generates_impl_s_swept_points(arm, x, lo1, w1, lo2,
     term = model.margin(x, ((sym[0], sym[1]), (sym[2], sym[3])), (sym[4], sym[5]),
                         (sym[6], sym[7]))
     values = (box[0][0], box[0][1], box[1][0], box[1][1], a1, a2, g1, g2)
-    pairs = [(z3.Real(k), S._q(v)) for k, v in env.items()] + [
-        (c, S._q(v)) for c, v in zip(sym, values)]
+    pairs = [(z3.Real(k), SC._q(v)) for k, v in env.items()] + [
+        (c, SC._q(v)) for c, v in zip(sym, values)]
     val = z3.simplify(z3.substitute(term, *pairs))
     assert abs(float(val.as_fraction()) - grow) <= 1e-12 * max(1.0, grow)
 
@@ -241,6 +242,6 @@ def test_the_comparison_with_impl_catches_a_wrong_frame(monkeypatch):
     want = link_rectangles(arm, np.array(0.3), np.array(0.7), 1).reshape(-1, 2)
     assert _same_set(_model_points(S.ArmModel.named("L"), 1, arm, [(0.3, 0.7)], 0.0), want)
     monkeypatch.setattr(S.ArmModel, "frame_point",
-                        lambda self, x, alpha, phi, uv: S._point2(self.b, self.l1, alpha, alpha,
+                        lambda self, x, alpha, phi, uv: SC._point2(self.b, self.l1, alpha, alpha,
                                                                   uv[0], uv[1]))
     assert not _same_set(_model_points(S.ArmModel.named("L"), 1, arm, [(0.3, 0.7)], 0.0), want)

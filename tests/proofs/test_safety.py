@@ -13,7 +13,12 @@ import z3
 
 from cfmpa.impl import SNAP, link_reach, sweep_margin
 from cfmpa.proofs import FIXED_IDS, collect_obligations
+from cfmpa.proofs import _obl_arc_chord as ARC
 from cfmpa.proofs import _obl_safety as S
+from cfmpa.proofs import _obl_safety_principal as SA
+from cfmpa.proofs import _obl_safety_region as SC
+from cfmpa.proofs import _obl_safety_separation as SD
+from cfmpa.proofs import _obl_safety_subordinate as SB
 from cfmpa.proofs._obligation import VC
 from cfmpa.spec import exact_n, exact_tf, left_angles, left_box, load_scenario, make_grid, right_box
 from z3answer import answer, as_float, exact_real
@@ -117,24 +122,24 @@ def test_the_skeleton_test_catches_a_propositional_vc():
 
 @pytest.mark.parametrize("variant", S.VARIANTS)
 def test_principal_needs_its_step_window(variant):
-    motion, rest = S.principal_lemmas(variant)
+    motion, rest = SA.principal_lemmas(variant)
     assert _refuted(motion.vc, motion.vc.key_premise)
     assert _refuted(rest.vc, rest.vc.key_premise)      # N's definition dropped
 
 
 @pytest.mark.parametrize("variant", S.VARIANTS)
 def test_principal_rest_fails_when_N_dt_falls_short_of_Tf(variant):
-    P = S.Principal.named()
+    P = SA.Principal.named()
     short = ("N >= 1, N dt < Tf", z3.And(P.N >= 1, z3.ToReal(P.N) * P.dt < P.Tf))
-    _, rest = S.principal_lemmas(variant, n_def=short)
+    _, rest = SA.principal_lemmas(variant, n_def=short)
     assert _refuted(rest.vc)
 
 
 @pytest.mark.parametrize("variant", S.VARIANTS)
 def test_principal_motion_needs_the_speed_bound(variant):
     # Without Tf = max_q |goal_q - start_q| / omega_q a joint may outrun its box.
-    motion, _ = S.principal_lemmas(variant)
-    tf = S.Principal.named().tf_def()[0]
+    motion, _ = SA.principal_lemmas(variant)
+    tf = SA.Principal.named().tf_def()[0]
     if variant == "tight":
         # The tight box follows the motion itself: it holds for any Tf >= 0.
         assert not _refuted(motion.vc, tf)
@@ -143,7 +148,7 @@ def test_principal_motion_needs_the_speed_bound(variant):
 
 
 def test_the_modified_box_with_its_sign_flipped_misses_the_motion():
-    motion, rest = S.principal_lemmas("modified", sign_flip=True)
+    motion, rest = SA.principal_lemmas("modified", sign_flip=True)
     assert _refuted(motion.vc)
     assert _refuted(rest.vc)
 
@@ -157,7 +162,7 @@ def _scenarios():
 @pytest.mark.parametrize("path", _scenarios(), ids=lambda p: p.stem)
 def test_the_box_rules_are_spec_left_box_and_right_box(path):
     s = load_scenario(path)
-    P = S.Principal.named()
+    P = SA.Principal.named()
     pins = [(P.start[q], exact_real(s.left.start[q])) for q in range(2)]
     pins += [(P.goal[q], exact_real(s.left.goal[q])) for q in range(2)]
     pins += [(P.omega[q], exact_real(s.left.omega[q])) for q in range(2)]
@@ -187,7 +192,7 @@ def test_the_box_rules_are_spec_left_box_and_right_box(path):
             assert as_float(sub(th[q])) == pytest.approx(float(a[q]), abs=1e-12)
     # The subordinate's box is spec.right_box's.
     g = make_grid(s)
-    R = S.Subordinate.named()
+    R = SB.Subordinate.named()
     rpins = ([(R.lo[q], exact_real(g.lo[q])) for q in range(2)]
              + [(R.h[q], exact_real(g.h[q])) for q in range(2)])
     for cell in ((0, 0), (g.m - 1, g.n - 1), (g.m // 2, 1)):
@@ -202,9 +207,9 @@ def test_the_box_rules_are_spec_left_box_and_right_box(path):
 # --- (b) the subordinate -----------------------------------------------------------------------
 
 def test_a_jump_of_two_cells_leaves_the_box():
-    move, _ = S.subordinate_lemmas(reach=2)
+    move, _ = SB.subordinate_lemmas(reach=2)
     assert _refuted(move.vc)
-    move, on_path = S.subordinate_lemmas()
+    move, on_path = SB.subordinate_lemmas()
     assert _refuted(move.vc, move.vc.key_premise)
     assert _refuted(on_path.vc, on_path.vc.key_premise)
 
@@ -224,7 +229,7 @@ def _sixteenth(arm, link, g, moving=(True, True)):
 
 def _arc_with(constant: int) -> VC:
     """Margin.arc_chord's VC with its bound r g^2/8 written r g^2/constant."""
-    arc = S.arc_chord()
+    arc = ARC.arc_chord()
     goal = z3.substitute(arc.vc.goal, (arc.delta, arc.r * arc.g * arc.g / constant))
     assert not z3.eq(goal, arc.vc.goal)
     return VC(arc.vc.name, arc.vc.hypotheses, goal, arc.vc.key_premise)
@@ -246,7 +251,7 @@ def test_region_soundness_instantiates_the_proved_arc_lemma(queries):
 
 
 def test_a_margin_lemma_with_1_16_is_refuted():
-    kit = S.region_kit(arc_vc=_arc_with(16))
+    kit = SC.region_kit(arc_vc=_arc_with(16))
     # The step where the constant is paid (cos x >= 1 - x^2/2 gives g^2/8, not g^2/16) fails.
     assert _refuted(kit["arc_gap"].vc, pins=())
     assert not _refuted(kit["arc_weight"].vc, pins=()) and not _refuted(kit["arc_dist"].vc, pins=())
@@ -254,18 +259,18 @@ def test_a_margin_lemma_with_1_16_is_refuted():
 
 def test_a_weaker_margin_lemma_no_longer_covers_sweep_margin():
     # r g^2/4 is true of an arc, but more than sweep_margin adds: margin_covers fails.
-    kit = S.region_kit(arc_vc=_arc_with(4))
-    assert not _refuted(S.region_query(kit).vcs[0], pins=()) and not _refuted(kit["arc_gap"].vc)
+    kit = SC.region_kit(arc_vc=_arc_with(4))
+    assert not _refuted(SC.region_query(kit).vcs[0], pins=()) and not _refuted(kit["arc_gap"].vc)
     for name in ("margin_covers_link1", "margin_covers_link2"):
         assert _refuted(kit[name].vc, pins=())
 
 
 def test_sweep_margin_with_1_16_fails_the_margin_comparison():
-    kit = S.region_kit(margin=_sixteenth)
+    kit = SC.region_kit(margin=_sixteenth)
     for name in ("margin_covers_link1", "margin_covers_link2"):
         assert _refuted(kit[name].vc, pins=())
     # ... and the composition reads the same mutant: its margin hypothesis changed.
-    good = S.region_kit()
+    good = SC.region_kit()
     for name in ("link1_in_region", "link2_in_region"):
         key = good[name].vc.key_premise
         mutated = dict(kit[name].vc.hypotheses)[key]
@@ -278,21 +283,21 @@ def test_the_margin_read_from_impl_is_its_formula():
         for flags in ((True, True), (True, False), (False, True), (False, False)):
             if link == 0 and flags[1]:
                 continue
-            read = S.impl_margin_term(link, (g1, g2), (rb, re), flags)
+            read = SC.impl_margin_term(link, (g1, g2), (rb, re), flags)
             reach = (rb, re if link == 1 else z3.RealVal(0))
-            want = sum((g * g / 8 * r if f else 0) + S.SNAP_Q * g * r
+            want = sum((g * g / 8 * r if f else 0) + SC.SNAP_Q * g * r
                        for g, r, f in zip((g1, g2), reach, flags))
             s = z3.Solver()
             s.add(read != want)
             assert s.check() == z3.unsat, (link, flags)
     # A margin function the reading cannot follow is refused, not read wrong.
     with pytest.raises(ValueError, match="the margin read"):
-        S.impl_margin_term(1, (g1, g2), (rb, re), (True, True),
+        SC.impl_margin_term(1, (g1, g2), (rb, re), (True, True),
                            lambda arm, link, g, moving: sweep_margin(arm, link, (0.5, 0.5), moving))
 
 
 def test_the_lattice_model_is_lattice_range():
-    S.check_lattice_reading()
+    SC.check_lattice_reading()
 
 
 def test_a_widened_snap_fails_lattice_span(monkeypatch):
@@ -306,15 +311,15 @@ def test_a_widened_snap_fails_lattice_span(monkeypatch):
             i_hi = ceil_of((hi - anchor) / g - 1000 * SNAP)
             return (min_of(i_lo, i_hi), max_of(i_lo, i_hi))
         return cases(g <= 0, lambda: (0, 0), span)
-    good = {L.vc.name: L.vc for L in S._lattice()}
+    good = {L.vc.name: L.vc for L in SC._lattice()}
     assert not _refuted(good["lattice_span"], pins=())
-    monkeypatch.setattr(S, "lattice_range", wide)
-    span, snap, whole = S._lattice()
+    monkeypatch.setattr(SC, "lattice_range", wide)
+    span, snap, whole = SC._lattice()
     assert span.vc.name == "lattice_span" and _refuted(span.vc, pins=())
 
 
 def test_region_lemmas_need_their_key_premises():
-    kit = S.region_kit()
+    kit = SC.region_kit()
     for name, L in kit.lemmas.items():
         assert _refuted(L.vc, L.vc.key_premise), name
 
@@ -322,7 +327,7 @@ def test_region_lemmas_need_their_key_premises():
 # --- (d), (e) ------------------------------------------------------------------------------------
 
 def test_separation_needs_the_rounding_bound_and_the_distance():
-    margin, common = S.separation_lemmas()
+    margin, common = SD.separation_lemmas()
     assert _refuted(margin.vc, margin.vc.key_premise)
     assert _refuted(common.vc, common.vc.key_premise)
     assert _refuted(common.vc, "(c) link a of the principal at theta_L lies in A (at p)")
@@ -331,7 +336,7 @@ def test_separation_needs_the_rounding_bound_and_the_distance():
 @pytest.mark.parametrize("eps", ["0", "1e-12", "2e-11"])
 def test_an_eps_below_the_rounding_bound_is_refuted(eps):
     # Seeded fault: spec.EPS set below spec.DISTANCE_ERROR_M (2.8e-11 m); eps_margin must fail.
-    margin, _ = S.separation_lemmas()
+    margin, _ = SD.separation_lemmas()
     vc = margin.vc
     hyps = tuple((n, z3.Real("eps") == z3.RealVal(eps)) if n == S.EPS_HYP else (n, h)
                  for n, h in vc.hypotheses)
@@ -360,7 +365,7 @@ def test_a_strengthened_region_hypothesis_is_refuted_by_the_instance_check(varia
         hs = real(v, at)
         region_l, _, _ = S._regions(v)
         hs[0] = (hs[0][0], z3.And([z3.Implies(z3.And(0 <= at.k, at.k < at.d.N), z3.Implies(
-            S.link_l(x, at.theta_l, at.p), S.member(region_l(at.k, x), at.p)))
+            SD.link_l(x, at.theta_l, at.p), S.member(region_l(at.k, x), at.p)))
             for x in S.LINKS]))
         return hs
     assert _proved(S.region_instance_vc(variant))

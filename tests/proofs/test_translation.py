@@ -28,8 +28,8 @@ def _planted(monkeypatch: pytest.MonkeyPatch, *, build=None, search=None) -> Non
     """cfmpa.impl.kernels("fast") gives the planted build or search in place of the real one."""
     real = impl.kernels
 
-    def kernels(name: str = "fast"):
-        b, s = real(name)
+    def kernels(name: str = "fast", **kw):
+        b, s = real(name, **kw)
         return (build(b) if build else b), (search(s) if search else s)
     monkeypatch.setattr(impl, "kernels", kernels)
 

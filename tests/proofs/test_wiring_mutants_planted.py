@@ -19,7 +19,7 @@ from cfmpa.proofs._obl_wiring import (
     reference_speed_vcs,
     trajectory_motion_vcs,
 )
-from cfmpa.runs import CODE_MUTANTS
+from cfmpa.runs._code_mutants import CODE_MUTANTS
 from mutant_module import mutated_module, source
 from z3answer import answer
 

@@ -12,7 +12,8 @@ import pytest
 import factory
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.runs import BATCH_JSON, find_plan_folders, run_batch
+from cfmpa.runs import run_batch
+from cfmpa.runs._batch import BATCH_JSON, find_plan_folders
 from cfmpa.runs._plan import plan, write_plan
 from cfmpa.runs._selftest import WORKCELLS
 from cfmpa.spec import load_scenario

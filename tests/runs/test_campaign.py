@@ -26,16 +26,10 @@ from cfmpa.errors import InputError
 from cfmpa.report import run_compare
 from cfmpa.report._compare import campaign_json
 from cfmpa.report._stats import mcnemar_exact_p, wilson_interval
-from cfmpa.runs import (
-    STORE_NAME,
-    Engine,
-    ProgressBar,
-    check_scheduler_address,
-    open_store,
-    random_workcell,
-    run_campaign,
-    workcell_task,
-)
+from cfmpa.runs import Engine, run_campaign
+from cfmpa.runs._campaign import STORE_NAME, random_workcell, workcell_task
+from cfmpa.runs._engine import ProgressBar, check_scheduler_address
+from cfmpa.runs._store import open_store
 
 SEED, N, DT = 5, 6, 0.2
 

@@ -8,7 +8,8 @@ import pytest
 from cfmpa.errors import InputError
 from cfmpa.impl import build_dr
 from cfmpa.report import run_compare
-from cfmpa.runs import CONTACT_NOTE, load_campaign, random_workcell, run_campaign
+from cfmpa.runs import load_campaign, run_campaign
+from cfmpa.runs._campaign import CONTACT_NOTE, random_workcell
 from cfmpa.spec import EPS, J1, J2, is_path, make_grid, polygon_distance
 from cfmpa.spec._kinematics import arm_corners
 

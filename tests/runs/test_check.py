@@ -360,7 +360,7 @@ def test_check_rejects_every_fault_the_selftest_seeds(tmp_path):
 def test_a_plan_file_is_read_within_its_limit(tmp_path, monkeypatch):
     # /dev/zero (or a plan.json cut short of nothing) is refused at the limit, naming it;
     # before, the whole device was read into memory (MemoryError).
-    from cfmpa.runs import read_plan
+    from cfmpa.runs._check import read_plan
 
     with pytest.raises(InputError) as e:
         read_plan("/dev/zero")

@@ -11,8 +11,15 @@ import pytest
 
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.runs import CODE_MUTANTS, CodeMutant, code_mutation_rows, imports_copy, mutated_copy
-from cfmpa.runs._code_mutants import _check_prove, _env
+from cfmpa.runs._code_mutants import (
+    CODE_MUTANTS,
+    CodeMutant,
+    _check_prove,
+    _env,
+    code_mutation_rows,
+    imports_copy,
+    mutated_copy,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 #: The smallest bundled workcell's translation checks: seconds, where the whole prove is a minute.

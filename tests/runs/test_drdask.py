@@ -117,10 +117,16 @@ def test_a_block_of_layers_is_those_layers_of_the_whole_build(small, variant, wo
 
 def test_blocks_are_whole_chunks_within_the_task_budget(monkeypatch):
     L, blocks = blocks_of((11, 10, 10), workers=2, layers_per_chunk=2)
-    assert L == 2 and blocks == [(0, 4), (4, 8), (8, 11)]       # 6 chunks, 2 workers x 2
+    # 6 chunks, 2 workers x 2 blocks, within one chunk of each other (no worker gets more)
+    assert L == 2 and blocks == [(0, 4), (4, 8), (8, 10), (10, 11)]
     assert blocks_of((11, 10, 10), workers=0, layers_per_chunk=2)[1] == [(0, 6), (6, 11)]
+    # 25 chunks, 2 workers: 7, 6, 6, 6 (cut by ceil, 7, 7, 7, 4: one worker 14, the other 11)
+    assert [b - a for a, b in blocks_of((250, 10, 10), 2, 10)[1]] == [70, 60, 60, 60]
+    assert blocks_of((3, 10, 10), 4, 1)[1] == [(0, 1), (1, 2), (2, 3)]   # fewer chunks
     monkeypatch.setattr(_drdask, "TASK_BYTES", 200)              # one chunk a task at most
     assert blocks_of((5, 10, 10), 1, 2)[1] == [(0, 2), (2, 4), (4, 5)]
+    monkeypatch.setattr(_drdask, "TASK_BYTES", 400)              # two chunks a task at most
+    assert [b - a for a, b in blocks_of((19, 10, 10), 2, 2)[1]] == [4, 4, 4, 4, 2, 1]  # 3 each
     with pytest.raises(ValueError, match="chunk's first layer"):
         _drdask.dr_block_task(parse_scenario(factory.doc(), check_budget=False), "modified",
                               1, 3, 2)

@@ -257,13 +257,13 @@ def test_a_corrupt_store_is_exit_2_naming_the_file(small, tmp_path, capsys, case
 def test_a_store_with_chunks_too_large_to_hold_is_refused_unread(tmp_path):
     dr = np.zeros((3, 4, 5), np.uint8)
     path, _ = write_dr(tmp_path, dr, "zarr")
-    _meta("shape", [3, 20000, 20000])(path)
-    _meta("chunk_shape", [1, 20000, 20000])(path)
+    _meta("shape", [3, 30000, 30000])(path)
+    _meta("chunk_shape", [1, 30000, 30000])(path)
     with pytest.raises(InputError) as exc:       # no grid given: the cell budget
         load_dr(path)
-    assert "has 1,200,000,000 cells, over the budget of 400,000,000" in str(exc.value)
+    assert "has 2,700,000,000 cells, over the budget of 2,000,000,000" in str(exc.value)
     with pytest.raises(InputError) as exc:       # the grid's shape, in chunks too large
-        load_dr(path, (3, 20000, 20000))
+        load_dr(path, (3, 30000, 30000))
     assert "over 268,435,456" in str(exc.value) and "zarr.json" in str(exc.value)
 
 

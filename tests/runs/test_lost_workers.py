@@ -26,7 +26,7 @@ import cfmpa.runs._batch as batch_module
 import cfmpa.runs._campaign as campaign_module
 import cfmpa.runs._engine as engine_module
 from cfmpa.cli import main
-from cfmpa.runs import STORE_NAME
+from cfmpa.runs._campaign import STORE_NAME
 
 SEED, N, DT = 5, 4, 0.5
 #: Seconds a guarded run may take before the test calls it hung (the runs here take ~5 s).

@@ -12,7 +12,7 @@ import pytest
 
 import cfmpa.spec._layers as layers_module
 import factory
-from cfmpa.runs import check_outputs, read_plan
+from cfmpa.runs._check import check_outputs, read_plan
 from cfmpa.runs._plan import plan, write_plan
 from cfmpa.spec import Layers, load_witness
 
@@ -48,3 +48,6 @@ def test_a_layered_witness_is_checked_written_and_verified(spill_everything, tmp
     bad = check_outputs(s, np.load(tmp_path / "dr.npy"), read_plan(tmp_path / "plan.json"),
                         witness=load_witness(tmp_path / "bad.npz"))
     assert not bad.ok and "witness.start" in bad.failed[0].what
+    p.search.witness.close()          # the spilled labels' temporary files, not left to the GC
+    with pytest.raises(ValueError, match="closed file"):
+        p.search.witness.j1.layer(1)

@@ -15,18 +15,9 @@ from rosbags.typesys import Stores, get_typestore
 
 import factory
 from cfmpa.cli import main
-from cfmpa.runs import (
-    BLOCK_ROWS,
-    MISSING_MESSAGES,
-    BagOptions,
-    Excursion,
-    bag_rows,
-    log_csv,
-    monitor_json,
-    monitor_log,
-    monitor_rows,
-    simulate_log,
-)
+from cfmpa.runs import BagOptions, Excursion, log_csv, monitor_json, monitor_log, simulate_log
+from cfmpa.runs._rosbag import bag_rows
+from cfmpa.runs._trajectory_runs import BLOCK_ROWS, MISSING_MESSAGES, monitor_rows
 from cfmpa.spec import TRAJECTORY_COLUMNS, load_trajectory, tolerance_rad, trajectory_csv
 
 DOC = factory.doc(right__start_cell=[2, 8], right__goal_cell=[13, 5])

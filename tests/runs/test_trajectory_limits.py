@@ -18,8 +18,8 @@ import factory
 import mutant_module
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.runs import BagOptions, certify_json, load_bag_trajectory
-from cfmpa.runs._rosbag import bag_row_name, bag_trajectory_rows, write_bag
+from cfmpa.runs import BagOptions, certify_json
+from cfmpa.runs._rosbag import bag_row_name, bag_trajectory_rows, load_bag_trajectory, write_bag
 from cfmpa.spec import _trajectory as tr
 from cfmpa.spec import certify_trajectory, certify_trajectory_file, load_trajectory
 

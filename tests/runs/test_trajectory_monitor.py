@@ -13,17 +13,8 @@ import pytest
 import factory
 from cfmpa.cli import main
 from cfmpa.errors import InputError
-from cfmpa.runs import (
-    AFTER_LOG,
-    BEFORE_LOG,
-    BETWEEN_SAMPLES,
-    LISTED_UNOBSERVED,
-    _trajectory_runs,
-    log_csv,
-    monitor_log,
-    parse_max_speed,
-    simulate_log,
-)
+from cfmpa.runs import _trajectory_runs, log_csv, monitor_log, parse_max_speed, simulate_log
+from cfmpa.runs._trajectory_runs import AFTER_LOG, BEFORE_LOG, BETWEEN_SAMPLES, LISTED_UNOBSERVED
 from cfmpa.spec import ReferenceSpeeds, Trajectory, load_trajectory, max_of, tolerance_rad
 
 DOC = factory.doc(right__start_cell=[2, 8], right__goal_cell=[13, 5])

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from cfmpa.runs import CODE_MUTANTS, code_mutation_rows
+from cfmpa.runs._code_mutants import CODE_MUTANTS, code_mutation_rows
 
 #: Mutant -> what must catch it (the --only of its prove run: each named one must fail).
 WIRING = {

@@ -120,7 +120,7 @@ def test_budget_message_names_the_grid_and_caps_its_numbers():
     assert "m=2.513e+301" in huge and "cells, over" in huge
     assert max(len(w) for w in huge.replace(",", " ").split()) < 40  # no 300-digit numbers
     # The factor blamed follows the grid: a long motion makes N + 1 the largest.
-    slow = str(refused(left__omega=[1e-5, 1e-5]))
+    slow = str(refused(left__omega=[1e-6, 1e-6]))
     assert "largest factor is N + 1 (from dt, left.omega" in slow
 
 
@@ -138,9 +138,12 @@ def test_angles_on_grid_points_are_accepted_as_cells():
 
 
 def test_budget_can_be_raised_by_environment(monkeypatch):
+    monkeypatch.setenv("CFMPA_MAX_CELLS", str(10**6))
+    with pytest.raises(InputError, match="over the memory budget of"):
+        parse_scenario(factory.doc(dt=0.005))
     monkeypatch.setenv("CFMPA_MAX_CELLS", str(10**9))
     s = parse_scenario(factory.doc(dt=0.005))
-    assert s.cells > DEFAULT_MAX_CELLS  # over the default budget, accepted now
+    assert s.cells > 10**6  # over the lowered budget, accepted once it is raised
     monkeypatch.setenv("CFMPA_MAX_CELLS", "lots")
     with pytest.raises(InputError, match="CFMPA_MAX_CELLS"):
         parse_scenario(factory.doc())

@@ -1,0 +1,93 @@
+"""`make lint` as the field does it (docs/contributing.md, "Lint"): mypy reads every package the
+wheel installs, none of them silenced wholesale. Checked on pyproject.toml, and each rule on a
+copy with the fault it is there to catch."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+PYPROJECT = Path(__file__).resolve().parents[1] / "pyproject.toml"
+
+#: Override settings that hide a module's own errors (each of ours must be checked).
+_SILENCING = {"follow_imports": ("silent", "skip"), "ignore_errors": (True,)}
+
+
+def _listed(names: Any) -> list[str]:
+    return [names] if isinstance(names, str) else list(names or ())
+
+
+def _covered(module: str, packages: list[str], modules: list[str]) -> bool:
+    """Whether mypy checks ``module``: named in ``modules`` or inside a package of ``packages``."""
+    return module in modules or any(module == p or module.startswith(p + ".") for p in packages)
+
+
+def lint_problems(doc: dict[str, Any]) -> list[str]:
+    """What keeps [tool.mypy] from checking every package, one line each ([] when nothing
+    does)."""
+    out: list[str] = []
+    tool = doc.get("tool", {})
+    installed = _listed(tool.get("setuptools", {}).get("packages"))
+    mypy = tool.get("mypy", {})
+    packages, modules = _listed(mypy.get("packages")), _listed(mypy.get("modules"))
+    out += [f"mypy does not check the package {p}" for p in installed
+            if not _covered(p, packages, modules)]
+    for o in mypy.get("overrides", []):
+        ours = [m for m in _listed(o.get("module")) if m == "cfmpa" or m.startswith("cfmpa.")]
+        for key, bad in _SILENCING.items():
+            if ours and o.get(key) in bad:
+                out.append(f"an override sets {key} = {o[key]!r} for {', '.join(ours)}")
+        if ours and o.get("ignore_missing_imports"):
+            out.append(f"ignore_missing_imports (for untyped third-party code) on {ours}")
+    return out
+
+
+@pytest.fixture(scope="module")
+def pyproject() -> dict[str, Any]:
+    return tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))
+
+
+def test_the_lint_configuration_checks_every_package(pyproject):
+    assert lint_problems(pyproject) == []
+
+
+def _mypy(doc: dict[str, Any]) -> dict[str, Any]:
+    return doc["tool"]["mypy"]
+
+
+def _drop_report(doc: dict[str, Any]) -> None:
+    m = _mypy(doc)
+    m["packages"] = ["cfmpa.spec", "cfmpa.impl", "cfmpa.runs", "cfmpa.proofs", "cfmpa.scenarios"]
+    m["modules"] = ["cfmpa", "cfmpa.cli"]
+
+
+def _silence_proofs(doc: dict[str, Any]) -> None:
+    _mypy(doc).setdefault("overrides", []).append(
+        {"module": ["cfmpa.proofs", "cfmpa.proofs.*"], "follow_imports": "silent"})
+
+
+def _ignore_report_errors(doc: dict[str, Any]) -> None:
+    _mypy(doc).setdefault("overrides", []).append({"module": "cfmpa.report.*",
+                                                   "ignore_errors": True})
+
+
+def _untyped_spec(doc: dict[str, Any]) -> None:
+    _mypy(doc).setdefault("overrides", []).append({"module": ["z3", "cfmpa.spec"],
+                                                   "ignore_missing_imports": True})
+
+
+@pytest.mark.parametrize("fault, said", [
+    (_drop_report, "does not check the package cfmpa.report"),
+    (_silence_proofs, "follow_imports = 'silent' for cfmpa.proofs"),
+    (_ignore_report_errors, "ignore_errors = True for cfmpa.report.*"),
+    (_untyped_spec, "ignore_missing_imports (for untyped third-party code) on ['cfmpa.spec']"),
+])
+def test_each_rule_catches_its_fault(pyproject, fault, said):
+    doc = copy.deepcopy(pyproject)
+    fault(doc)
+    problems = lint_problems(doc)
+    assert any(said in p for p in problems), problems
