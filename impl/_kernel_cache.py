@@ -322,7 +322,9 @@ def _warm(name: str) -> None:
         from ._fast_search import search_opt_path_fast
         dr = build_dr(s, v, g)
         search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False)
-        search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False,
-                             with_witness=True)
+        found = search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, progress=False,
+                                     with_witness=True)
+        if found.witness is not None:
+            found.witness.close()          # its labels' spill files, if any: not left to the GC
     else:
         raise ValueError(f"no kernel group {name!r} (known: {', '.join(GROUPS)})")

@@ -291,6 +291,7 @@ class WitnessLabels:
             j1, j2 = self.spills[0].layers(), self.spills[1].layers()
             if found:
                 return Witness.of_labels(j1, j2)
+            j2.close()                      # the set reads j1 only: closed here, not by the GC
             return Witness.of_reachable(j1.map(lambda a: a != none, np.bool_))
         if found:
             return Witness.of_labels(self.j1, self.j2)

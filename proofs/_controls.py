@@ -42,31 +42,28 @@ from __future__ import annotations
 
 import functools
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 import z3
 
-from ..scenarios import SELFCHECK_WORKCELLS
 from ..spec import (
     J1,
     J2,
     MOVES,
-    SearchResult,
-    SearchStatus,
     Witness,
     certify,
     check_witness,
     dr_cell_failures,
     is_path,
     left_angles,
-    make_grid,
-    parse_scenario,
     path_violations,
     pose_distance,
 )
+from ._control_base import Control, ControlNotMade, _case, _rejected, _require
+from ._controls_wiring import wiring_controls, wiring_positive_controls
 
 __all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_PINNED_MS", "PREMISE_FREE_MS",
            "checker_controls", "collect_controls", "harness_controls", "positive_controls",
@@ -75,18 +72,6 @@ __all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_PINNED_MS", "P
 #: Z3's budget per premise control: with the composition's pins, then without them.
 PREMISE_PINNED_MS = 1_000
 PREMISE_FREE_MS = 1_000
-
-
-@dataclass(frozen=True)
-class Control:
-    """A seeded wrong input and the checker that must reject it (or a composition that must not
-    be proved). ``run`` returns (outcome, detail); ``expected`` lists the outcomes that pass."""
-
-    id: str
-    checker: str
-    what: str
-    expected: tuple[str, ...]
-    run: Callable[[], tuple[str, str]]
 
 
 @dataclass(frozen=True)
@@ -111,15 +96,6 @@ class ControlResult:
                 "detail": self.detail, "seconds": round(self.seconds, 3)}
 
 
-class ControlNotMade(AssertionError):
-    """A control's wrong input is not what the control says (a bug in the control)."""
-
-
-def _require(ok: bool, what: str) -> None:
-    if not ok:
-        raise ControlNotMade(what)
-
-
 def run_control(c: Control) -> ControlResult:
     """Run one control; an exception (a control that could not be built) ends ``error``, which no
     control expects, saying why."""
@@ -133,50 +109,6 @@ def run_control(c: Control) -> ControlResult:
 
 
 # --- the checkers' controls --------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class _Case:
-    """The workcell, its D_R (reference BuiltDR, modified variant) and the optimal answer."""
-
-    scenario: Any
-    grid: Any
-    dr: np.ndarray
-    start: tuple[int, int]
-    goal: tuple[int, int]
-    best: SearchResult
-
-
-_CASE: list[_Case] = []
-
-
-def _case() -> _Case:
-    if not _CASE:
-        from ..impl import build_dr, search_opt_path
-
-        s = parse_scenario(SELFCHECK_WORKCELLS["small"], check_budget=False)
-        g = make_grid(s)
-        dr = build_dr(s, "modified", g)
-        start, goal = s.right.start_cell, s.right.goal_cell
-        best = search_opt_path(dr, start, goal, with_witness=True)
-        _require(best.status is SearchStatus.FOUND, "the small workcell has no path")
-        _CASE.append(_Case(s, g, dr, start, goal, best))
-    return _CASE[0]
-
-
-def _rejected(failures: list[Any], want: Sequence[str] = ()) -> tuple[str, str]:
-    """``rejected`` when the checker's first failure is at a condition of ``want`` (any, for a
-    positive control's empty ``want``), ``accepted`` when it raised nothing, and ``error`` when
-    it failed elsewhere: the input is then not the fault the control plants."""
-    if failures:
-        f = failures[0]
-        what = getattr(f, "condition", None) or getattr(f, "clause", None) or type(f).__name__
-        text = f"{what}: {getattr(f, 'message', f)}"
-        if want and what not in want:
-            return "error", (f"rejected at {what}, not at {' or '.join(want)} where the control "
-                             f"plants its fault (its input is not what it says); {text}")
-        return "rejected", text
-    return "accepted", "the checker raised nothing"
 
 
 def _forged_witness() -> tuple[str, str]:
@@ -297,8 +229,6 @@ def _accept_certificate() -> tuple[str, str]:
 
 def positive_controls() -> list[Control]:
     """One right input per checker: each must accept it."""
-    from ._controls_wiring import wiring_positive_controls
-
     A = ("accepted",)
     return [
         Control("Control.accept.witness", "witness (spec.check_witness)",
@@ -343,8 +273,6 @@ def harness_controls() -> list[Control]:
 def checker_controls() -> list[Control]:
     """One wrong input per checker the safety argument reads at run time, and the wiring's (a
     moving near-contact, a gap over three pieces, a raised start label)."""
-    from ._controls_wiring import wiring_controls
-
     R = ("rejected",)
     return [
         Control("Control.witness.forged", "witness (spec.check_witness)",

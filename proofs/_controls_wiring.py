@@ -62,7 +62,8 @@ from ..spec import (
     parse_scenario,
     trajectory_distances,
 )
-from ._controls import Control, ControlNotMade, _case, _rejected, _require
+from ._control_base import Control, ControlNotMade, _case, _rejected, _require
+from ._registry import FIXED_IDS, kind_of
 
 __all__ = ["MARGIN_M", "THEOREM_PREFIXES", "definitional_failures", "wiring_controls",
            "wiring_positive_controls"]
@@ -267,14 +268,10 @@ THEOREM_PREFIXES = ("Safety.", "Certificate.", "Tolerance.", "Exact.", "Monitor.
 
 def definitional_failures(kind_of: Callable[[str], str]) -> list[str]:
     """The obligations of THEOREM_PREFIXES that ``kind_of`` calls anything but a theorem."""
-    from ._runner import FIXED_IDS
-
     return [i for i in FIXED_IDS if i.startswith(THEOREM_PREFIXES) and kind_of(i) != "theorem"]
 
 
 def _kinds_verdict(kind_of: Callable[[str], str]) -> tuple[str, str]:
-    from ._runner import FIXED_IDS
-
     n = sum(1 for i in FIXED_IDS if i.startswith(THEOREM_PREFIXES))
     bad = definitional_failures(kind_of)
     if bad:
@@ -284,8 +281,6 @@ def _kinds_verdict(kind_of: Callable[[str], str]) -> tuple[str, str]:
 
 
 def _theorem_moved() -> tuple[str, str]:
-    from ._runner import FIXED_IDS, kind_of
-
     moved = "Safety.separation"
     _require(moved in FIXED_IDS and kind_of(moved) == "theorem",
              f"{moved} is not a theorem of the run")
@@ -293,8 +288,6 @@ def _theorem_moved() -> tuple[str, str]:
 
 
 def _accept_kinds() -> tuple[str, str]:
-    from ._runner import kind_of
-
     return _kinds_verdict(kind_of)
 
 
@@ -357,7 +350,7 @@ def wiring_controls() -> list[Control]:
         Control("Control.exact.rest_layer_contact", "exact re-decision (spec.exact_path_gaps)",
                 "a path waiting N steps, then moving to a cell blocked in the rest layer, "
                 "visited only there", R, _rest_layer_contact),
-        Control("Control.kinds.theorem_moved", "the kinds (proofs._runner.kind_of)",
+        Control("Control.kinds.theorem_moved", "the kinds (proofs._registry.kind_of)",
                 "Safety.separation moved into the definitional list", R, _theorem_moved),
         Control("Control.loader.spacing_above_bound", "scenario loader (spec.parse_scenario)",
                 "the principal's omega dt the double 3.14, just above the spacing bound the "
@@ -373,7 +366,7 @@ def wiring_positive_controls() -> list[Control]:
                     "a gap inside one piece, within the tube", ("accepted",), _accept_gap),
             Control("Control.accept.exact", "exact re-decision (spec.exact_path_gaps)",
                     "the optimal path of the small workcell", ("accepted",), _accept_exact),
-            Control("Control.accept.kinds", "the kinds (proofs._runner.kind_of)",
+            Control("Control.accept.kinds", "the kinds (proofs._registry.kind_of)",
                     "the kinds as the code gives them", ("accepted",), _accept_kinds),
             Control("Control.accept.loader.spacing_at_bound",
                     "scenario loader (spec.parse_scenario)",

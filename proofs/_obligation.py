@@ -202,7 +202,7 @@ class Obligation:
     label: str = ""
     #: Why the proof is definitional (docs/model.md §10: true by a definition's own clauses, a
     #: termination measure or a named choice instance); empty for a theorem. The one place an
-    #: obligation's kind is declared (``_runner.DEFINITIONAL`` is a view of it).
+    #: obligation's kind is declared (``_registry.DEFINITIONAL`` is a view of it).
     definitional: str = ""
     #: What the obligation establishes, in one plain sentence for a reader who does not read the
     #: statement (docs/model.md §8; ``_summaries.summary_problems`` checks it).

@@ -1,11 +1,12 @@
 """`make prove`: collect the obligations, discharge them, compare with the last run, report.
 
 Each obligation is declared once, by an ``Obligation(...)`` in a collector of COLLECTORS;
-EXPECTED_VERDICTS, DEFINITIONAL and FIXED_IDS are views of the declarations, and
+EXPECTED_VERDICTS, DEFINITIONAL and FIXED_IDS are views of the declarations (all four kept in
+the registry, proofs/_registry.py, and re-exported here), and
 proofs/obligations.lock the independent pin (its ids are expected, its verdicts and kinds
 compared). The run passes only if every verdict is the declared one, the statements and kinds
 are the pinned ones, and the set of obligation ids equals the expected list, without
-repeats: the fixed ids below plus one per check (CHECKS) and scenario, by name for the bundled
+repeats: the fixed ids (FIXED_IDS) plus one per check (CHECKS) and scenario, by name for the bundled
 folder's scenarios (so a deleted file is a missing id) and per file found for any other folder
 (said in the report). Nothing can be dropped silently. Every obligation's query is saved under
 the output directory with its sha256, and results.json says which obligations are new, changed or
@@ -19,7 +20,7 @@ import hashlib
 import json
 import os
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
@@ -33,21 +34,20 @@ from ..gitstate import package_state
 from ..scenarios import BUNDLED_DIR
 from ._controls import Control, ControlResult, run_control
 from ._ledger import ASSUMPTIONS, Assumption
-from ._obl_builtdr import builtdr_obligations
-from ._obl_constants import constants_obligations
-from ._obl_geometry import geometry_obligations
-from ._obl_margin import margin_obligations
-from ._obl_monitor import monitor_obligations
-from ._obl_paths import path_obligations, prop8_obligations, theorem_obligations
-from ._obl_safety import safety_obligations
 from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
-from ._obl_tolerance import tolerance_obligations
-from ._obl_tools import tools_obligations
-from ._obl_wiring import wiring_obligations
-from ._obl_witness import witness_obligations
 from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
 from ._pins import LOCK, Mismatch, check_kinds, check_pins, cvc5_skips, load_lock
 from ._pins import repin as repin_lock
+from ._registry import (
+    COLLECTORS,
+    DEFINITIONAL,
+    EXPECTED_VERDICTS,
+    FIXED_IDS,
+    declared,
+    fixed_ids,
+    kind_and_why,
+    kind_of,
+)
 from ._select import selected
 
 __all__ = [
@@ -72,82 +72,6 @@ __all__ = [
     "scenarios_note",
     "selected",
 ]
-
-#: The collector of each module of fixed obligations, in the order a run discharges them: the
-#: registry the views below and ``collect_obligations`` read (the per-scenario checks,
-#: ``scenario_obligations``, come after them). A new module of obligations is one entry here;
-#: a new obligation is one ``Obligation(...)`` in its module's collector.
-COLLECTORS: tuple[Callable[[], Sequence[Obligation]], ...] = (
-    geometry_obligations, margin_obligations, builtdr_obligations, path_obligations,
-    theorem_obligations, witness_obligations, prop8_obligations, tolerance_obligations,
-    monitor_obligations, constants_obligations, safety_obligations, tools_obligations,
-    wiring_obligations)
-
-
-@dataclass(frozen=True)
-class Declared:
-    """What the declarations (``Obligation(...)`` in each collector) say, by id: the expected
-    verdicts, why each definitional one is (docs/model.md §10), and the plain summaries."""
-
-    expected: dict[str, Verdict]
-    definitional: dict[str, str]
-    summaries: dict[str, str]
-
-
-def declared(collectors: Iterable[Callable[[], Sequence[Obligation]]] = COLLECTORS) -> Declared:
-    """The views of the fixed obligations' declarations (cheap: no query is built). An id
-    declared twice is an error here (the run would count it as a duplicate)."""
-    expected: dict[str, Verdict] = {}
-    definitional: dict[str, str] = {}
-    summaries: dict[str, str] = {}
-    for collect in collectors:
-        for o in collect():
-            if o.id in expected:
-                raise ValueError(f"obligation id {o.id!r} declared twice")
-            expected[o.id] = o.expected
-            if o.definitional:
-                definitional[o.id] = o.definitional
-            if o.summary:
-                summaries[o.id] = o.summary
-    return Declared(expected, definitional, summaries)
-
-
-_DECLARED = declared()
-
-#: Every fixed obligation id and the verdict it must get, as declared (``Obligation.expected``).
-#: proofs/obligations.lock pins it independently (a drifted expectation is a changed statement),
-#: and every id it pins is expected of a full run (FIXED_IDS), so an obligation that
-#: disappears from the code is a missing id.
-EXPECTED_VERDICTS: dict[str, Verdict] = dict(_DECLARED.expected)
-
-#: Obligations whose proof is definitional: true by a definition's own clauses, a termination
-#: measure or a named choice instance rather than a theorem about the robot (docs/model.md
-#: §10), with why, as declared (``Obligation.definitional``); results.json, the summary and
-#: the report count them apart from the theorems, and the lock pins each kind.
-DEFINITIONAL: dict[str, str] = dict(_DECLARED.definitional)
-
-
-def kind_of(ident: str) -> str:
-    """``definitional`` for the ids of DEFINITIONAL, else ``theorem``."""
-    return "definitional" if ident in DEFINITIONAL else "theorem"
-
-
-def kind_and_why(ident: str) -> tuple[str, str]:
-    """(kind, why) of an id, as proofs/obligations.lock pins it (``_pins.check_kinds``)."""
-    return kind_of(ident), DEFINITIONAL.get(ident, "")
-
-
-def fixed_ids(declared_ids: Iterable[str], lock: dict[str, Any]) -> tuple[str, ...]:
-    """The fixed ids a run must produce: ``declared_ids``, then (sorted) every id ``lock`` pins
-    that none of them is, the per-scenario keys left out: an obligation that disappeared from
-    the code stays expected, so a run misses it."""
-    ids = tuple(declared_ids)
-    return ids + tuple(sorted(k for k in lock if not k.startswith("Scenario.") and k not in ids))
-
-
-#: The obligations every run must produce, besides the per-scenario ones: the declared ids,
-#: then any id proofs/obligations.lock pins that no declaration has (a missing id).
-FIXED_IDS: tuple[str, ...] = fixed_ids(EXPECTED_VERDICTS, load_lock(LOCK))
 
 #: The bundled scenario files (stems) of ``BUNDLED_DIR``: their checks are expected by name, so
 #: a deleted file is a missing id, not a quietly shorter run. Every scenario check must prove.

@@ -277,13 +277,25 @@ def optimality_failures(dr: DR, start: Sequence[int], goal: Sequence[int],
     certifies the other answer (a path where none is reported, or none where one is) is
     verified for that answer, and the mismatch is the failure."""
     start, goal = (int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))
+    if witness is None and result.witness is None:
+        answer = search_opt_path_fast(dr, start, goal, with_witness=True)
+        if answer.witness is None:                       # with_witness: never
+            return _optimality(dr, start, goal, result, None, answer)
+        with answer.witness:            # its spill files (large grids) closed here, not by the GC
+            return _optimality(dr, start, goal, result, answer.witness, answer)
+    return _optimality(dr, start, goal, result, witness, None)
+
+
+def _optimality(dr: DR, start: tuple[int, int], goal: tuple[int, int], result: SearchResult,
+                witness: Witness | None, answer: SearchResult | None
+                ) -> tuple[str, list[Failure]]:
+    """``optimality_failures`` given the witness, and the fast search's ``answer`` when the
+    witness is the one it computed."""
     source = "the search's own witness"
     if witness is None:
         witness = result.witness
-    if witness is None:
+    if answer is not None:
         source = "a witness computed by the fast search"
-        answer = search_opt_path_fast(dr, start, goal, with_witness=True)
-        witness = answer.witness
         if answer.status is not result.status:
             wrong = check_witness(dr, start, goal, answer, witness)
             if wrong:

@@ -192,6 +192,12 @@ class Witness:
             if isinstance(a, Layers):
                 a.close()
 
+    def __enter__(self) -> Witness:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
     def npz_members(self) -> dict[str, Any]:
         """The witness file's members: ``format``, ``kind`` and the arrays (``npz_bytes`` writes
         them whole, ``spec.save_npz`` layer by layer)."""

@@ -1,6 +1,6 @@
 """`make lint` as the field does it (docs/contributing.md, "Lint"): mypy reads every package the
-wheel installs, none of them silenced wholesale. Checked on pyproject.toml, and each rule on a
-copy with the fault it is there to catch."""
+wheel installs, none of them silenced wholesale, and pytest turns warnings into errors. Checked
+on pyproject.toml, and each rule on a copy with the fault it is there to catch."""
 
 from __future__ import annotations
 
@@ -27,8 +27,8 @@ def _covered(module: str, packages: list[str], modules: list[str]) -> bool:
 
 
 def lint_problems(doc: dict[str, Any]) -> list[str]:
-    """What keeps [tool.mypy] from checking every package, one line each ([] when nothing
-    does)."""
+    """What keeps [tool.mypy] and [tool.pytest.ini_options] from checking every package with
+    warnings as errors, one line each ([] when nothing does)."""
     out: list[str] = []
     tool = doc.get("tool", {})
     installed = _listed(tool.get("setuptools", {}).get("packages"))
@@ -43,6 +43,11 @@ def lint_problems(doc: dict[str, Any]) -> list[str]:
                 out.append(f"an override sets {key} = {o[key]!r} for {', '.join(ours)}")
         if ours and o.get("ignore_missing_imports"):
             out.append(f"ignore_missing_imports (for untyped third-party code) on {ours}")
+    warnings = _listed(tool.get("pytest", {}).get("ini_options", {}).get("filterwarnings"))
+    if not warnings or warnings[0] != "error":
+        out.append("pytest's filterwarnings does not start with \"error\"")
+    out += [f"a filter {w!r} ignores every warning, not one by name" for w in warnings
+            if w.split(":")[0] == "ignore" and not any(w.split(":")[1:])]
     return out
 
 
@@ -51,7 +56,7 @@ def pyproject() -> dict[str, Any]:
     return tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))
 
 
-def test_the_lint_configuration_checks_every_package(pyproject):
+def test_the_lint_configuration_checks_every_package_with_warnings_as_errors(pyproject):
     assert lint_problems(pyproject) == []
 
 
@@ -80,11 +85,22 @@ def _untyped_spec(doc: dict[str, Any]) -> None:
                                                    "ignore_missing_imports": True})
 
 
+def _warnings_off(doc: dict[str, Any]) -> None:
+    doc["tool"]["pytest"]["ini_options"].pop("filterwarnings", None)
+
+
+def _ignore_all_warnings(doc: dict[str, Any]) -> None:
+    ini = doc["tool"]["pytest"]["ini_options"]
+    ini["filterwarnings"] = [*_listed(ini.get("filterwarnings")), "ignore::"]
+
+
 @pytest.mark.parametrize("fault, said", [
     (_drop_report, "does not check the package cfmpa.report"),
     (_silence_proofs, "follow_imports = 'silent' for cfmpa.proofs"),
     (_ignore_report_errors, "ignore_errors = True for cfmpa.report.*"),
     (_untyped_spec, "ignore_missing_imports (for untyped third-party code) on ['cfmpa.spec']"),
+    (_warnings_off, "does not start with \"error\""),
+    (_ignore_all_warnings, "ignores every warning"),
 ])
 def test_each_rule_catches_its_fault(pyproject, fault, said):
     doc = copy.deepcopy(pyproject)

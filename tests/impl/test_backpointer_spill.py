@@ -13,19 +13,20 @@ from cfmpa.impl._search import BackPointers
 
 def test_spilled_pointers_read_back_as_held_ones():
     rng = np.random.default_rng(0)
-    held, spilled = BackPointers((2, 3), 6, 9), BackPointers((2, 3), 6, 9, spill_bytes=0)
-    for s in range(1, 7):
-        values = rng.integers(-1, 9, size=held.new(s).shape).astype(np.int8)
-        held.layers[s - 1][:] = values
-        spilled.new(s)[:] = values
-    assert spilled.spilled == 5 and held.spilled == 0      # the newest step stays in memory
-    assert all(a is None for a in spilled.layers[:5])
-    for s in range(1, 7):
-        r0, r1, c0, c1 = held.box(s)
-        for d in range(9):
-            for i in range(r0, r1):
-                for j in range(c0, c1):
-                    assert spilled.at(s, d, i, j) == held.at(s, d, i, j)
+    held = BackPointers((2, 3), 6, 9)
+    with BackPointers((2, 3), 6, 9, spill_bytes=0) as spilled:   # its file closed here
+        for s in range(1, 7):
+            values = rng.integers(-1, 9, size=held.new(s).shape).astype(np.int8)
+            held.layers[s - 1][:] = values
+            spilled.new(s)[:] = values
+        assert spilled.spilled == 5 and held.spilled == 0      # the newest step stays in memory
+        assert all(a is None for a in spilled.layers[:5])
+        for s in range(1, 7):
+            r0, r1, c0, c1 = held.box(s)
+            for d in range(9):
+                for i in range(r0, r1):
+                    for j in range(c0, c1):
+                        assert spilled.at(s, d, i, j) == held.at(s, d, i, j)
 
 
 def test_pointers_under_the_budget_stay_in_memory():

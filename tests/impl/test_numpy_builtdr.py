@@ -4,6 +4,7 @@ the pairs it leaves to the reference (thresholds widened so that many do)."""
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from pathlib import Path
@@ -126,11 +127,16 @@ def test_polygons_the_kernel_cannot_decide_go_to_the_reference(poison):
         link2[3, 5, 0, 0] = bad
         link1[7, 2, 1] = bad
     poisoned = RightRegions(link1=link1, link2=link2)
-    for variant in Variant:
-        ref = assert_same(s, variant, grid=g, right=poisoned)
-        if poison == "nan":
-            assert ref[:, 3, 5].all() and ref[:, 7, :].all()
-            assert not ref.all()
+    # An infinite vertex makes its polygon's edge normals inf / inf (impl/_collide.py,
+    # PolygonSet.of): numpy says "invalid value", expected here and only here; the kernel sends
+    # a coordinate not finite to the reference (docs/model.md §7.5), whose answer is compared.
+    with (pytest.warns(RuntimeWarning, match="invalid value") if poison == "inf"
+          else contextlib.nullcontext()):
+        for variant in Variant:
+            ref = assert_same(s, variant, grid=g, right=poisoned)
+            if poison == "nan":
+                assert ref[:, 3, 5].all() and ref[:, 7, :].all()
+                assert not ref.all()
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
