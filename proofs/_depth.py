@@ -45,7 +45,7 @@ def _unsat(text: str, timeout_ms: int, ctx: z3.Context | None) -> bool:
     s = z3.Solver(ctx=ctx or z3.Context())
     s.set("timeout", timeout_ms)
     s.from_string(text)
-    return s.check() == z3.unsat
+    return bool(s.check() == z3.unsat)
 
 
 def vc_depth(hypotheses: list[z3.BoolRef], goal: z3.BoolRef,

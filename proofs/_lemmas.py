@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import z3
 
@@ -49,7 +49,8 @@ class Lemma:
         Sound: the lemma's VC is proved with those facts and its instances of proved lemmas
         as hypotheses, and the instances hold where the norms are |v|^2 (for an abstract
         lemma) or are none (for a concrete one)."""
-        sub = (lambda f: z3.substitute(f, *pairs)) if pairs else (lambda f: f)
+        def sub(f: Any) -> Any:
+            return z3.substitute(f, *pairs) if pairs else f
         carried = [(n, h) for n, h in self.hyps if n.startswith(CARRIED)]
         rest = [h for n, h in self.hyps if not n.startswith(CARRIED + (PROVED,))]
         out = [(f"{n} [{at}]", sub(h)) for n, h in carried]

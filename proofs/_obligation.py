@@ -452,7 +452,7 @@ def _text_of(formulas: Sequence[z3.BoolRef]) -> str:
     s = z3.Solver()
     for f in formulas:
         s.add(f)
-    return s.sexpr()
+    return str(s.sexpr())
 
 
 def _stats(s: z3.Solver, into: dict[str, float]) -> None:

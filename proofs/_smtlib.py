@@ -113,7 +113,7 @@ class _Printer:
         c = self.c
         if _C.Z3_get_symbol_kind(c, s) == z3.Z3_INT_SYMBOL:
             return f"k!{_C.Z3_get_symbol_int(c, s)}"
-        return _C.Z3_get_symbol_string(c, s)
+        return str(_C.Z3_get_symbol_string(c, s))
 
     def _new_name(self, base: str) -> str:
         name, n = _quote(base), 1
@@ -180,7 +180,7 @@ class _Printer:
         return out
 
     def _is_bool(self, a: object) -> bool:
-        return _C.Z3_get_sort_kind(self.c, _C.Z3_get_sort(self.c, a)) == z3.Z3_BOOL_SORT
+        return bool(_C.Z3_get_sort_kind(self.c, _C.Z3_get_sort(self.c, a)) == z3.Z3_BOOL_SORT)
 
     def _term(self, a: object, frame: tuple[str, ...], pol: int) -> str:
         c = self.c
@@ -189,7 +189,7 @@ class _Printer:
             i = _C.Z3_get_index_value(c, a)
             if i >= len(frame):
                 raise NotStandard("a free de Bruijn variable")
-            return frame[i]
+            return str(frame[i])
         if kind == z3.Z3_QUANTIFIER_AST:
             return self._quantifier(a, frame, pol)
         if kind == z3.Z3_NUMERAL_AST:

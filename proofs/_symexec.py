@@ -98,7 +98,7 @@ class _Run:
         s.add([h for _, h in self.explorer.hypotheses])
         s.add([h for _, h in self.defs] + [c for _, c in self.conds] + [cond])
         with _paused():
-            return s.check() != z3.unsat          # unknown: the branch is explored
+            return bool(s.check() != z3.unsat)    # unknown: the branch is explored
 
 
 _ACTIVE: list[_Run] = []
@@ -118,7 +118,7 @@ def _truth(self: z3.AstRef) -> bool:
     if z3.is_false(self):
         return False
     if not _ACTIVE or not z3.is_bool(self):
-        return _ORIGINAL_BOOL(self)
+        return bool(_ORIGINAL_BOOL(self))
     return _ACTIVE[-1].decide(self)
 
 

@@ -107,3 +107,40 @@ def test_each_rule_catches_its_fault(pyproject, fault, said):
     fault(doc)
     problems = lint_problems(doc)
     assert any(said in p for p in problems), problems
+
+
+#: The proofs engine's modules (docs/contributing.md, "Lint"): checked at mypy --strict's level.
+ENGINE = ("_obligation", "_runner", "_cvc5", "_smtlib", "_sos", "_depth", "_pins", "_controls",
+          "_control_base", "_controls_wiring", "_registry", "_select", "_symexec", "_onterms",
+          "_extract", "_while", "_lemmas", "_z3vec")
+#: What --strict adds to the project's settings, each of which the engine's override must set.
+STRICT = ("warn_return_any", "disallow_untyped_calls", "disallow_any_generics",
+          "disallow_untyped_decorators", "disallow_subclassing_any")
+
+
+def engine_not_strict(doc: dict[str, Any]) -> list[str]:
+    """The engine modules and the strict settings no override of ``doc`` sets for them."""
+    strict: dict[str, set[str]] = {}
+    for o in doc["tool"]["mypy"].get("overrides", []):
+        for m in _listed(o.get("module")):
+            strict.setdefault(m, set()).update(k for k in STRICT if o.get(k) is True)
+    return [f"cfmpa.proofs.{m}: {k}" for m in ENGINE for k in STRICT
+            if k not in strict.get(f"cfmpa.proofs.{m}", set())]
+
+
+def test_the_proofs_engine_is_checked_at_strict_level():
+    doc = tomllib.loads(PYPROJECT.read_text())
+    assert engine_not_strict(doc) == []
+    assert all((Path(__file__).resolve().parents[1] / "proofs" / f"{m}.py").is_file()
+               for m in ENGINE)
+    # Seeded faults: a module dropped from the override, a setting turned off.
+    dropped = copy.deepcopy(doc)
+    o = next(o for o in dropped["tool"]["mypy"]["overrides"]
+             if "cfmpa.proofs._runner" in _listed(o.get("module")))
+    o["module"] = [m for m in o["module"] if m != "cfmpa.proofs._runner"]
+    assert engine_not_strict(dropped) == [f"cfmpa.proofs._runner: {k}" for k in STRICT]
+    off = copy.deepcopy(doc)
+    o = next(o for o in off["tool"]["mypy"]["overrides"]
+             if "cfmpa.proofs._runner" in _listed(o.get("module")))
+    o["warn_return_any"] = False
+    assert len(engine_not_strict(off)) == len(ENGINE)
