@@ -104,7 +104,7 @@ __all__ = ["VARIANTS", "safety_obligations"]
 
 GROUP = "End-to-end safety (docs/model.md §10)"
 
-VARIANTS = ("original", "modified", "tight")
+VARIANTS = tuple(v.value for v in Variant)
 
 
 _R = z3.RealSort()
@@ -129,8 +129,8 @@ def _regions(variant: str) -> tuple[Callable[..., z3.ExprRef], Callable[..., z3.
     region_l = z3.Function(f"regionL_{variant}", ints, ints, REGION)
     region_r = z3.Function("regionR", ints, ints, ints, REGION)
     N = Z3Dims.named().N
-    if variant == "tight":
-        region_rest = z3.Function("regionRest_tight", ints, REGION)
+    if Variant(variant).rest_at_goal:
+        region_rest = z3.Function(f"regionRest_{variant}", ints, REGION)
 
         def rest(a: z3.ArithRef) -> z3.ExprRef:
             return region_rest(a)
@@ -809,13 +809,8 @@ def composition_vc(variant: str, *, a: tuple[Lemma, Lemma] | None = None,
 
 # --- the obligations ---------------------------------------------------------------------------
 
-_RULES = {
-    "original": ("[a - omega_q dt, a + omega_q dt], a = theta_L(k dt) (Algorithm 1)",
-                 "layer N-1's box"),
-    "modified": ("from a = theta_L(k dt) to a + s_q omega_q dt, s_q = +1 if goal_q > start_q "
-                 "else -1 (Section IV.A)", "layer N-1's box"),
-    "tight": ("from theta_L(k dt) to theta_L((k+1) dt)", "the goal, a one-point box"),
-}
+#: Each variant's box rule and rest layer in words, as its rule states them (docs/model.md §4.1).
+_RULES = {v.value: (v.rule.words, v.rule.rest_words) for v in Variant}
 
 
 def _principal_query(variant: str) -> Z3Query:
@@ -959,7 +954,8 @@ def safety_obligations() -> list[Obligation]:
                  "apart, since rounding errs by under 3e-11 m; links in regions apart share no "
                  "point.")))
     for v in VARIANTS:
-        rest = ("the principal at rest at its goal" if v == "tight" else "layer N-1's region")
+        rest = ("the principal at rest at its goal" if Variant(v).rest_at_goal
+                else "layer N-1's region")
         out.append(Obligation(
             f"Safety.{v}.composition", GROUP, "docs/model.md §5, §7.2, §10 (e)",
             f"For the {v} variant: if D_R meets Theorem 1/3's postcondition with the "
