@@ -26,6 +26,9 @@ class Kernel:
     name: str
     build: str
     search: str
+    #: The kernel run in its place while its machine code is compiled in the background (None:
+    #: nothing to compile), docs/model.md §7.5.
+    cold: str | None = None
 
     def load(self) -> tuple[Callable[..., Any], Callable[..., Any]]:
         """(build, search), their modules imported now."""
@@ -45,6 +48,9 @@ def registry(entries: Iterable[Kernel]) -> dict[str, Kernel]:
         if k.name in out:
             raise ValueError(f"kernel {k.name!r} is registered twice")
         out[k.name] = k
+    for k in out.values():
+        if k.cold is not None and k.cold not in out:
+            raise ValueError(f"kernel {k.name!r} runs {k.cold!r} while cold, which is not registered")
     return out
 
 
@@ -52,7 +58,8 @@ def registry(entries: Iterable[Kernel]) -> dict[str, Kernel]:
 #: "reference" (tested). "numpy" (no compile) is what "fast" gives while the fast kernels'
 #: machine code is compiled in the background (docs/model.md §7.5).
 REGISTRY: Mapping[str, Kernel] = registry((
-    Kernel("fast", "._fast_builtdr:build_dr_fast", "._fast_search:search_opt_path_fast"),
+    Kernel("fast", "._fast_builtdr:build_dr_fast", "._fast_search:search_opt_path_fast",
+           cold="numpy"),
     Kernel("reference", "._builtdr:build_dr", "._search:search_opt_path"),
     Kernel("numpy", "._numpy_builtdr:build_dr_numpy", "._numpy_search:search_opt_path_numpy"),
 ))
@@ -76,12 +83,13 @@ def resolved(name: str = "fast") -> str:
     """The kernel ``kernels(name)`` gives: ``name``, or "numpy" for "fast" while the fast
     kernels' machine code is compiled in the background (what a run records and prints, so that
     plan.json names the kernel that ran); ValueError for a name not in KERNELS."""
-    if name not in REGISTRY:
+    kernel = REGISTRY.get(name)
+    if kernel is None:
         raise ValueError(f"kernel={name!r} is not one of {', '.join(KERNELS)}")
-    if name == "fast":
+    if kernel.cold is not None:
         from ._kernel_cache import numpy_while_cold
         if numpy_while_cold():
-            return "numpy"
+            return kernel.cold
     return name
 
 

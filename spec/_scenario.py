@@ -28,7 +28,7 @@ from fractions import Fraction
 from typing import Any
 
 from ..errors import MISSING, InputError
-from ..files import LIMITS, echo, read_bounded
+from ..files import LIMITS, echo, env_positive_int, read_bounded
 from ._counts import (
     MAX_SPACING,
     GridRefused,
@@ -161,26 +161,13 @@ _RIGHT_KEYS = _ARM_KEYS | _ARM_OPTIONAL | {"limits", "start_cell", "goal_cell", 
 
 def max_cells() -> int:
     """The memory budget in cells: CFMPA_MAX_CELLS if set (a positive integer), else the default."""
-    return _env_cells("CFMPA_MAX_CELLS", DEFAULT_MAX_CELLS)
+    return env_positive_int("CFMPA_MAX_CELLS", DEFAULT_MAX_CELLS, "cells")
 
 
 def whole_max_cells() -> int:
     """The budget in cells of a D_R held whole in memory (WHOLE_MAX_CELLS): CFMPA_MAX_WHOLE_CELLS
     if set (a positive integer), else the default."""
-    return _env_cells("CFMPA_MAX_WHOLE_CELLS", WHOLE_MAX_CELLS)
-
-
-def _env_cells(name: str, default: int) -> int:
-    raw = os.environ.get(name)
-    if raw is None:
-        return default
-    try:
-        value = int(raw)
-    except ValueError:
-        value = -1
-    if value <= 0:
-        raise InputError(name, raw, "must be a positive integer")
-    return value
+    return env_positive_int("CFMPA_MAX_WHOLE_CELLS", WHOLE_MAX_CELLS, "cells")
 
 
 class _Reader:

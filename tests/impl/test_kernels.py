@@ -83,6 +83,13 @@ def test_a_name_registered_twice_is_refused():
         registry(twice)
 
 
+def test_a_cold_stand_in_must_be_registered():
+    assert REGISTRY["fast"].cold == "numpy"            # what "fast" runs while it compiles
+    lone = (Kernel("fast", "._builtdr:build_dr", "._search:search_opt_path", cold="numpy"),)
+    with pytest.raises(ValueError, match="runs 'numpy' while cold, which is not registered"):
+        registry(lone)
+
+
 def test_the_registry_imports_no_kernel():
     # The parser lists KERNELS; the fast kernels (numba) load only when a kernel is asked for.
     probe = ("import sys\nfrom cfmpa.impl import KERNELS\nassert KERNELS\n"

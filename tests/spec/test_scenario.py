@@ -147,6 +147,11 @@ def test_budget_can_be_raised_by_environment(monkeypatch):
     monkeypatch.setenv("CFMPA_MAX_CELLS", "lots")
     with pytest.raises(InputError, match="CFMPA_MAX_CELLS"):
         parse_scenario(factory.doc())
+    # A value of any length is echoed cut short (cfmpa.files.echo), in one short line.
+    monkeypatch.setenv("CFMPA_MAX_CELLS", "9" * 100_000 + "x")
+    with pytest.raises(InputError, match="CFMPA_MAX_CELLS") as exc:
+        parse_scenario(factory.doc())
+    assert len(str(exc.value)) < 300 and "\n" not in str(exc.value)
 
 
 def test_file_errors_carry_file_and_line(tmp_path):
