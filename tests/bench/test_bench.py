@@ -304,3 +304,36 @@ def test_bench_only_tools_gives_each_workcells_ratio_to_the_default(tmp_path):
         assert r["ratio_to_default"] == round(r["median_s"] / sec["rows"]["default"]["median_s"], 2)
     assert sec["rows"]["default"]["ratio_to_default"] == 1.0
     assert "BuiltDR fast with tools and heights" in proc.stdout
+
+
+def test_a_failed_make_prove_is_never_met_and_keeps_why():
+    """A make prove that exits non-zero is timed but its targets are missed whatever the time,
+    and the row says what failed (not only the output's tail)."""
+    run = bench_module()
+    res = made_up()
+    text = ("prove: Safety.tool_region ... unexpected verdict: unknown (expected proved)\n"
+            + "audit: a long report line\n" * 50)
+    res["prove"] = {"error": "exit 1: audit: a long report line", "argv": ["prove"],
+                    "seconds": 10.0, "peak_rss_mb": 1.0, "obligations_s": 5.0, "ok": False,
+                    "failure_lines": run.failure_lines(text)}
+    rows = {r["target"]: r for r in run.targets(res, run.Config.of(False, None))}
+    whole = rows["proving: make prove, whole process (s)"]
+    alone = rows["proving: make prove, obligations alone (s)"]
+    assert whole["measured"] == 10.0 and whole["met"] is False
+    assert "FAILED" in whole["note"] and "Safety.tool_region" in whole["note"]
+    assert alone["measured"] == 5.0 and alone["met"] is False and "ok false" in alone["note"]
+    # The same times from a run that passed are met: the failure alone made them missed.
+    res["prove"] = {k: v for k, v in res["prove"].items()
+                    if k not in ("error", "failure_lines")} | {"median_s": 10.0, "ok": True}
+    rows = {r["target"]: r for r in run.targets(res, run.Config.of(False, None))}
+    assert rows["proving: make prove, whole process (s)"]["met"] is True
+    assert rows["proving: make prove, obligations alone (s)"]["met"] is True
+
+
+def test_failure_lines_keep_what_failed_and_are_bounded():
+    run = bench_module()
+    text = "ok line\n" + "x FAILED y " * 100 + "\n" + "unexpected z\n" * 100
+    got = run.failure_lines(text)
+    assert len(got) == 40 and all(len(ln) <= 300 for ln in got)
+    assert got[0].startswith("x FAILED") and got[1] == "unexpected z"
+    assert run.failure_lines("all good\nstill good\n") == []
