@@ -300,20 +300,28 @@ def _settle_unsure(pair: tuple[npt.NDArray[np.float64], ...],
 # ---------------------------------------------------------------- compiled kernel (numba) ----
 # Arrays are indexed in place, never sliced: a view costs reference counting in compiled code.
 
-@njit(cache=True)
-def _pack(verts):  # pragma: no cover - compiled; PolygonSet.of's formulas, per polygon
+def _pack(verts: npt.NDArray[np.float64]
+          ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """geo (C, V, 6) and box (C, 4) of CCW polygons (C, V, 2), see the module docstring.
 
     A polygon with a coordinate that is NaN, infinite or beyond MAX_COORD gets a NaN box: the
-    kernel then leaves every pair with it to the reference."""
+    kernel then leaves every pair with it to the reference. The arrays are made here, not in
+    the kernel: a kernel that allocates makes numba's cache load import numba's array
+    implementation (0.04 s CPU of `cfmpa dr`'s start-up, docs/model.md §7.5)."""
     C, V = verts.shape[0], verts.shape[1]
     geo = np.zeros((C, V, 6))
     box = np.empty((C, 4))
-    for c in range(C):
+    _pack_into(verts, geo, box)
+    return geo, box
+
+
+@njit(cache=True)
+def _pack_into(verts, geo, box):  # pragma: no cover - compiled; PolygonSet.of's formulas
+    """_pack's geo and box, per polygon, into the zeroed geo and the box given."""
+    for c in range(verts.shape[0]):
         _box_one(verts, c, box)
         if box[c, 0] == box[c, 0]:
             _geo_one(verts, c, geo)
-    return geo, box
 
 
 @njit(cache=True, nogil=True)

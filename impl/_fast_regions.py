@@ -39,9 +39,23 @@ def convex_hulls(point_sets: list[Points]) -> list[Polygon]:
     flat = np.ascontiguousarray(np.concatenate(sets))
     starts = np.zeros(len(sets) + 1, dtype=np.int64)
     starts[1:] = np.cumsum([len(p) for p in sets])
-    order, counts = _hulls(flat, starts, HULL_SCALE_ABOVE)
+    order, counts = _hull_order(flat, starts)
     return [convex_hull(p) if k < 0 else flat[order[a:a + k]]
             for p, k, a in zip(sets, counts, starts)]
+
+
+def _hull_order(flat: Points, starts: npt.NDArray[np.int64]
+                ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+    """(order, counts) of ``_hulls`` on the point sets flat[starts[c]:starts[c + 1]]. Every
+    array the kernel writes is made here: a kernel that allocates makes numba's cache load
+    import numba's array implementation (0.04 s CPU of `cfmpa dr`'s start-up, docs/model.md
+    §7.5)."""
+    most = int(np.diff(starts).max(initial=0))
+    order = np.empty(flat.shape[0], dtype=np.int64)
+    counts = np.empty(starts.shape[0] - 1, dtype=np.int64)
+    _hulls(flat, starts, HULL_SCALE_ABOVE, order, counts, np.empty(most, dtype=np.int64),
+           np.empty(2 * most, dtype=np.int64))
+    return order, counts
 
 
 def left_regions_fast(s: Scenario, variant: Variant | str, grid: Grid | None = None
@@ -154,21 +168,19 @@ def _lattice_points(arm: Any, link: int, lo: Points, hi: Points, anchor: Points,
 # ---------------------------------------------------------------- compiled kernel (numba) ----
 
 @njit(cache=True)
-def _hulls(flat, starts, big):  # pragma: no cover - compiled; tested against convex_hull
+def _hulls(flat, starts, big, order, counts, idx, chain
+           ):  # pragma: no cover - compiled; tested against convex_hull
     """Per point set c (rows starts[c]:starts[c+1] of flat): the flat row indices of its hull's
-    vertices, counter-clockwise from the least (x, y), in order[starts[c]:], and their count
-    (-1: left to convex_hull, see the module docstring)."""
-    order = np.empty(flat.shape[0], dtype=np.int64)
-    counts = np.empty(starts.shape[0] - 1, dtype=np.int64)
+    vertices, counter-clockwise from the least (x, y), in order[starts[c]:], and their count in
+    counts[c] (-1: left to convex_hull, see the module docstring). idx and chain: scratch of at
+    least the largest set's size and twice it (nothing here allocates)."""
     for c in range(starts.shape[0] - 1):
-        counts[c] = _hull(flat, starts[c], starts[c + 1], big, order)
-    return order, counts
+        counts[c] = _hull(flat, starts[c], starts[c + 1], big, order, idx, chain)
 
 
 @njit(cache=True)
-def _hull(flat, lo, hi, big, order):  # pragma: no cover - compiled
+def _hull(flat, lo, hi, big, order, idx, chain):  # pragma: no cover - compiled
     n = hi - lo
-    idx = np.empty(n, dtype=np.int64)
     for k in range(n):
         x, y = flat[lo + k, 0], flat[lo + k, 1]
         if not (abs(x) <= big and abs(y) <= big):   # NaN, infinite or huge: convex_hull's case
@@ -193,7 +205,7 @@ def _hull(flat, lo, hi, big, order):  # pragma: no cover - compiled
         u += 1
     if u <= 2:
         return -1
-    chain = np.empty(2 * u, dtype=np.int64)        # lower hull, then upper, as _hull_indices
+    # chain[:2 u]: the lower hull, then the upper, as _hull_indices
     top = 0
     for k in range(u):
         while top >= 2 and _cross(flat, chain[top - 2], chain[top - 1], idx[k]) <= 0:

@@ -13,6 +13,13 @@ workcell with the same types as a real run), while stderr says so with a count, 
 written; this process then loads the kernels from the cache as they are called. A lock file makes
 processes that start cold together (a campaign's workers) wait for one compile. With a warm cache
 it costs a few file reads and prints nothing. docs/model.md §7.5.
+
+Loading from a warm cache: numba's FunctionCache refreshes its typing and target registries
+before the first load in a process (it imports and registers every implementation numba has:
+about 0.16 s CPU, a quarter of `cfmpa dr`'s whole process), which only a compile needs. So the
+first ``ensure_compiled`` in a process gives the groups' dispatchers ``_LeanCache``
+(``lean_loads``): the same cache, loaded after the runtime's set-up alone; a compile (a cache
+miss) still refreshes, in numba's compiler, and a load that fails lean is done numba's way.
 """
 
 from __future__ import annotations
@@ -30,7 +37,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-__all__ = ["COMPILE_ENV", "GROUPS", "WARM_UP", "cold_groups", "ensure_compiled",
+__all__ = ["COMPILE_ENV", "GROUPS", "WARM_UP", "cold_groups", "ensure_compiled", "lean_loads",
            "load_fast_kernels", "numpy_while_cold", "wait_compiled"]
 
 #: The environment variable choosing what a cold cache does: "background" (the default: the
@@ -69,7 +76,56 @@ def ensure_compiled() -> None:
     with _LOCK:
         if not _READY[0]:
             _compile_cold()
+            for name in GROUPS:
+                lean_loads(_module(name))
             _READY[0] = True
+
+
+def lean_loads(mod: ModuleType) -> int:
+    """Give the numba dispatchers of ``mod`` that cache with numba's own FunctionCache the
+    ``_LeanCache`` (see the module docstring); how many were given it."""
+    lean = _lean_cache()
+    if lean is None:
+        return 0
+    count = 0
+    for obj in vars(mod).values():
+        cache = getattr(obj, "_cache", None)
+        if type(cache) is lean.__base__:
+            cache.__class__ = lean
+            count += 1
+    return count
+
+
+_LEAN: list[Any] = []
+
+
+def _lean_cache() -> Any:
+    """The class ``_LeanCache`` (made once: it subclasses numba's FunctionCache, imported
+    only here), or None where numba's cache lacks what it overrides."""
+    if _LEAN:
+        return _LEAN[0]
+    from numba.core.caching import FunctionCache
+    from numba.core.runtime.nrt import rtsys
+
+    if not all(hasattr(FunctionCache, a) for a in ("load_overload", "_load_overload",
+                                                   "_guard_against_spurious_io_errors")):
+        _LEAN.append(None)
+        return None
+
+    class _LeanCache(FunctionCache):
+        """numba's FunctionCache, loading without the registries' refresh: the machine code,
+        its environment and its wrapper need only the runtime (NRT) set up."""
+
+        def load_overload(self, sig: Any, target_context: Any) -> Any:
+            try:
+                rtsys.initialize(target_context)
+                with self._guard_against_spurious_io_errors():
+                    return self._load_overload(sig, target_context)
+            except Exception:  # noqa: BLE001 - loaded again numba's way, which raises its own
+                return super().load_overload(sig, target_context)
+
+    _LEAN.append(_LeanCache)
+    return _LeanCache
 
 
 def load_fast_kernels() -> float:

@@ -41,28 +41,31 @@ MAX_COORD = 1e100
 
 
 class _Packed:
-    """One per-cell part's polygons (C, V, 2) laid out for the gap: x, y (V, C), contiguous (a
-    reduction over the vertices is then elementwise over polygons); the boxes' lo x, lo y,
+    """One per-cell part's polygons (C, V, 2) laid out for the gap: x, y (C, V), contiguous
+    (``_columns`` gathers a subset as (V, C'), over which a reduction over the vertices is
+    elementwise over polygons); the boxes' lo x, lo y,
     hi x, hi y (C,), PolygonSet's values; ``row_box`` (rows, 4) the union of each row's n boxes
     (NaN where one is); ``sane`` (C,) every coordinate finite and within MAX_COORD; ``scale``
-    the largest |coordinate| of the sane polygons. The normals and offsets (V, C), PolygonSet's
+    the largest |coordinate| of the sane polygons. The normals and offsets (C, V), PolygonSet's
     own values, are made for a polygon when it first reaches the gap (most never do):
     PolygonSet.of is elementwise per polygon, so a subset's are the whole set's."""
 
     def __init__(self, verts: npt.NDArray[np.float64], n: int) -> None:
         self.verts = verts
-        self.sane = np.asarray((np.abs(verts) <= MAX_COORD).all(axis=(1, 2)), dtype=bool)
-        self.scale = float(np.abs(verts[self.sane]).max()) if self.sane.any() else 0.0
-        self.x = np.ascontiguousarray(verts[..., 0].T)
-        self.y = np.ascontiguousarray(verts[..., 1].T)
-        lo, hi = verts.min(-2), verts.max(-2)
-        self.box = tuple(np.ascontiguousarray(c) for c in (lo[:, 0], lo[:, 1], hi[:, 0],
-                                                           hi[:, 1]))
+        self.x = np.ascontiguousarray(verts[..., 0])
+        self.y = np.ascontiguousarray(verts[..., 1])
+        # The boxes as PolygonSet's min and max over the vertices (the same values: a min or
+        # max rounds nothing; a NaN coordinate gives NaN either way).
+        self.box = (self.x.min(1), self.y.min(1), self.x.max(1), self.y.max(1))
+        # Every coordinate within MAX_COORD (so finite) iff every box bound is (a NaN is not).
+        bound = np.abs(np.stack(self.box))
+        self.sane = (bound <= MAX_COORD).all(axis=0)
+        self.scale = float(bound[:, self.sane].max()) if self.sane.any() else 0.0
         rows = len(verts) // n
         b = self.box
         self.row_box = np.stack([b[0].reshape(rows, n).min(1), b[1].reshape(rows, n).min(1),
                                  b[2].reshape(rows, n).max(1), b[3].reshape(rows, n).max(1)], -1)
-        shape = (verts.shape[1], verts.shape[0])
+        shape = verts.shape[:2]
         self.nx, self.ny, self.off = np.empty(shape), np.empty(shape), np.empty(shape)
         self.packed = np.zeros(len(verts), dtype=bool)
 
@@ -72,9 +75,9 @@ class _Packed:
         if new.size == 0:
             return
         ps = PolygonSet.of(self.verts[new])
-        self.nx[:, new] = ps.normals[..., 0].T
-        self.ny[:, new] = ps.normals[..., 1].T
-        self.off[:, new] = np.where(ps.ok, ps.offsets, np.inf).T  # no length: never separates
+        self.nx[new] = ps.normals[..., 0]
+        self.ny[new] = ps.normals[..., 1]
+        self.off[new] = np.where(ps.ok, ps.offsets, np.inf)  # no length: never separates
         self.packed[new] = True
 
     def polygons(self, cells: npt.NDArray[np.int64]) -> PolygonSet:
@@ -164,22 +167,46 @@ def _gap(aset: PolygonSet, b: _Packed, near: npt.NDArray[np.int64], eps: float,
     """The separating-axis gap of polygon ``aset`` against b's polygons ``near`` (see
     ``_collide._separation``), elementwise: within a few ulps of the reference's; where a's
     normals alone give more than eps + margin (free), b's are not tried (a lower bound)."""
-    x, y = b.x[:, near], b.y[:, near]
-    gap = np.full(len(near), -np.inf)
+    x, y = _columns(b.x, near), _columns(b.y, near)         # (V, C) C-contiguous
     av, an, ao, aok = aset.verts[0], aset.normals[0], aset.offsets[0], aset.ok[0]
-    for e in range(len(av)):                      # along a's normals: b's nearest vertex
-        if aok[e]:
-            term = (x * an[e, 0] + y * an[e, 1]).min(axis=0) - ao[e]
-            np.maximum(gap, term, out=gap)
+    an, ao = an[aok], ao[aok]                     # an edge without length never separates
+    if len(an):                                   # along a's normals: b's nearest vertex
+        # least[e, c] over b's vertices v, one vertex at a time: the products and the sum
+        # are the reference's own per element (x an_x + y an_y), only their order of work
+        # differs (so the same floats as one normal at a time).
+        least = np.empty((len(an), len(near)))
+        term = np.empty_like(least)
+        other = np.empty_like(least)
+        np.multiply.outer(an[:, 0], x[0], out=least)
+        least += np.multiply.outer(an[:, 1], y[0], out=other)
+        for v in range(1, len(x)):
+            np.multiply.outer(an[:, 0], x[v], out=term)
+            term += np.multiply.outer(an[:, 1], y[v], out=other)
+            np.minimum(least, term, out=least)
+        least -= ao[:, None]
+        gap = least.max(axis=0)
+    else:
+        gap = np.full(len(near), -np.inf)
     rest = np.flatnonzero(~(gap > eps + margin))  # not yet free on a's normals alone
     if rest.size == 0:
         return gap
     sub = near[rest]
     b.pack(sub)
-    nx, ny = b.nx[:, sub], b.ny[:, sub]
-    least = nx * av[0, 0] + ny * av[0, 1]
+    nx, ny = _columns(b.nx, sub), _columns(b.ny, sub)
+    least = nx * av[0, 0]
+    term_b, other_b = np.empty_like(least), np.empty_like(least)
+    least += np.multiply(ny, av[0, 1], out=term_b)
     for v in range(1, len(av)):                   # along b's normals: a's nearest vertex
-        np.minimum(least, nx * av[v, 0] + ny * av[v, 1], out=least)
-    least -= b.off[:, sub]               # an edge without length: offset +inf, term -inf
+        np.multiply(nx, av[v, 0], out=term_b)
+        term_b += np.multiply(ny, av[v, 1], out=other_b)
+        np.minimum(least, term_b, out=least)
+    least -= _columns(b.off, sub)             # an edge without length: offset +inf, term -inf
     gap[rest] = np.maximum(gap[rest], least.max(axis=0))
     return gap
+
+
+def _columns(a: npt.NDArray[np.float64], cells: npt.NDArray[np.int64]) -> npt.NDArray[np.float64]:
+    """Rows ``cells`` of ``a`` (C, V) as a C-contiguous (V, len(cells)): a reduction over the
+    vertices is then elementwise over polygons (rows gathered, then transposed: faster than
+    gathering columns)."""
+    return np.ascontiguousarray(a.take(cells, axis=0).T)

@@ -18,7 +18,9 @@ Levels, weakest first:
   equality resolution, macro finding), which is instantiation by another name. A VC with no
   quantifier left once skolemised (nothing abstracted) is ground by its own proof.
 - ``full``: neither abstraction is unsat (or the solver did not decide it within
-  ``DEPTH_TIMEOUT_MS``); the proof needs quantifier instantiation (or more time).
+  ``DEPTH_RLIMIT``, Z3's deterministic resource count, so the level does not depend on the
+  machine's load; ``DEPTH_TIMEOUT_MS`` times ``_limits.WALL_NET_FACTOR`` is a wall-clock safety
+  net); the proof needs quantifier instantiation (or more work).
 
 Both abstractions over-approximate the check (a model of the check gives one of the
 abstraction), so their unsat is a proof of the VC by the weaker reasoning: the level is an upper
@@ -32,27 +34,41 @@ import z3
 
 from ._smtlib import Mode, NotStandard, smtlib_query
 
-__all__ = ["DEPTH_TIMEOUT_MS", "LEVELS", "deepest", "is_nonlinear", "vc_depth"]
+__all__ = ["DEPTH_RLIMIT", "DEPTH_TIMEOUT_MS", "LEVELS", "deepest", "is_nonlinear", "vc_depth"]
 
 #: Per abstraction check; the abstractions are small, or they fail fast.
 DEPTH_TIMEOUT_MS = 3_000
+#: Z3's resource limit per abstraction check: every abstraction proved unsat on the bundled
+#: obligations needs under 5 000 (docs/model.md §6.4), a satisfiable one up to about 550 000.
+DEPTH_RLIMIT = 1_000_000
 
 #: Weakest first.
 LEVELS = ("propositional", "ground", "full")
 
 
-def _unsat(text: str, timeout_ms: int, ctx: z3.Context | None) -> bool:
+def _unsat(text: str, timeout_ms: int, ctx: z3.Context | None, rlimit: int | None = None
+           ) -> bool:
+    """Whether Z3 shows ``text`` unsat within ``rlimit`` (resource count, counted from the
+    check's start) and ``timeout_ms`` (wall clock)."""
     s = z3.Solver(ctx=ctx or z3.Context())
     s.set("timeout", timeout_ms)
+    if rlimit is not None:
+        s.set("rlimit", rlimit)
     s.from_string(text)
     return bool(s.check() == z3.unsat)
 
 
 def vc_depth(hypotheses: list[z3.BoolRef], goal: z3.BoolRef,
-             timeout_ms: int = DEPTH_TIMEOUT_MS, ctx: z3.Context | None = None) -> str:
+             timeout_ms: int = DEPTH_TIMEOUT_MS, ctx: z3.Context | None = None,
+             rlimit: int | None = DEPTH_RLIMIT) -> str:
     """The weakest level (LEVELS) at which ``hypotheses ∧ ¬goal`` is unsat; call it only for
     a VC already proved (the level is then ``full`` at worst). The abstractions are parsed
-    into ``ctx`` (default: a fresh context), each by a fresh solver."""
+    into ``ctx`` (default: a fresh context), each by a fresh solver, under ``rlimit`` (None:
+    ``timeout_ms`` alone; with it, ``timeout_ms`` is only a safety net, made that much
+    longer)."""
+    from ._limits import wall_net_ms
+
+    timeout_ms = wall_net_ms(timeout_ms, rlimit)
     for level, mode in (("propositional", Mode.PROPOSITIONAL), ("ground", Mode.GROUND)):
         try:
             q = smtlib_query(hypotheses, goal, mode)
@@ -62,7 +78,7 @@ def vc_depth(hypotheses: list[z3.BoolRef], goal: z3.BoolRef,
             # Nothing was abstracted: once skolemised the check has no quantifier at all, and
             # it is the proof itself (proved unsat), which instantiated nothing.
             return level
-        if _unsat(q.text, timeout_ms, ctx):
+        if _unsat(q.text, timeout_ms, ctx, rlimit):
             return level
     return "full"
 

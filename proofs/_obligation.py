@@ -232,6 +232,9 @@ class VCResult:
     nonlinear: bool = False        # nonlinear real or integer arithmetic (_depth.is_nonlinear)
     #: cvc5's answer taken from proofs/obligations.lock (undecided when pinned), not re-run.
     cvc5_from_pin: bool = False
+    #: Z3's resource count on the vacuity check and on the proof check (each in a context of
+    #: its own, so a function of the statement alone): what ``_limits`` calibrates from.
+    rlimit_count: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -267,6 +270,8 @@ class Proof:
     pins: dict[str, str] = field(default_factory=dict)   # what obligations.lock pins
     standard: str = ""                  # every VC in standard SMT-LIB 2.6 (Z3 obligations)
     cvc5_seconds: float = 0.0
+    #: Z3's resource limit per check that ran (``_limits.z3_rlimit``); None: wall clock only.
+    rlimit: int | None = None
 
     @property
     def as_expected(self) -> bool:
@@ -294,8 +299,10 @@ def discharge(ob: Obligation) -> Proof:
         return discharge_pending(ob, pool).settle()
 
 
-#: Per smoke-test check (with the pins, the ground abstraction, without the pins).
+#: Per smoke-test check (with the pins, the ground abstraction, without the pins): a resource
+#: limit (every bundled smoke check is decided in under 40 000) and a wall-clock safety net.
 SMOKE_TIMEOUT_MS = 1_500
+SMOKE_RLIMIT = 1_000_000
 
 
 @dataclass
@@ -370,9 +377,12 @@ def discharge_pending(ob: Obligation, pool: Any, skip: dict[str, str] | None = N
     certs: list[Any] = []
     try:
         query = ob.build()
-        text = render_query(ob, query)
+        # Each check's Z3 text, printed once: the saved query holds it and each check's
+        # solver is rebuilt from it (``_solver``), the same text either way.
+        texts = _check_texts(query) if isinstance(query, Z3Query) else []
+        text = render_query(ob, query, texts)
         if isinstance(query, Z3Query):
-            fields, futures, certs = _run_z3(ob, query, pool, skip or {}, recheck)
+            fields, futures, certs = _run_z3(ob, query, pool, skip or {}, recheck, texts)
         else:
             outcome = _guarded(query.run, ob.timeout_ms)
             fields = _check_fields(ob, outcome)
@@ -425,26 +435,54 @@ def standard_smtlib(vc: VC) -> tuple[str | None, str, str]:
 
 
 def _solver(timeout_ms: int, ctx: z3.Context | None = None,
-            formulas: Sequence[z3.BoolRef] = ()) -> z3.Solver:
+            formulas: Sequence[z3.BoolRef] = (), text: str | None = None,
+            rlimit: int | None = None) -> z3.Solver:
     """A solver with a timeout; given ``formulas``, in a context of its own holding them, rebuilt
-    from their SMT-LIB text.
+    from their SMT-LIB text (``text``, when the caller has printed it already: ``_text_of`` of
+    the same formulas, which it must be).
 
     Z3's search on quantified VCs depends on the order of the terms it holds: a VC proved in
     0.1 s ran out of its 20 s once a vacuity check had run in the same context, or after other
     proofs in the process. Rebuilt from text in a new context, a check's answer depends on its
     statement alone, wherever and whenever it runs.
     """
-    if formulas:
+    if formulas or text is not None:
+        # (No formulas: an empty check, in a context of its own too, so that its resource
+        # count is its own.)
         ctx = z3.Context()
-        text = _text_of(formulas)
+        if text is None:
+            text = _text_of(formulas)
         parsed = list(z3.parse_smt2_string(text, ctx=ctx))
         if len(parsed) != len(formulas):
             raise AssertionError(f"re-read {len(parsed)} assertions of {len(formulas)}")
     s = z3.Solver(ctx=ctx)
     s.set("timeout", timeout_ms)
+    if rlimit is not None:
+        # Z3's resource limit, counted from where the check starts: deterministic, so the
+        # answer does not depend on the machine's load (``_limits``); ``timeout_ms`` is then
+        # only a safety net.
+        s.set("rlimit", rlimit)
     if formulas:
         s.add(parsed)
     return s
+
+
+def _why_unknown(s: z3.Solver, rlimit: int | None) -> str:
+    """Z3's reason for an unknown, saying when the check ran into its resource limit (some
+    tactics report that as "canceled")."""
+    why = str(s.reason_unknown())
+    if rlimit is not None and rlimit_count(s) >= rlimit:
+        why = (why if "resource limit" in why else f"{why}: resource limit") + f" {rlimit} reached"
+    return why
+
+
+def rlimit_count(s: z3.Solver) -> int:
+    """Z3's resource count of the solver's context so far (``rlimit count``; 0 before any
+    check): for a check in a context of its own, what the check used."""
+    for key, value in s.statistics():
+        if key == "rlimit count":
+            return int(value)
+    return 0
 
 
 def _text_of(formulas: Sequence[z3.BoolRef]) -> str:
@@ -467,10 +505,12 @@ def _smoke(sm: Smoke, stats: dict[str, float], ctx: z3.Context | None = None) ->
     without), unsat (none does: shown on the test itself, or on its ground abstraction, which
     over-approximates it, so its unsat is the test's), or unknown (neither shown)."""
     from ._depth import _unsat
+    from ._limits import wall_net_ms
     from ._smtlib import Mode, NotStandard, smtlib_query
 
+    net = wall_net_ms(SMOKE_TIMEOUT_MS, SMOKE_RLIMIT)
     ctx = ctx or z3.Context()
-    s = _solver(SMOKE_TIMEOUT_MS, ctx)
+    s = _solver(net, ctx, rlimit=SMOKE_RLIMIT)
     s.add([h.translate(ctx) for _, h in sm.hypotheses])
     s.add(z3.Not(sm.goal.translate(ctx)))
     if sm.lemmas and sm.lemma_witness:
@@ -487,7 +527,7 @@ def _smoke(sm: Smoke, stats: dict[str, float], ctx: z3.Context | None = None) ->
     # The pins only help find a model: unsat with them says nothing.
     try:
         text = smtlib_query([h for _, h in sm.hypotheses], sm.goal, Mode.GROUND).text
-        if _unsat(text, SMOKE_TIMEOUT_MS, ctx):
+        if _unsat(text, net, ctx, SMOKE_RLIMIT):
             return SmokeResult(sm.name, "unsat", "its ground abstraction is unsat")
     except NotStandard:
         pass
@@ -509,6 +549,8 @@ def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> Smo
     """A model of the smoke test with ``lemma_witness`` substituted, its lemmas proved valid
     there and replaced by true (a closed fact proved valid is true in every model, so the test
     and the test with it replaced by true have the same models); None if that does not work."""
+    from ._limits import wall_net_ms
+
     sig = [(c, v) for c, v in sm.lemma_witness]
     f = z3.substitute(z3.And(*[h for _, h in sm.hypotheses], z3.Not(sm.goal)), *sig)
     used = []
@@ -516,7 +558,7 @@ def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> Smo
         closed = z3.substitute(lemma, *sig)
         if z3.eq(z3.substitute(f, (closed, z3.BoolVal(True))), f):
             continue                    # not in this test
-        s = _solver(SMOKE_TIMEOUT_MS, ctx)
+        s = _solver(wall_net_ms(SMOKE_TIMEOUT_MS, SMOKE_RLIMIT), ctx, rlimit=SMOKE_RLIMIT)
         s.add(z3.Not(closed.translate(ctx)))
         r = s.check()
         _stats(s, stats)
@@ -524,7 +566,7 @@ def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> Smo
             return None
         f = z3.substitute(f, (closed, z3.BoolVal(True)))
         used.append(lname)
-    s = _solver(SMOKE_TIMEOUT_MS, ctx)
+    s = _solver(wall_net_ms(SMOKE_TIMEOUT_MS, SMOKE_RLIMIT), ctx, rlimit=SMOKE_RLIMIT)
     s.add(f.translate(ctx))
     r = s.check()
     _stats(s, stats)
@@ -539,10 +581,15 @@ def _short_text(f: z3.ExprRef, width: int = 50) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
-def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck: bool = False
+def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck: bool = False,
+            texts: Sequence[tuple[str, str]] | None = None
             ) -> tuple[dict[str, Any], list[Any], list[Any]]:
+    """Z3's answers on each VC's vacuity and proof checks (``texts``: their Z3 text,
+    ``_check_texts``, printed by the caller; printed here if not given), its depth, statement
+    hash and cvc5 replay; the Proof's fields, cvc5's futures and the VCs to certify."""
     from ._cvc5 import CVC5_TIMEOUT_MS
     from ._depth import deepest, is_nonlinear, vc_depth
+    from ._limits import wall_net_ms, z3_rlimit
 
     if not q.vcs:
         return (dict(verdict=Verdict.FAILED, statistics={}, counterexample=None,
@@ -557,26 +604,33 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
     unknowns: list[str] = []
     refuted: list[tuple[str, str]] = []
     want = "sat" if ob.expected is Verdict.REFUTED_AS_EXPECTED else "unsat"
-    for vc in q.vcs:
+    if texts is None:
+        texts = _check_texts(q)
+    limit = z3_rlimit(ob.id)
+    net = wall_net_ms(ob.timeout_ms, limit)
+    for vc, (vac_text, proof_text) in zip(q.vcs, texts, strict=True):
         hyps = [h for _, h in vc.hypotheses]
         # Vacuity: the hypotheses (with the optional witness pinned) must have a model.
-        s = _solver(ob.timeout_ms, formulas=hyps + [c == v for c, v in vc.witness])
+        s = _solver(net, formulas=hyps + [c == v for c, v in vc.witness], text=vac_text,
+                    rlimit=limit)
         vac = s.check()
         _stats(s, stats)
+        vac_count = rlimit_count(s)
         if vac == z3.unsat:
             vacuous.append(vc.name)
         elif vac == z3.unknown:
-            unknowns.append(f"{vc.name} (vacuity check): {s.reason_unknown()}")
+            unknowns.append(f"{vc.name} (vacuity check): {_why_unknown(s, limit)}")
         # The proof: hypotheses and the negated goal must have no model.
-        s = _solver(ob.timeout_ms, formulas=hyps + [z3.Not(vc.goal)])
+        s = _solver(net, formulas=hyps + [z3.Not(vc.goal)], text=proof_text, rlimit=limit)
         ans = s.check()
         _stats(s, stats)
+        counts = (vac_count, rlimit_count(s))
         if ans == z3.sat:
             model = s.model().translate(z3.main_ctx())
             text = q.render(model) if q.render is not None else _default_render(model)
             refuted.append((vc.name, text))
         elif ans == z3.unknown:
-            unknowns.append(f"{vc.name}: {s.reason_unknown()}")
+            unknowns.append(f"{vc.name}: {_why_unknown(s, limit)}")
         # The statement in standard SMT-LIB: pinned by its hash, replayed by cvc5.
         std, sha, note = standard_smtlib(vc)
         key = vc.name if vc.name not in pins else f"{vc.name}#{len(pins) + 1}"
@@ -603,7 +657,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
         results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
                                 cvc5=cvc5, cvc5_reason=why,
                                 solvers=("z3",) if str(ans) == want else (), note=note,
-                                nonlinear=is_nonlinear(hyps + [vc.goal]), cvc5_from_pin=pinned))
+                                nonlinear=is_nonlinear(hyps + [vc.goal]), cvc5_from_pin=pinned,
+                                rlimit_count=counts))
     smoke = [_smoke(sm, stats) for sm in q.smoke]      # each in a context of its own
     dead = [r.name for r in smoke if r.answer == "unsat"]
     undecided = [r.name for r in smoke if r.answer == "unknown"]
@@ -635,7 +690,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
     return (dict(verdict=verdict, statistics=dict(sorted(stats.items())),
                  counterexample=cex_or_none, reason_unknown=unknown_text, reason=reason,
                  vcs=tuple(results), depth=depth_all, smoke=tuple(smoke), pins=pins,
-                 standard="\n".join(standard) + ("\n(exit)\n" if standard else "")),
+                 standard="\n".join(standard) + ("\n(exit)\n" if standard else ""),
+                 rlimit=limit),
             futures, certs)
 
 
@@ -708,9 +764,22 @@ def _default_render(model: z3.ModelRef) -> str:
     return "\n".join(lines)
 
 
-def render_query(ob: Obligation, query: Query) -> str:
+def _check_texts(query: Z3Query) -> list[tuple[str, str]]:
+    """Per VC, Z3's text of its vacuity check (the hypotheses, the witness pinned) and of its
+    proof check (the hypotheses, the goal negated): ``_text_of`` of those formulas, in order."""
+    out = []
+    for vc in query.vcs:
+        hyps = [h for _, h in vc.hypotheses]
+        out.append((_text_of(hyps + [c == v for c, v in vc.witness]),
+                    _text_of(hyps + [z3.Not(vc.goal)])))
+    return out
+
+
+def render_query(ob: Obligation, query: Query,
+                 texts: Sequence[tuple[str, str]] | None = None) -> str:
     """The replayable text of an obligation: SMT-LIB for Z3 (one block per check, then (reset)),
-    the canonical inputs for sympy and data checks. Its sha256 identifies the obligation."""
+    the canonical inputs for sympy and data checks. Its sha256 identifies the obligation.
+    ``texts``: the checks' Z3 text (``_check_texts``) if printed already."""
     head = [f"; obligation {ob.id} ({ob.paper_ref})", f"; method {ob.method}, expected {ob.expected}"]
     head += [f"; {line}" for line in ob.statement.splitlines()]
     if isinstance(query, CheckQuery):
@@ -718,17 +787,19 @@ def render_query(ob: Obligation, query: Query) -> str:
     out = head
     second = ("refutation (expect sat: the counterexample)"
               if ob.expected is Verdict.REFUTED_AS_EXPECTED else "proof (expect unsat)")
-    for vc in query.vcs:
-        for label, negate in (("vacuity (expect sat)", False), (second, True)):
-            s = z3.Solver()
-            s.add([h for _, h in vc.hypotheses])
-            if negate:
-                s.add(z3.Not(vc.goal))
-            else:
-                s.add([c == v for c, v in vc.witness])
+    if texts is None:
+        texts = _check_texts(query)
+    from ._limits import wall_net_ms, z3_rlimit
+
+    limit = z3_rlimit(ob.id)
+    # The limits each check runs under: the resource limit, and the wall clock as a net.
+    options = [f"(set-option :timeout {wall_net_ms(ob.timeout_ms, limit)})"]
+    if limit is not None:
+        options.append(f"(set-option :rlimit {limit})")
+    for vc, pair in zip(query.vcs, texts, strict=True):
+        for label, body in zip(("vacuity (expect sat)", second), pair):
             names = ", ".join(n for n, _ in vc.hypotheses) or "none"
             # (reset) rather than push/pop: incremental mode would change Z3's tactics.
             out += ["", f"; VC {vc.name}: {label}; hypotheses: {names}",
-                    f"(set-option :timeout {ob.timeout_ms})", s.sexpr().rstrip(), "(check-sat)",
-                    "(reset)"]
+                    *options, body.rstrip(), "(check-sat)", "(reset)"]
     return "\n".join(out) + "\n"

@@ -470,13 +470,13 @@ def _proof_json(p: Proof, ob: Obligation, change: str) -> dict[str, Any]:
         "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer, "depth": v.depth,
                  "sha256": v.sha256, "solvers": list(v.solvers), "cvc5": v.cvc5,
                  "cvc5_reason": v.cvc5_reason, "note": v.note, "nonlinear": v.nonlinear,
-                 "cvc5_from_pin": v.cvc5_from_pin}
+                 "cvc5_from_pin": v.cvc5_from_pin, "rlimit_count": list(v.rlimit_count)}
                 for v in p.vcs],
         "cvc5_tally": cvc5_tally(p),
         "depth": p.depth, "label": p.label, "solvers": list(p.solvers),
         "kind": kind_of(p.id), "kind_why": DEFINITIONAL.get(p.id, ""),
         "smoke": [{"name": s.name, "answer": s.answer, "how": s.how} for s in p.smoke],
-        "cvc5_seconds": p.cvc5_seconds,
+        "cvc5_seconds": p.cvc5_seconds, "rlimit": p.rlimit,
     }
 
 

@@ -20,10 +20,22 @@ postcondition raises ContractViolation too, unless the caller asked to record an
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import gc
 import math
+import os
+import pickle
+import signal
+import struct
+import sys
+import threading
+import time
+import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from enum import Enum
+from types import TracebackType
 from typing import Any
 
 import numpy as np
@@ -54,6 +66,7 @@ from ..spec import (
 
 __all__ = [
     "DEFAULT_SAMPLE",
+    "BuiltDRCheck",
     "Check",
     "Mode",
     "Settings",
@@ -67,6 +80,7 @@ __all__ = [
     "checked_search",
     "contracts_json",
     "optimality_failures",
+    "overlap_helps",
     "sample_cells",
     "violation_json",
 ]
@@ -243,6 +257,16 @@ def search_pre(variant: Variant | str, grid: Grid, dr: Any, start: Sequence[int]
 
     It is established (coverage ``all``) only when that check covered every cell; after a
     sampled check the record says that it held on the sample, and no more."""
+    return _run(search_triple(variant), "pre", [
+        ("pre.dr.shape", f"shape {list(grid.shape)}, uint8, values 0/1", 1,
+         dr_shape_failures(grid, dr, "pre.dr.shape")),
+        ("pre.cells", "start and goal cells", 2, cells_failures(grid, start, goal)),
+        _dr_spec_item(established),
+    ])
+
+
+def _dr_spec_item(established: TripleRun | None) -> Item:
+    """search_pre's pre.dr.spec, from the BuiltDR postcondition check ``established``."""
     spec: list[Failure] | None
     coverage = "all"
     if established is None:
@@ -259,12 +283,7 @@ def search_pre(variant: Variant | str, grid: Grid, dr: Any, start: Sequence[int]
                      + "; the other cells of D_R are not checked")
         spec = [Failure("pre.dr.spec", f"D_R fails {name}'s {f.condition}: "
                         f"{f.message}", f.values, f.count) for f in established.failures]
-    return _run(search_triple(variant), "pre", [
-        ("pre.dr.shape", f"shape {list(grid.shape)}, uint8, values 0/1", 1,
-         dr_shape_failures(grid, dr, "pre.dr.shape")),
-        ("pre.cells", "start and goal cells", 2, cells_failures(grid, start, goal)),
-        ("pre.dr.spec", scope, 0, spec, coverage),
-    ])
+    return ("pre.dr.spec", scope, 0, spec, coverage)
 
 
 def optimality_failures(dr: DR, start: Sequence[int], goal: Sequence[int],
@@ -360,35 +379,235 @@ def checked_build_dr(s: Scenario, variant: Variant | str, grid: Grid, settings: 
     A failed precondition raises ContractViolation before building; a failed postcondition
     raises after it when ``stop``, else it is returned in the runs.
     """
-    v = Variant(variant)
-    if settings.mode is Mode.OFF:
-        return build(s, v, grid), ()
-    pre = builtdr_pre(s, v, grid)
-    pre.raise_first()
-    dr = build(s, v, grid)
-    post = builtdr_post(s, v, grid, dr, settings)
-    if stop:
-        post.raise_first()
-    return dr, (pre, post)
+    check = BuiltDRCheck(s, variant, grid, settings, build=build, stop=stop, overlap=False)
+    return check.dr, check.runs
+
+
+def overlap_helps(dr: Any) -> bool:
+    """Whether BuiltDR's postcondition check can run beside the search to advantage
+    (docs/model.md §7.5), in a forked worker process: on Linux, D_R is an array in memory (not
+    a store read a layer at a time, whose reader a fork would share), this process may run on
+    more than one CPU and is running one thread (a fork copies no other thread, yet a lock one
+    of them holds), and the kernels run on more than one thread (the prove run's and the audit's
+    workers and Dask's workers set one: there the cores are shared out already)."""
+    from ..impl import kernel_threads
+
+    return (sys.platform.startswith("linux") and isinstance(dr, np.ndarray)
+            and len(os.sched_getaffinity(0)) > 1 and threading.active_count() == 1
+            and kernel_threads() > 1)
+
+
+#: The most bytes a forked check may send back (its pickled TripleRun or exception).
+_ANSWER_LIMIT = 64 << 20
+#: What the worker process sends before its pickled answer: the check's start and end
+#: (time.perf_counter, CLOCK_MONOTONIC on Linux: the same clock in both processes).
+_SPAN = struct.Struct("<dd")
+
+
+class _Forked:
+    """``fn()`` in a forked child process, its value or exception sent back pickled on a pipe
+    (read, bounded, by ``answer``); the child ends with os._exit (no atexit, no flush)."""
+
+    def __init__(self, fn: Callable[[], Any]) -> None:
+        rfd, wfd = os.pipe()
+        pid = os.fork()
+        if pid == 0:                                              # pragma: no cover - the child
+            code = 70
+            try:
+                gc.disable()          # a collection would touch, so copy, every object's page
+                os.close(rfd)
+                t0 = time.perf_counter()
+                try:
+                    answer: tuple[str, Any] = ("value", fn())
+                except BaseException as exc:  # noqa: BLE001 - sent to the parent
+                    where = "".join(traceback.format_exception(exc))[-4000:]
+                    exc.add_note(f"(in BuiltDR's postcondition check's worker process)\n{where}")
+                    answer = ("error", exc)
+                t1 = time.perf_counter()
+                try:
+                    data = pickle.dumps(answer)
+                except Exception:  # noqa: BLE001 - an answer that cannot be pickled
+                    what = ("".join(traceback.format_exception(answer[1]))[-4000:]
+                            if answer[0] == "error" else repr(answer[1])[:200])
+                    data = pickle.dumps(("error", RuntimeError(
+                        f"BuiltDR's postcondition check's answer cannot be sent back: {what}")))
+                with os.fdopen(wfd, "wb") as fh:
+                    fh.write(_SPAN.pack(t0, t1) + data)
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(wfd)
+        self._pid, self._rfd = pid, rfd
+
+    def answer(self, *, kill: bool = False) -> tuple[str, Any, tuple[float, float]]:
+        """("value" | "error", the value or exception, the check's (start, end)); once. ``kill``:
+        end the child first (the caller is being interrupted)."""
+        data = b""
+        try:
+            if kill:
+                os.kill(self._pid, signal.SIGKILL)
+            else:
+                with os.fdopen(self._rfd, "rb", closefd=False) as fh:
+                    data = fh.read(_ANSWER_LIMIT + 1)
+        finally:
+            os.close(self._rfd)
+            _, status = os.waitpid(self._pid, 0)
+        if kill:
+            return "error", KeyboardInterrupt(), (0.0, 0.0)
+        if len(data) > _ANSWER_LIMIT:
+            return "error", RuntimeError(f"BuiltDR's postcondition check's answer is over "
+                                         f"{_ANSWER_LIMIT} bytes"), (0.0, 0.0)
+        if len(data) <= _SPAN.size or os.waitstatus_to_exitcode(status) != 0:
+            return "error", RuntimeError(
+                "BuiltDR's postcondition check's worker process ended without an answer "
+                f"(exit status {os.waitstatus_to_exitcode(status)})"), (0.0, 0.0)
+        try:
+            kind, value = pickle.loads(data[_SPAN.size:])
+        except Exception as exc:  # noqa: BLE001 - e.g. an exception class that cannot be rebuilt
+            return "error", RuntimeError(f"BuiltDR's postcondition check's answer cannot be "
+                                         f"read back: {exc!r}"[:400]), (0.0, 0.0)
+        return kind, value, _SPAN.unpack(data[:_SPAN.size])
+
+
+class BuiltDRCheck:
+    """``checked_build_dr`` with its postcondition check possibly in a forked worker process
+    (docs/model.md §7.5), beside what does not depend on it: the search, its own checks, the
+    certificate, the exact re-decision.
+
+    The precondition is checked and D_R built in this process (a failed precondition raises
+    here). ``overlap``: True runs ``builtdr_post`` in a child process forked right after the
+    build (a copy of D_R's pages, shared until written: neither process writes them), False
+    runs it here before returning (the serial order: with ``stop``, a failed postcondition
+    raises from the constructor), None decides by ``overlap_helps``. Use it as a context
+    manager around the dependent work: leaving the block waits for the child (in every case;
+    an interrupt kills it), and then, in this order, re-raises an exception the check raised
+    (its traceback in the child as a note), raises its first failure as ContractViolation when
+    ``stop`` (the block's own result or exception discarded: the serial order would never have
+    run the block), else lets the block's exception go on. ``established`` is what
+    ``checked_search`` takes for pre.dr.spec (this object while the check is pending), ``runs``
+    the BuiltDR checks once joined, ``settled`` the search's checks with pre.dr.spec filled in
+    from them. ``seconds`` is the contract time (the precondition and the postcondition's own
+    wall time, in whichever process it ran); ``overlapped`` the part of it spent beside this
+    process's work (0.0 in the serial order)."""
+
+    def __init__(self, s: Scenario, variant: Variant | str, grid: Grid, settings: Settings, *,
+                 build: Builder = build_dr, stop: bool = True, overlap: bool | None = False
+                 ) -> None:
+        v = Variant(variant)
+        self.stop = stop
+        self.seconds = 0.0
+        self.overlapped = 0.0
+        self._pre: TripleRun | None = None
+        self._post: TripleRun | None = None
+        self._error: BaseException | None = None
+        self._worker: _Forked | None = None
+        self._span = (0.0, 0.0)
+        self._joined = False
+        if settings.mode is Mode.OFF:
+            self.dr = build(s, v, grid)
+            return
+        t0 = time.perf_counter()
+        pre = builtdr_pre(s, v, grid)
+        pre.raise_first()
+        self.seconds = time.perf_counter() - t0
+        self.dr = dr = build(s, v, grid)
+        self._pre = pre
+        if overlap or (overlap is None and overlap_helps(dr)):
+            self._worker = _Forked(functools.partial(builtdr_post, s, v, grid, dr, settings))
+        else:
+            t0 = time.perf_counter()
+            try:
+                self._post = builtdr_post(s, v, grid, dr, settings)
+            finally:
+                self._span = (t0, time.perf_counter())
+            self.join()
+
+    @property
+    def pending(self) -> bool:
+        """The postcondition check is in its worker process, not yet joined."""
+        return self._worker is not None
+
+    def join(self, *, kill: bool = False) -> tuple[TripleRun, ...]:
+        """Wait for the check (if in a worker; ``kill`` ends it instead); raise its exception,
+        or with ``stop`` its first failure; the BuiltDR checks run (none with contracts off).
+        Idempotent."""
+        if not self._joined:
+            if self._worker is not None:
+                waited = time.perf_counter()
+                worker, self._worker = self._worker, None
+                kind, value, self._span = worker.answer(kill=kill)
+                if kind == "value":
+                    self._post = value
+                else:
+                    self._error = value
+                self.overlapped = max(0.0, min(self._span[1], waited) - self._span[0])
+            self.seconds += self._span[1] - self._span[0]
+            self._joined = True
+        if self._error is not None:
+            raise self._error
+        if self._pre is None:
+            return ()
+        assert self._post is not None
+        if self.stop:
+            self._post.raise_first()
+        return (self._pre, self._post)
+
+    @property
+    def established(self) -> TripleRun | BuiltDRCheck | None:
+        """For ``checked_search``: the postcondition's run, or this object while pending."""
+        return self if self.pending else self._post
+
+    @property
+    def runs(self) -> tuple[TripleRun, ...]:
+        """The BuiltDR checks (joined: see ``join``)."""
+        return self.join()
+
+    def settled(self, search_runs: tuple[TripleRun, ...]) -> tuple[TripleRun, ...]:
+        """``checked_search``'s runs with pre.dr.spec taken from this check (joined), as
+        ``search_pre`` would have made it given the check's run."""
+        if not search_runs:
+            return search_runs
+        pre, post = search_runs[0], (self.join()[1:] or (None,))[0]
+        spec = _run(pre.triple, "pre", [_dr_spec_item(post)])
+        return (TripleRun(pre.triple, pre.checks[:-1] + spec.checks,
+                          tuple(f for f in pre.failures if f.condition != "pre.dr.spec")
+                          + spec.failures), *search_runs[1:])
+
+    def __enter__(self) -> BuiltDRCheck:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        if exc is not None and not isinstance(exc, Exception):
+            with contextlib.suppress(BaseException):    # an interrupt or an exit goes first
+                self.join(kill=True)
+            return
+        self.join()      # the check's exception, or its failure with ``stop``, goes first
 
 
 def checked_search(s: Scenario, variant: Variant | str, grid: Grid, dr: DR,
-                   settings: Settings, *, established: TripleRun | None = None,
+                   settings: Settings, *,
+                   established: TripleRun | BuiltDRCheck | None = None,
                    search: Searcher = search_opt_path, stop: bool = True
                    ) -> tuple[SearchResult, tuple[TripleRun, ...]]:
     """``search(dr, start, goal)`` under Theorem 2/4: (the result, the checks run).
 
     ``established`` is the BuiltDR postcondition check that discharges pre.dr.spec. In sampled
     mode, Theorem 1/3's cell condition is also checked at every cell the found path occupies.
+    While that check is still running (a pending ``BuiltDRCheck``), pre.dr.spec is left
+    unchecked here and filled in by ``BuiltDRCheck.settled`` once it is joined (a failure of
+    it, with ``stop``, is raised by the join).
     """
     v = Variant(variant)
     start, goal = s.right.start_cell, s.right.goal_cell
     if settings.mode is Mode.OFF:
         return search(dr, start, goal), ()
-    pre = search_pre(v, grid, dr, start, goal, established)
+    pending = isinstance(established, BuiltDRCheck)
+    pre = search_pre(v, grid, dr, start, goal,
+                     None if isinstance(established, BuiltDRCheck) else established)
     # A D_R that fails BuiltDR's postcondition is already a recorded violation; without ``stop``
     # the search still runs on it (any 0/1 array of the right shape is a valid input).
-    (pre if stop else _without(pre, "pre.dr.spec")).raise_first()
+    (pre if stop and not pending else _without(pre, "pre.dr.spec")).raise_first()
     result = search(dr, start, goal)
     runs = [pre, search_post(v, dr, start, goal, result, settings)]
     if settings.mode is Mode.SAMPLED and result.status is SearchStatus.FOUND:

@@ -53,11 +53,11 @@ from ..spec import (
 )
 from ._contracts import (
     Builder,
+    BuiltDRCheck,
     Mode,
     Searcher,
     Settings,
     TripleRun,
-    checked_build_dr,
     checked_search,
     contracts_json,
     violation_json,
@@ -144,7 +144,8 @@ def z3_version() -> str:
 def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
          sample: int | None = None, stop: bool = True, grid: Grid | None = None,
          build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast,
-         kernel: str | None = None, witness: bool = False) -> PlanResult:
+         kernel: str | None = None, witness: bool = False,
+         overlap: bool | None = None) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
 
     ``contracts`` is off (this function's default; `cfmpa plan` defaults to full), sampled
@@ -164,6 +165,9 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     (``SearchResult.witness``, docs/model.md §11; a search that makes none gets the fast
     search's), which ``write_plan`` can write and ``full`` verifies; timings_s.search then
     includes making it. The result keeps it only when ``witness`` asked for it.
+    ``overlap`` (docs/model.md §7.5): BuiltDR's postcondition check in a forked worker process
+    beside the search and what follows it (True), in the serial order (False), or where it can
+    help (None: ``overlap_helps``); the same result, record and violation either way.
     """
     v = Variant(variant)
     settings = Settings.of(contracts, seed, sample)
@@ -176,36 +180,43 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     t: dict[str, float] = {}
     if kernel == "fast":
         t["kernel_load"] = _load_fast_kernels()
-    t0 = time.perf_counter()
-    dr, runs = checked_build_dr(s, v, g, settings, build=_timed(build, t, "build_dr"), stop=stop)
+    built = BuiltDRCheck(s, v, g, settings, build=_timed(build, t, "build_dr"), stop=stop,
+                         overlap=overlap)
+    dr = built.dr
     if enforce:
-        t["contracts_builtdr"] = time.perf_counter() - t0 - t["build_dr"]
-    t0 = time.perf_counter()
-    result, search_runs = checked_search(s, v, g, dr, settings, established=runs[-1] if runs
-                                         else None, search=_timed(search, t, "search"), stop=stop)
+        t["contracts_builtdr"] = built.seconds    # its place in timings_s; set once joined
+    with built:          # a postcondition check in its worker process is joined here (§7.5)
+        t0 = time.perf_counter()
+        result, search_runs = checked_search(s, v, g, dr, settings, established=built.established,
+                                             search=_timed(search, t, "search"), stop=stop)
+        if enforce:
+            t["contracts_search"] = time.perf_counter() - t0 - t["search"]
+        if witness and result.witness is None:
+            made = search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell,
+                                        with_witness=True)
+            result = replace(result, witness=made.witness)
+        elif not witness and result.witness is not None:
+            result.witness.close()                    # its temporary files, if spilled
+            result = replace(result, witness=None)    # checked; not kept (N + 1 grids large)
+        cert = None
+        exact = None
+        if result.status is SearchStatus.FOUND:
+            t0 = time.perf_counter()
+            cert = certify(s, g, result.path)
+            t["certificate"] = time.perf_counter() - t0
+            if stop:
+                require_clear(cert, name=CERTIFICATE)
+            t0 = time.perf_counter()
+            from ..spec import exact_path_gaps  # python-flint, for plan only (not `cfmpa dr`)
+            exact = exact_path_gaps(s, v, g, result.path)
+            t["exact_gaps"] = time.perf_counter() - t0
+            if stop and not exact.ok:
+                raise _exact_violation(exact)
+    runs = built.runs + built.settled(search_runs)
     if enforce:
-        t["contracts_search"] = time.perf_counter() - t0 - t["search"]
-    runs += search_runs
-    if witness and result.witness is None:
-        made = search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell, with_witness=True)
-        result = replace(result, witness=made.witness)
-    elif not witness and result.witness is not None:
-        result.witness.close()                    # its temporary files, if spilled
-        result = replace(result, witness=None)    # checked; not kept (it is N + 1 grids large)
-    cert = None
-    exact = None
-    if result.status is SearchStatus.FOUND:
-        t0 = time.perf_counter()
-        cert = certify(s, g, result.path)
-        t["certificate"] = time.perf_counter() - t0
-        if stop:
-            require_clear(cert, name=CERTIFICATE)
-        t0 = time.perf_counter()
-        from ..spec import exact_path_gaps  # python-flint, for plan only (not `cfmpa dr`)
-        exact = exact_path_gaps(s, v, g, result.path)
-        t["exact_gaps"] = time.perf_counter() - t0
-        if stop and not exact.ok:
-            raise _exact_violation(exact)
+        t["contracts_builtdr"] = built.seconds
+        if built.overlapped:
+            t["contracts_builtdr_overlapped"] = built.overlapped
     record = contracts_json(settings, runs,
                             _certificate_violation(cert) if cert and not cert.clear else None,
                             certificate_checked=True)

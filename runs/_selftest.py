@@ -18,6 +18,7 @@ dt = 0.04 s gives 1.06M cells, too slow for a unit test, and runs in a slow test
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -179,19 +180,27 @@ def _coarse_grid(s: Scenario, v: Variant, g: Grid) -> Mutant:
 def _non_optimal(s: Scenario, v: Variant, g: Grid) -> Mutant:
     """A valid path with true costs that is not the least: the optimum with one cell blocked."""
     def search(dr: DR, start: Cell, goal: Cell) -> SearchResult:
-        best = search_opt_path(dr, start, goal)
-        _require(best.status is SearchStatus.FOUND, "no path to make worse")
-        N = dr.shape[0] - 1
-        for k in range(1, len(best.path) - 1):
-            more = dr.copy()
-            more[min(k, N), best.path[k][0], best.path[k][1]] = 1   # more blocked: still valid
-            alt = opt_path(more, start, goal)
-            if alt.status is SearchStatus.FOUND and (alt.J1, alt.J2) > (best.J1, best.J2):
-                return SearchResult.found(alt.path, J1(alt.path), J2(alt.path))
-        raise FaultNotMade("no single blocked cell makes the optimum worse")
+        return _worse_path(dr.shape, dr.tobytes(), tuple(start), tuple(goal))
 
     return Mutant(search=search, detail="the optimum with one of its cells blocked; true costs "
                   "reported")
+
+
+@functools.lru_cache(maxsize=2)
+def _worse_path(shape: tuple[int, ...], cells: bytes, start: Cell, goal: Cell) -> SearchResult:
+    """_non_optimal's path on D_R (``shape``, ``cells``: its bytes): one search per table, as
+    full and sampled mode, and the forged witness, ask for it on the same one."""
+    dr = np.frombuffer(cells, dtype=np.uint8).reshape(shape)
+    best = search_opt_path(dr, start, goal)
+    _require(best.status is SearchStatus.FOUND, "no path to make worse")
+    N = dr.shape[0] - 1
+    for k in range(1, len(best.path) - 1):
+        more = dr.copy()
+        more[min(k, N), best.path[k][0], best.path[k][1]] = 1   # more blocked: still valid
+        alt = opt_path(more, start, goal)
+        if alt.status is SearchStatus.FOUND and (alt.J1, alt.J2) > (best.J1, best.J2):
+            return SearchResult.found(alt.path, J1(alt.path), J2(alt.path))
+    raise FaultNotMade("no single blocked cell makes the optimum worse")
 
 
 def _forged_witness(s: Scenario, v: Variant, g: Grid) -> Mutant:
@@ -298,11 +307,13 @@ def workcell(name: str, **changes: Any) -> Scenario:
 
 
 def run_fault(fault: Fault, mode: Mode | str, *, scenario: Scenario | None = None,
-              sample: int = SAMPLE, seed: int = 0) -> tuple[Outcome, str]:
-    """Plan with the fault seeded, contracts in ``mode``: (what caught it, the fault's size)."""
+              sample: int = SAMPLE, seed: int = 0, mutant: Mutant | None = None
+              ) -> tuple[Outcome, str]:
+    """Plan with the fault seeded, contracts in ``mode``: (what caught it, the fault's size).
+    ``mutant``: the fault as made already from ``scenario`` (None: made here)."""
     s = scenario or workcell(fault.workcell)
     g = make_grid(s)
-    m = fault.make(s, fault.variant, g)
+    m = mutant or fault.make(s, fault.variant, g)
     kwargs: dict[str, Any] = {k: v for k, v in (("grid", m.grid), ("build", m.build),
                                                 ("search", m.search)) if v is not None}
     try:
@@ -324,8 +335,11 @@ def selftest_rows(*, sample: int = SAMPLE, seed: int = 0) -> tuple[SelftestRow, 
     """Every fault run in full and in sampled mode."""
     rows = []
     for f in FAULTS:
-        full, detail = run_fault(f, Mode.FULL, sample=sample, seed=seed)
-        sampled, _ = run_fault(f, Mode.SAMPLED, sample=sample, seed=seed)
+        # One workcell and one fault for both modes (making a fault builds D_R, some twice).
+        s = workcell(f.workcell)
+        m = f.make(s, f.variant, make_grid(s))
+        full, detail = run_fault(f, Mode.FULL, scenario=s, sample=sample, seed=seed, mutant=m)
+        sampled, _ = run_fault(f, Mode.SAMPLED, scenario=s, sample=sample, seed=seed, mutant=m)
         rows.append(SelftestRow(
             fault=f.name, workcell=f.workcell, caught_full=full.caught,
             caught_sampled=sampled.caught, caught_by=_by(full), caught_by_sampled=_by(sampled),

@@ -12,7 +12,7 @@ regions, leaving to ``expected_cells`` the cells no bound decides (tests check t
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -166,6 +166,9 @@ def _report(s: Scenario, variant: Variant | str, grid: Grid, ok: bool, checked: 
 #   4. the separating-axis test on the edges of both convex polygons (one-sided: the other
 #      polygon beyond an edge's line): no separating edge means they meet (blocked), a gap
 #      above the limit means free (a gap on any unit axis is at most the distance).
+# ``decide`` runs them in the order 1 (rows' boxes, then cells'), 3, 2 at the cells 3 leaves
+# open, 4 where the hull's extents along link 2's axes leave it open: each skips only cells
+# the next would decide as it does (docs/model.md §7.5, tests/spec/test_check_shortcuts.py).
 # A free verdict needs every gap above eps + band + SLACK, SLACK covering the rounding of two
 # float computations of one polygon; a cell no bound decides (a distance within about eps of
 # eps: none on the bundled scenarios) is decided by ``expected_cells`` itself. The right link-2
@@ -225,6 +228,10 @@ def _block_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, b
             close = np.flatnonzero(_box_gap(shapely.bounds(a), b1) <= free_at)
             d1[close] = np.minimum(d1[close], shapely.distance(a, r1[close]))   # exact
         link1.append(d1)
+    # The link-2 and tool pairs, the principal's outer parts first: the cells they block are
+    # skipped for the others (``decide``'s skip; a cell's verdict is the same in any order:
+    # blocked by any pair, undecided by one and blocked by none).
+    link2_pairs = sorted(((p, q) for p, q in pairs if q != 0), key=lambda pq: -pq[0])
     step = max(1, BLOCK_CELLS // n)
     row0 = {q: _row0(s, grid, q) for q in parts(s.right) if q > 0}     # once, not per block
     left_edges: dict[int, _LeftEdges] = {}     # each left region's corners and edges, once
@@ -236,9 +243,7 @@ def _block_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, b
             d1 = link1[k][i0:i1]
             meets = np.repeat(d1 <= eps - band, n)
             unsure = np.repeat(np.abs(d1 - eps) <= band, n)
-            for p, q in pairs:
-                if q == 0:
-                    continue
+            for p, q in link2_pairs:
                 hit, open_ = per_cell[q].decide(links[p], free_at, meets)
                 meets |= hit
                 unsure |= open_
@@ -294,6 +299,10 @@ class _Link2:
         self.offset = self.nx * self.hx + self.ny * self.hy
         self.box = (self.hx.min(axis=0), self.hy.min(axis=0), self.hx.max(axis=0),
                     self.hy.max(axis=0))
+        # Each row's box, around its cells' boxes: a gap to it is at most the gap to any of them.
+        self.n = n
+        self.row_box = tuple(f(b.reshape(m, n), axis=1) for f, b in
+                             zip((np.min, np.min, np.max, np.max), self.box))
         # The rectangle at the cell's own angles (lattice point 4 of 9) lies in the region; its
         # axis runs between the midpoints of its short sides. A tool has no such core (bound 2
         # is left out for it); its projections use the forearm's axis at the cell's angles.
@@ -332,46 +341,108 @@ class _Link2:
         if held is None or held[0] is not a:
             held = self.left[id(a)] = _left_edges(a)
         _, ax, ay, (anx, any_, aoff) = held                               # (V, 1) each
-        bx0, by0, bx1, by1 = self.box
-        gap = np.maximum(np.maximum(ax.min() - bx1, bx0 - ax.max()),
-                         np.maximum(ay.min() - by1, by0 - ay.max()))
-        c = np.flatnonzero((gap <= free_at) & ~skip)                     # 1. boxes
+        # 1. boxes: first the rows' (``row_box``), then the cells' of the rows from the first
+        # to the last row within reach (a cell of a row apart is apart: its gap is at least
+        # the row's).
+        rows = np.flatnonzero(_box_gap_of(ax, ay, self.row_box) <= free_at)
+        if rows.size == 0:
+            return meets, undecided
+        lo, hi = int(rows[0]) * self.n, (int(rows[-1]) + 1) * self.n
+        gap = _box_gap_of(ax, ay, tuple(b[lo:hi] for b in self.box))
+        c = lo + np.flatnonzero((gap <= free_at) & ~skip[lo:hi])
         if c.size == 0:
             return meets, undecided
-        if self.has_core:
-            cross = _crosses(self.q0[0][c], self.q0[1][c], self.d[0][c], self.d[1][c],
-                             anx, any_, aoff)                            # 2. the axis
-        else:
-            cross = np.zeros(c.size, dtype=bool)
         # 3. A's corners on the axis and its normal: a corner inside the rectangle at the
         # cell's angles means they meet; a gap of the projections above the limit, free.
         pu = ax * self.u[0][c] + ay * self.u[1][c]                       # (V, S)
         pv = ax * self.v[0][c] + ay * self.v[1][c]
         u0, u1, v0, half = self.core[0][c], self.core[1][c], self.core[2][c], self.core[3]
         inside = ((pu >= u0) & (pu <= u1) & (np.abs(pv - v0) <= half)).any(axis=0)
-        hit = cross | (inside if self.has_core else False)
-        meets[c[hit]] = True
+        hit = inside if self.has_core else np.zeros(c.size, dtype=bool)
         e = [x[c] for x in self.ext]
         gap = np.maximum(np.maximum(e[0] - pu.max(axis=0), pu.min(axis=0) - e[1]),
                          np.maximum(e[2] - pv.max(axis=0), pv.min(axis=0) - e[3]))
+        if self.has_core:
+            # 2. the axis crossing A, at the cells 3 leaves open (regions that meet have no
+            # gap above the limit of 3 on any axis: a cell 3 frees is not one it would block).
+            at = np.flatnonzero(~hit & (gap <= free_at))
+            hit[at] = _crosses(self.q0[0][c[at]], self.q0[1][c[at]], self.d[0][c[at]],
+                               self.d[1][c[at]], anx, any_, aoff)
+        meets[c[hit]] = True
         c = c[~hit & (gap <= free_at)]
         if c.size == 0:
             return meets, undecided
         # 4. separating axes, one-sided: every corner of one polygon beyond an edge's line of
         # the other. Edges of A against the hull's corners, then the hull's edges against A's.
-        hx, hy = self.hx[:, c], self.hy[:, c]                            # (L, S)
-        sep = np.full(c.size, -np.inf)
-        for k in range(len(ax)):
-            np.maximum(sep, (hx * anx[k] + hy * any_[k]).min(axis=0) - aoff[k], out=sep)
+        # First a bound below each edge's sum: the hull lies in its extents along u and v
+        # (``ext``), so n . h is at least min(nu e0, nu e1) + min(nv e2, nv e3), nu = n . u,
+        # nv = n . v; a cell it shows separated by more than the limit and SLACK (the two
+        # computations' rounding) is one the sums below would drop.
+        nu = anx * self.u[0][c] + any_ * self.u[1][c]                    # (V, S)
+        nv = anx * self.v[0][c] + any_ * self.v[1][c]
+        c = c[_extent_sep(nu, nv, [x[c] for x in self.ext], aoff) <= free_at + SLACK]
+        if c.size == 0:
+            return meets, undecided
+        sep = _chunked(lambda at: _a_edges_sep(self.hx[:, at], self.hy[:, at], anx, any_, aoff),
+                       c)
         c, sep = c[sep <= free_at], sep[sep <= free_at]      # the rest: an edge of A separates
-        nx, ny = self.nx[:, c], self.ny[:, c]
-        least = nx * ax[0] + ny * ay[0]
-        for k in range(1, len(ax)):
-            np.minimum(least, nx * ax[k] + ny * ay[k], out=least)
-        np.maximum(sep, (least - self.offset[:, c]).max(axis=0), out=sep)
+        np.maximum(sep, _chunked(lambda at: _hull_edges_sep(self.nx[:, at], self.ny[:, at],
+                                                            self.offset[:, at], ax, ay), c),
+                   out=sep)
         meets[c[sep <= 0]] = True
         undecided[c[(sep > 0) & (sep <= free_at)]] = True
         return meets, undecided
+
+
+def _box_gap_of(ax: npt.NDArray[np.float64], ay: npt.NDArray[np.float64],
+                box: tuple[npt.NDArray[np.float64], ...]) -> npt.NDArray[np.float64]:
+    """The larger per-axis gap between the box of corners (ax, ay) and boxes (xmin, ymin, xmax,
+    ymax), each (K,): at most the distance between anything inside them."""
+    bx0, by0, bx1, by1 = box
+    return np.maximum(np.maximum(ax.min() - bx1, bx0 - ax.max()),
+                      np.maximum(ay.min() - by1, by0 - ay.max()))
+
+
+def _extent_sep(nu: npt.NDArray[np.float64], nv: npt.NDArray[np.float64],
+                ext: list[npt.NDArray[np.float64]], aoff: npt.NDArray[np.float64]
+                ) -> npt.NDArray[np.float64]:
+    """Per cell, at most (up to rounding) ``_a_edges_sep``: the greatest over A's edges of the
+    least n . h - offset over the rectangle of the hull's extents along u and v (``ext``: e0..e1
+    along u, e2..e3 along v), n = nu u + nv v ((V, S) each)."""
+    e0, e1, e2, e3 = ext
+    low = np.minimum(nu * e0, nu * e1) + np.minimum(nv * e2, nv * e3) - aoff
+    return low.max(axis=0)
+
+
+#: Cells whose (V, L) projections bound 4 holds at once (``_chunked``): a few MB.
+SEP_CHUNK = 2048
+
+
+def _chunked(f: Callable[[npt.NDArray[np.int64]], npt.NDArray[np.float64]],
+             c: npt.NDArray[np.int64]) -> npt.NDArray[np.float64]:
+    """``f(c)`` computed SEP_CHUNK cells at a time (f is elementwise over the cells)."""
+    if c.size <= SEP_CHUNK:
+        return f(c)
+    return np.concatenate([f(c[k:k + SEP_CHUNK]) for k in range(0, c.size, SEP_CHUNK)])
+
+
+def _a_edges_sep(hx: npt.NDArray[np.float64], hy: npt.NDArray[np.float64],
+                 anx: npt.NDArray[np.float64], any_: npt.NDArray[np.float64],
+                 aoff: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Per cell (hull corners (L, S)): the greatest over A's edges k ((V, 1) normals and
+    offsets) of min over the corners of n_k . h - offset_k, every edge at once (V, L, S): each
+    value the same float operations as one edge at a time."""
+    proj = hx[None] * anx[:, :, None] + hy[None] * any_[:, :, None]
+    return (proj.min(axis=1) - aoff).max(axis=0)
+
+
+def _hull_edges_sep(nx: npt.NDArray[np.float64], ny: npt.NDArray[np.float64],
+                    offset: npt.NDArray[np.float64], ax: npt.NDArray[np.float64],
+                    ay: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Per cell (hull edges' normals and offsets (L, S)): the greatest over the hull's edges of
+    min over A's corners ((V, 1)) of n . a - offset, every corner at once (V, L, S)."""
+    least = (nx[None] * ax[:, :, None] + ny[None] * ay[:, :, None]).min(axis=0)
+    return (least - offset).max(axis=0)
 
 
 #: A left region (kept, so that its id is not reused), its corners' x and y (V, 1), counter-
@@ -445,13 +516,25 @@ def _crosses(x0: npt.NDArray[np.float64], y0: npt.NDArray[np.float64],
 def _hull_order(pts: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.int64], bool]:
     """For point sets (n, P, 2): the indices of each hull's corners, counter-clockwise, padded
     to one length by repeating the last (a zero-length edge); and whether some hull is not a
-    polygon (then the indices mean nothing)."""
+    polygon (then the indices mean nothing). Every hull at once: its ring's corners (shapely's
+    coordinates, the closing one left out), turned counter-clockwise where the shoelace sum is
+    negative (``_ccw``'s test), each matched to the point it is."""
     hulls = shapely.convex_hull(shapely.linestrings(pts))
     if np.any(shapely.get_type_id(hulls) != 3):
         return np.zeros((len(pts), 1), dtype=np.int64), True
-    out = []
-    for q, hull in zip(pts, hulls):
-        ring = _ccw(shapely.get_coordinates(hull)[:-1])
-        out.append(np.argmax((ring[:, None] == q[None]).all(axis=2), axis=1).tolist())
-    width = max(len(o) for o in out)
-    return np.array([o + [o[-1]] * (width - len(o)) for o in out], dtype=np.int64), False
+    coords, owner = shapely.get_coordinates(hulls, return_index=True)
+    size = np.bincount(owner, minlength=len(pts)) - 1          # corners, the closing one out
+    first = np.cumsum(size + 1) - (size + 1)                    # each ring's first coordinate
+    ring_of = np.repeat(np.arange(len(pts)), size)
+    pos = np.arange(size.sum()) - np.repeat(np.cumsum(size) - size, size)   # index in its ring
+    at = first[ring_of] + pos                                   # the corner's coordinate row
+    after = first[ring_of] + (pos + 1) % size[ring_of]          # the next corner's (np.roll)
+    x, y = coords[:, 0], coords[:, 1]
+    area = np.zeros(len(pts))
+    np.add.at(area, ring_of, x[at] * y[after] - x[after] * y[at])
+    turned = first[ring_of] + np.where(area[ring_of] >= 0, pos, size[ring_of] - 1 - pos)
+    corner = coords[turned]                                     # counter-clockwise (C, 2)
+    index = np.argmax((corner[:, None] == pts[ring_of]).all(axis=2), axis=1)
+    width = int(size.max())
+    take = np.minimum(np.arange(width)[None, :], size[:, None] - 1)
+    return index[(np.cumsum(size) - size)[:, None] + take].astype(np.int64), False

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import shapely
 from flint import arb, ctx
 
@@ -39,9 +40,14 @@ EXACT_PREC_BITS = 128
 
 Cell = tuple[int, int]
 Points = list[tuple[arb, arb]]
-#: A region: its corner points in balls and the convex hull of their midpoints (shapely), the
-#: hull made once per region, not once per pair of regions compared (``_gap``).
-Region = tuple[Points, shapely.Geometry]
+#: A region: its corner points in balls, the convex hull of their midpoints (shapely), the
+#: midpoints as doubles (P, 2) and the slack of their float projections (``_slack``), all made
+#: once per region, not once per pair of regions compared (``_gap``).
+Region = tuple[Points, shapely.Geometry, npt.NDArray[np.float64], float]
+
+#: A bound on the relative error of a double midpoint and of its float projection n.x (a
+#: rounding of the midpoint and two of the dot product: about 3 * 2**-53 = 3.3e-16), with room.
+FLOAT_REL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -90,20 +96,29 @@ def path_layer_cells(path: Sequence[Sequence[int]], N: int) -> list[tuple[int, C
     return list(out)
 
 
+@functools.lru_cache(maxsize=1 << 12)
+def _cos_sin(t1: float, t2: float | None, prec: int) -> tuple[arb, arb]:
+    """(cos phi, sin phi) in balls at ``prec`` bits, phi = arb(t1) (t2 None) or arb(t1) +
+    arb(t2): the same balls each time, computed once for the lattice angles that neighbouring
+    cells and both links share."""
+    phi = arb(t1) if t2 is None else arb(t1) + arb(t2)
+    return phi.cos(), phi.sin()
+
+
 def _corners(arm: Arm, t1: float, t2: float, link: int, r: arb) -> Points:
     """The four corners of the link's rectangle of half-width ``r`` at the float angles
     (t1, t2), enclosed in balls (the spec's ``corners`` formula, term for term)."""
-    a1 = arb(t1)
+    c1, s1 = _cos_sin(t1, None, ctx.prec)
     bx, by = arb(arm.base[0]), arb(arm.base[1])
-    ex, ey = bx + arb(arm.links[0]) * a1.cos(), by + arb(arm.links[0]) * a1.sin()
+    ex, ey = bx + arb(arm.links[0]) * c1, by + arb(arm.links[0]) * s1
     if link == 0:
-        phi = a1
+        c, s = c1, s1
         px, py, qx, qy = bx, by, ex, ey
     else:
-        phi = a1 + arb(t2)
+        c, s = _cos_sin(t1, t2, ctx.prec)
         px, py = ex, ey
-        qx, qy = ex + arb(arm.links[1]) * phi.cos(), ey + arb(arm.links[1]) * phi.sin()
-    ux, uy = r * phi.cos(), r * phi.sin()
+        qx, qy = ex + arb(arm.links[1]) * c, ey + arb(arm.links[1]) * s
+    ux, uy = r * c, r * s
     return [(px - ux + uy, py - uy - ux), (qx + ux + uy, qy + uy - ux),
             (qx + ux - uy, qy + uy + ux), (px - ux - uy, py - uy + ux)]
 
@@ -156,19 +171,51 @@ def _region_points(arm: Arm, link: int, axes: tuple[np.ndarray, np.ndarray],
             balls += (_tool_points(arm, float(t1), float(t2), grow) if link == TOOL
                       else _corners(arm, float(t1), float(t2), link, r))
     floats = np.array([[float(x.mid()), float(y.mid())] for x, y in balls])
-    return balls, shapely.convex_hull(shapely.multipoints(floats))
+    return balls, shapely.convex_hull(shapely.multipoints(floats)), floats, _slack(balls, floats)
+
+
+def _slack(balls: Points, floats: npt.NDArray[np.float64]) -> float:
+    """s such that |float(n . m) - n . x| <= (|nx| + |ny|) s / 4 for every ball's double
+    midpoint m and every point x of the ball, doubles n: the midpoint's and the dot product's
+    rounding (``FLOAT_REL`` of the largest coordinate, which also covers the ball arithmetic's
+    own rounding of n . x) and the balls' radius (twice the largest, covering its rounding to a
+    double), with a factor 4 (``_extreme`` needs 2). The largest radius is bounded by the radius
+    of the balls' sum: a ball holding every sum of points of balls of radii r_1, r_2, ... has a
+    radius of at least r_1 + r_2 + ... (one sum, not a radius read per coordinate)."""
+    total = arb(0)
+    for x, y in balls:
+        total += x
+        total += y
+    rad = float(total.rad())
+    return 4.0 * (float(np.abs(floats).max(initial=0.0)) * FLOAT_REL + 2.0 * rad)
+
+
+def _extreme(r: Region, dx: float, dy: float, sign: float) -> Points:
+    """The balls of ``r`` that may hold the greatest sign * n . x, n = (dx, dy): all but those
+    whose float projection lies more than (|dx| + |dy|) s below the float greatest (s =
+    ``_slack``). A ball left out has every point's projection, and so its end, below the end of
+    the ball of the float greatest: max (sign 1) of the upper ends, or min (sign -1) of the
+    lower ends, over the balls kept is that over all of them, the same value
+    (tests/spec/test_check_shortcuts.py; a slack without the balls' radii, the seeded fault,
+    drops a wide ball that holds the end)."""
+    # Python floats, not numpy: a region has tens of points, fewer than numpy's overhead.
+    sx, sy = sign * dx, sign * dy
+    f = [x * sx + y * sy for x, y in r[2].tolist()]
+    least = max(f) - (abs(dx) + abs(dy)) * r[3]
+    return [b for b, v in zip(r[0], f) if v >= least]
 
 
 def _gap(a: Region, b: Region) -> arb:
     """A ball containing a lower bound on dist(hull A, hull B), by the float nearest direction;
-    arb(0) when the float hulls already meet (no direction separates them)."""
-    line = shapely.shortest_line(a[1], b[1])
-    (x0, y0), (x1, y1) = line.coords[0], line.coords[1]
+    arb(0) when the float hulls already meet (no direction separates them). The projections'
+    ends are taken over the balls that may hold them (``_extreme``): the same ends as over
+    every ball, without the ball arithmetic of the others."""
+    (x0, y0), (x1, y1) = shapely.get_coordinates(shapely.shortest_line(a[1], b[1])).tolist()
     dx, dy = x1 - x0, y1 - y0
     if dx == 0.0 and dy == 0.0:
         return arb(0)
     nx, ny = arb(dx), arb(dy)
-    hi_a, lo_b = projection_bounds(nx, ny, a[0], b[0])
+    hi_a, lo_b = projection_bounds(nx, ny, _extreme(a, dx, dy, 1.0), _extreme(b, dx, dy, -1.0))
     return gap_over_norm(hi_a, lo_b, nx, ny)
 
 

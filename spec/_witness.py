@@ -286,26 +286,18 @@ def check_witness(dr: npt.ArrayLike, start: Sequence[int], goal: Sequence[int],
 
 def _check_labels(free: Layers, start: tuple[int, int], goal: tuple[int, int],
                   result: SearchResult, j1: Array, j2: Array) -> list[Failure]:
+    # One pass over the layers: witness.form at each layer as witness.edge reads it (the
+    # labels are read once, not once per condition); the form's failure, the first layer's,
+    # is still reported before the start's and the edges'.
     N = free.shape[0] - 1
-    none = np.iinfo(j1.dtype).max
-    for s in range(N + 1):
-        a, b = j1[s] == none, j2[s] == none
-        if not np.array_equal(a, b):
-            p, i, j = _first(a != b)
-            return [_fail("form", "a state has a label in one array only",
-                          ("state", _state(s, (i, j), p)), ("j1", int(j1[s, p, i, j])),
-                          ("j2", int(j2[s, p, i, j])), ("no label", int(none)))]
-        big = ~a & ~label_in_range(j1[s], j2[s])
-        if big.any():
-            p, i, j = _first(big)
-            return [_fail("form", "a label is out of range (J1 < 2**30, J2 < 2**31)",
-                          ("state", _state(s, (i, j), p)),
-                          ("label", [int(j1[s, p, i, j]), int(j2[s, p, i, j])]))]
+    form: list[Failure] = []
+    edge = _check_edges(free, j1, j2, form)
+    if form:
+        return form
     at = (0, _WAIT, *start)
     if start_label_breaks(j1[at], j2[at]):
         return [_fail("start", "the start state's label is not (0, 0)",
                       ("state", _state(0, start, _WAIT)), ("label", _label(j1, j2, at)))]
-    edge = _check_edges(free, j1, j2)
     if edge:
         return edge
     path = list(result.path)
@@ -335,14 +327,47 @@ def _keys(j1: Array, j2: Array) -> Array:
     return np.where(j1 == none, _NONE, k)
 
 
-def _check_edges(free: Array, j1: Array, j2: Array) -> list[Failure]:
-    """witness.edge, layer by layer on the box of the labelled free states (plus one cell)."""
+def _form_failures(s: int, j1: Array, j2: Array, a: Array) -> list[Failure]:
+    """witness.form at layer s (``a``: its states without a label in j1): a label in both
+    arrays or in neither, and every label in range (``label_in_range``), judged on the box of
+    the cells that hold a label (outside it there is none to judge); its first failure."""
+    none = np.iinfo(j1.dtype).max
+    b = j2[s] == none
+    if not np.array_equal(a, b):
+        p, i, j = _first(a != b)
+        return [_fail("form", "a state has a label in one array only",
+                      ("state", _state(s, (i, j), p)), ("j1", int(j1[s, p, i, j])),
+                      ("j2", int(j2[s, p, i, j])), ("no label", int(none)))]
+    box = _box(~a.all(axis=0))
+    if box is None:
+        return []
+    r0, r1, c0, c1 = box
+    big = ~a[:, r0:r1, c0:c1] & ~label_in_range(j1[s, :, r0:r1, c0:c1], j2[s, :, r0:r1, c0:c1])
+    if big.any():
+        p, i, j = _first(big)          # the first in (p, i, j) order: the box holds them all
+        i, j = i + r0, j + c0
+        return [_fail("form", "a label is out of range (J1 < 2**30, J2 < 2**31)",
+                      ("state", _state(s, (i, j), p)),
+                      ("label", [int(j1[s, p, i, j]), int(j2[s, p, i, j])]))]
+    return []
+
+
+def _check_edges(free: Array, j1: Array, j2: Array,
+                 form: list[Failure] | None = None) -> list[Failure]:
+    """witness.edge, layer by layer on the box of the labelled free states (plus one cell).
+    With ``form``, witness.form too, each layer as it is read (``_form_failures``): its first
+    failure is put in ``form`` and the edges' check stops there (the form's is reported)."""
     N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
     none = np.iinfo(j1.dtype).max
     first, count = None, 0
     for s in range(N + 1):
         t = min(s + 1, N)
-        src = (j1[s] != none) & free[s]                      # labelled free states (9, m, n)
+        unlabelled = j1[s] == none
+        if form is not None:
+            form += _form_failures(s, j1, j2, unlabelled)
+            if form:
+                return []
+        src = ~unlabelled & free[s]                          # labelled free states (9, m, n)
         box = _box(src.any(axis=0))
         if box is None:
             continue

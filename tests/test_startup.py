@@ -3,14 +3,16 @@
 a certify), a fresh interpreter holds no z3, matplotlib, dask or distributed, and certify no numba,
 python-flint or shapely either. The packages spec, impl, report and runs import their modules on
 first use (PEP 562 ``__getattr__``, cfmpa.lazy); their ``__all__`` and the type checker's imports
-are the same names, each the module's own object. Seeded faults: an eager import planted before the
-check is caught."""
+are the same names, each the module's own object; `cfmpa dr` loads its kernels without numba's
+registries. Seeded faults: an eager import planted before the check is caught, and so is numba's
+own cache load."""
 
 from __future__ import annotations
 
 import ast
 import importlib
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -199,3 +201,38 @@ def test_seeded_faults_an_eager_bag_reader_or_exact_import_is_caught(workdir):
         code, loaded = _command_modules(_argv("dr", workdir), planted)
         assert code == 0 and module in loaded
         assert module in set(NOT_NEEDED) - COMMANDS["dr"][1]
+
+
+#: What `cfmpa dr` no longer loads with its kernels (docs/model.md §7.5): numba's registries
+#: (imported by numba's refresh before a cache load; a load needs only the runtime) and numba's
+#: array implementation (imported by the cache load of a kernel that allocates).
+NUMBA_REGISTRIES = ("numba.cpython.unicode", "numba.typed.typeddict", "numba.np.arrayobj")
+
+
+def _dr_numba_modules(workdir: Path, prelude: str = "") -> tuple[str, set[str]]:
+    """(the `variant` line, NUMBA_REGISTRIES loaded) of `cfmpa dr` run whole in a fresh
+    interpreter with the fast kernels (compiled first if the cache is cold)."""
+    probe = (f"{prelude}\nimport contextlib, io, json, sys\nfrom cfmpa.cli import main\n"
+             "out = io.StringIO()\nwith contextlib.redirect_stdout(out):\n"
+             f"    assert main({_argv('dr', workdir)!r}) == 0\n"
+             "line = next(x for x in out.getvalue().splitlines() if x.startswith('variant'))\n"
+             f"print(json.dumps([line, [m for m in {list(NUMBA_REGISTRIES)!r} "
+             "if m in sys.modules]]))")
+    env = dict(os.environ, CFMPA_KERNEL_COMPILE="wait")
+    proc = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, env=env, capture_output=True,
+                          text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    line, mods = json.loads(proc.stdout.strip().splitlines()[-1])
+    return line, set(mods)
+
+
+def test_dr_loads_its_kernels_without_numbas_registries(workdir):
+    line, loaded = _dr_numba_modules(workdir)
+    assert "(fast kernel)" in line and not loaded, (line, sorted(loaded))
+
+
+def test_seeded_fault_numbas_own_cache_load_is_caught(workdir):
+    # The kernels' cache as numba gives it (no lean loads): the registries come with `dr`.
+    line, loaded = _dr_numba_modules(
+        workdir, "import cfmpa.impl._kernel_cache as k\nk.lean_loads = lambda mod: 0\n")
+    assert "(fast kernel)" in line and set(NUMBA_REGISTRIES) <= loaded

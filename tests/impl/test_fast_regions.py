@@ -15,8 +15,12 @@ from hypothesis import strategies as st
 from cfmpa.impl import build_dr, convex_hull, left_regions, right_regions, swept_region
 from cfmpa.impl._collide import pad_polygons
 from cfmpa.impl._fast_builtdr import build_dr_fast
-from cfmpa.impl._fast_regions import _hulls, convex_hulls, left_regions_fast, right_regions_fast
-from cfmpa.impl._regions import HULL_SCALE_ABOVE
+from cfmpa.impl._fast_regions import (
+    _hull_order,
+    convex_hulls,
+    left_regions_fast,
+    right_regions_fast,
+)
 from cfmpa.spec import Variant, load_scenario, make_grid
 from dr_strategies import random_workcells
 
@@ -53,7 +57,7 @@ def test_hull_twin_on_the_cases_it_hands_back():
         assert same_bytes(got, convex_hull(p))
         # ...by handing each back: the twin itself answers -1 (equality alone would also hold
         # if the twin happened to choose as np.unique did).
-        _, counts = _hulls(np.ascontiguousarray(p), np.array([0, len(p)]), HULL_SCALE_ABOVE)
+        _, counts = _hull_order(np.ascontiguousarray(p), np.array([0, len(p)]))
         assert counts[0] == -1, p.tolist()
     line = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0], [3.0, 3.0]])      # the twin's own case
     assert same_bytes(convex_hulls([line])[0], convex_hull(line))

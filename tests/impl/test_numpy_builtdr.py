@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import factory
+import mutant_module
 from cfmpa.impl import _numpy_builtdr, build_dr, right_regions
 from cfmpa.impl._builtdr import RightRegions
 from cfmpa.impl._numpy_builtdr import build_dr_numpy
@@ -147,3 +149,30 @@ def test_absurd_magnitudes_past_the_loader_block_every_cell(field, value):
     s = dataclasses.replace(s0, left=dataclasses.replace(s0.left, **{field: value}))
     for variant in (Variant.ORIGINAL, Variant.TIGHT):
         assert assert_same(s, variant).all()
+
+
+#: One-line faults planted in a copy of the kernel: each must make the coarse default differ.
+MUTANTS = {
+    # the gap along a's normals skips b's second vertex
+    "a-normals-vertex-off-by-one": [("for v in range(1, len(x)):", "for v in range(2, len(x)):")],
+    # the gap along b's normals skips a's second vertex
+    "b-normals-vertex-off-by-one": [("for v in range(1, len(av)):",
+                                     "for v in range(2, len(av)):")],
+    # the boxes' upper x bound taken as the lower one
+    "box-wrong-bound": [("self.x.max(1), self.y.max(1))", "self.x.min(1), self.y.max(1))")],
+}
+
+
+@pytest.mark.parametrize("name", sorted(MUTANTS))
+def test_seeded_fault_in_a_copy_is_caught(monkeypatch, name):
+    mod = mutant_module.mutated_module(name, "impl/_numpy_builtdr.py", MUTANTS[name],
+                                       lambda k, v: monkeypatch.setitem(sys.modules, k, v))
+    s = factory.scenario(dt=0.08, right__start_cell=[10, 25], right__goal_cell=[38, 15])
+    g = make_grid(s)
+    rr = right_regions(s, g)
+    diff = 0
+    for variant in (Variant.ORIGINAL, Variant.MODIFIED):
+        ref = build_dr(s, variant, g, right=rr)
+        assert np.array_equal(build_dr_numpy(s, variant, g, right=rr), ref)   # the original
+        diff += int((mod.build_dr_numpy(s, variant, g, right=rr) != ref).sum())
+    assert diff > 0, f"mutant {name} not caught"

@@ -87,12 +87,17 @@ def test_replay_reports_new_same_changed_and_writes_atomically(tmp_path: Path):
     text = (tmp_path / "Def1.segment.smt2").read_text()
     assert entry["sha256"] == hashlib.sha256(text.encode()).hexdigest()
 
-    # The saved SMT-LIB replays to the same answers, check by check.
-    for o in doc1["obligations"]:
-        if o["method"] == "z3":
-            ctx = z3.Context()
-            out = z3.Z3_eval_smtlib2_string(ctx.ref(), (tmp_path / o["file"]).read_text())
-            assert out.split() == [a for v in o["vcs"] for a in (v["vacuity"], v["answer"])]
+    # The saved SMT-LIB replays to the same answers, check by check. Its `set-option`s
+    # (:rlimit, :timeout) set Z3's global parameters for the whole process, as a script's
+    # options do: put back afterwards, or every later solver in this process inherits them.
+    try:
+        for o in doc1["obligations"]:
+            if o["method"] == "z3":
+                ctx = z3.Context()
+                out = z3.Z3_eval_smtlib2_string(ctx.ref(), (tmp_path / o["file"]).read_text())
+                assert out.split() == [a for v in o["vcs"] for a in (v["vacuity"], v["answer"])]
+    finally:
+        z3.reset_params()
 
     second = run_obligations(obs, tmp_path, exp)
     assert set(second.changes.values()) == {"same"}
