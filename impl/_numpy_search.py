@@ -5,9 +5,10 @@ The "numpy" kernel's search (``_kernels``): a run uses it while the fast kernels
 in the background. Same answer as ``search_opt_path`` (status, reason, J1, J2, the path with
 its tie-break) and, with ``with_witness`` (the default here: a run under full contracts then
 verifies that witness instead of asking the fast search for one, which would compile it in the
-foreground), the same witness arrays. The input checks, the size check, the back-pointers, the
-labels and the walk back (``_prepare``, ``BackPointers``, ``WitnessLabels``, ``_unwind``,
-``hold_waits``) are the reference's own. What differs is how the labels are computed:
+foreground), the same witness arrays. The driver (``search_by_phases``: the input and size
+checks, the walk back, the witness), the back-pointers and the labels (``BackPointers``,
+``WitnessLabels``, ``hold_waits``) are the reference's own; this module gives the driver its two
+phases. What differs is how the labels are computed:
 
 - DAG steps 1..N: the reference's ``_step`` arithmetic (the same ``_min_plus_gap``, the same
   int64 sums clamped to INF) on the box of cells within s - 1 moves of the start only, shifted
@@ -25,12 +26,10 @@ labels and the walk back (``_prepare``, ``BackPointers``, ``WitnessLabels``, ``_
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import numpy.typing as npt
 
-from ..spec import MOVES, REASON_UNREACHABLE, Cell, SearchResult
+from ..spec import MOVES, Cell, SearchResult
 from ._search import (
     INF,
     J2_MASK,
@@ -40,10 +39,9 @@ from ._search import (
     FreeLayers,
     WitnessLabels,
     _min_plus_gap,
-    _prepare,
     _targets,
-    _unwind,
     hold_waits,
+    search_by_phases,
 )
 
 __all__ = ["search_opt_path_numpy"]
@@ -68,22 +66,7 @@ def search_opt_path_numpy(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, 
     (least (J1, J2), its path, or why none; the same witness); ``progress`` is accepted for the
     fast search's signature and ignored."""
     del progress
-    setup, early = _prepare(dr, start, goal, with_witness)
-    if early is not None:
-        return early
-    N, m, n, start, goal, free, reason, labels = setup
-    keys, dag_pred = _dag_phase(free, start, labels)
-    with dag_pred:                  # its temporary file closed once the path is walked back
-        found = _static_phase(free[N], keys, goal, labels)
-        if found is None:
-            result = SearchResult.no_path(reason or REASON_UNREACHABLE)
-        else:
-            key, last, static_pred, static_from = found
-            path = _unwind(goal, last, start, static_pred, static_from, dag_pred)
-            result = SearchResult.found(path, key >> SHIFT, key & J2_MASK)
-    if labels is None:
-        return result
-    return replace(result, witness=labels.witness(found=found is not None))
+    return search_by_phases(dr, start, goal, with_witness, _dag_phase, _static_phase)
 
 
 def _dag_phase(free: FreeLayers, start: Cell, labels: WitnessLabels | None = None

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Callable
 from dataclasses import replace
 from typing import IO, Any
 
@@ -99,13 +100,24 @@ def search_opt_path(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, *,
     otherwise), and a wait at step N gets the label of the state it holds plus |p|_1 (waits
     are left out of the search, being never better). The path and costs are the same either way.
     """
+    return search_by_phases(dr, start, goal, with_witness, _dag_phase, _static_phase)
+
+
+def search_by_phases(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness: bool,
+                     dag_phase: Callable[[FreeLayers, Cell, WitnessLabels | None],
+                                         tuple[IntArray, BackPointers]],
+                     static_phase: Callable[..., Any]) -> SearchResult:
+    """searchoptpath's driver: the early exits (``_prepare``), ``dag_phase`` (steps 0..N, its
+    keys and back-pointers), ``static_phase`` (the capped step), the walk back and the witness.
+    The reference passes its own phases; the numpy kernel (``_numpy_search``) passes faster
+    ones with the same results, and so shares everything else."""
     setup, early = _prepare(dr, start, goal, with_witness)
     if early is not None:
         return early
     N, m, n, start, goal, free, reason, labels = setup
-    keys, dag_pred = _dag_phase(free, start, labels)
+    keys, dag_pred = dag_phase(free, start, labels)
     with dag_pred:                  # its temporary file closed once the path is walked back
-        found = _static_phase(free[N], keys, goal, labels)
+        found = static_phase(free[N], keys, goal, labels)
         if found is None:
             result = SearchResult.no_path(reason or REASON_UNREACHABLE)
         else:

@@ -214,6 +214,62 @@ def _point2(b: Vec, l1: z3.ArithRef, alpha: z3.ArithRef, phi: z3.ArithRef, u: z3
     return _point2_cs(b, l1, e(alpha), e(phi), u, v)
 
 
+@dataclass(frozen=True)
+class BoxPoints:
+    """A box of both joints' angles, the lattice cell snapped from it, and the named points of
+    link 2's frame point (u, v) that link 2's and the tool's region lemmas chain through: X0 at
+    theta, X1 after snapping theta1, X2 after snapping theta2, the chord's ends A, B and the
+    cell's corners K0..K3 (``at``: name, alpha, phi, where; ``pts``: each name's vector)."""
+
+    joint1: tuple[z3.ArithRef, ...]        # lo1, hi1, theta1, A1, g1
+    joint2: tuple[z3.ArithRef, ...]        # lo2, hi2, theta2, A2, g2
+    L1: Lattice
+    L2: Lattice
+    alphas: tuple[z3.ArithRef, ...]
+    phis: tuple[z3.ArithRef, ...]
+    at: tuple[tuple[str, z3.ArithRef, z3.ArithRef, str], ...]
+    pts: dict[str, Vec]
+
+    @property
+    def named(self) -> tuple[Vec, ...]:
+        """X0, X1, X2, A, B."""
+        return tuple(self.pts[n] for n in ("X0", "X1", "X2", "A", "B"))
+
+    @property
+    def corners(self) -> list[Vec]:
+        return [self.pts[f"K{i}"] for i in range(4)]
+
+    def lattice_hyps(self, k: dict[str, Lemma]) -> list[Hyp]:
+        """Both lattices' definitions and the lattice lemma at each joint."""
+        (lo1, hi1, th1, A1, g1), (lo2, hi2, th2, A2, g2) = self.joint1, self.joint2
+        return [*self.L1.defs, *self.L2.defs,
+                *k["lattice"].at("joint 1", lo=lo1, hi=hi1, theta=th1, A=A1, g=g1,
+                                 **self.L1.names()),
+                *k["lattice"].at("joint 2", lo=lo2, hi=hi2, theta=th2, A=A2, g=g2,
+                                 **self.L2.names())]
+
+
+def box_points(prefix: str) -> BoxPoints:
+    """The box's angles and lattices under ``prefix`` (``prefix.theta1``, ``prefix.joint1``...),
+    and the names of link 2's points at them (docs/model.md §4)."""
+    joint1 = tuple(z3.Reals(f"{prefix}.lo1 {prefix}.hi1 {prefix}.theta1 {prefix}.A1 {prefix}.g1"))
+    joint2 = tuple(z3.Reals(f"{prefix}.lo2 {prefix}.hi2 {prefix}.theta2 {prefix}.A2 {prefix}.g2"))
+    L1 = lattice(f"{prefix}.joint1", *joint1)
+    L2 = lattice(f"{prefix}.joint2", *joint2)
+    th1, th2 = joint1[2], joint2[2]
+    t1c, t2c = L1.theta_c, L2.theta_c
+    c1, G1, c2, G2 = L1.c, L1.G, L2.c, L2.G
+    c1e = c1 + G1
+    alphas = (c1, c1, c1e, c1e)
+    phis = (c1 + c2, (c1 + c2) + G2, c1e + c2, (c1e + c2) + G2)
+    at = [("X0", th1, th1 + th2, "theta"), ("X1", t1c, t1c + th2, "(theta1', theta2)"),
+          ("X2", t1c, t1c + t2c, "theta'"), ("A", c1, c1 + t2c, "(c1, theta2')"),
+          ("B", c1e, c1e + t2c, "(c1 + G1, theta2')")]
+    at += [(f"K{i}", a, ph, f"corner {i}") for i, (a, ph) in enumerate(zip(alphas, phis))]
+    pts = {n: _v(f"{prefix}.{n}") for n, *_ in at}
+    return BoxPoints(joint1, joint2, L1, L2, alphas, phis, tuple(at), pts)
+
+
 def grown_coords(phi: z3.ArithRef, u: z3.ArithRef, v: z3.ArithRef, d: Vec) -> Vec:
     """The frame coordinates (at angle phi) of the frame point (u, v) moved by d."""
     c, s = e(phi)
@@ -882,28 +938,17 @@ def _link2(kit: Kit) -> Lemma:
     b = _v("lk2.b")
     l1, l2, r, re, u, v, r1, r2, dl = z3.Reals("lk2.l1 lk2.l2 lk2.r lk2.Re lk2.u lk2.v lk2.r1 "
                                                "lk2.r2 lk2.Delta")
-    lo1, hi1, th1, A1, g1 = z3.Reals("lk2.lo1 lk2.hi1 lk2.theta1 lk2.A1 lk2.g1")
-    lo2, hi2, th2, A2, g2 = z3.Reals("lk2.lo2 lk2.hi2 lk2.theta2 lk2.A2 lk2.g2")
     rb = l1 + re
-    L1 = lattice("lk2.joint1", lo1, hi1, th1, A1, g1)
-    L2 = lattice("lk2.joint2", lo2, hi2, th2, A2, g2)
-    t1c, t2c = L1.theta_c, L2.theta_c
-    c1, G1, c2, G2 = L1.c, L1.G, L2.c, L2.G
+    box = box_points("lk2")
+    (lo1, hi1, th1, A1, g1), (lo2, hi2, th2, A2, g2) = box.joint1, box.joint2
+    L1, L2, alphas, phis, at, pts = box.L1, box.L2, box.alphas, box.phis, box.at, box.pts
+    t2c, c1, G1, c2, G2 = L2.theta_c, L1.c, L1.G, L2.c, L2.G
     c1e = c1 + G1
+    X0, X1, X2, A, B = box.named
+    Ks = box.corners
 
     def P(alpha: z3.ArithRef, phi: z3.ArithRef) -> Vec:
         return _point2(b, l1, alpha, phi, u, v)
-    alphas = (c1, c1, c1e, c1e)
-    phis = (c1 + c2, (c1 + c2) + G2, c1e + c2, (c1e + c2) + G2)
-    # The points, named by their definitions: the link's point at theta, after snapping theta1
-    # (X1) and theta2 (X2), the chord's ends A, B about the base, the cell's corners K.
-    at = [("X0", th1, th1 + th2, "theta"), ("X1", t1c, t1c + th2, "(theta1', theta2)"),
-          ("X2", t1c, t1c + t2c, "theta'"), ("A", c1, c1 + t2c, "(c1, theta2')"),
-          ("B", c1e, c1e + t2c, "(c1 + G1, theta2')")]
-    at += [(f"K{i}", a, ph, f"corner {i}") for i, (a, ph) in enumerate(zip(alphas, phis))]
-    pts = {n: _v(f"lk2.{n}") for n, *_ in at}
-    X0, X1, X2, A, B = (pts[n] for n in ("X0", "X1", "X2", "A", "B"))
-    Ks = [pts[f"K{i}"] for i in range(4)]
     key = "Delta = impl.sweep_margin(arm, link 2, g, moving), read"
     moving = (L1.moving, L2.moving)
     hyps: list[Hyp] = [
@@ -918,9 +963,7 @@ def _link2(kit: Kit) -> Lemma:
     ]
     hyps += [(f"{n} = the point (u, v) of link 2 at {where} (named)", _veq(pts[n], P(a, ph)))
              for n, a, ph, where in at]
-    hyps += L1.defs + L2.defs
-    hyps += k["lattice"].at("joint 1", lo=lo1, hi=hi1, theta=th1, A=A1, g=g1, **L1.names())
-    hyps += k["lattice"].at("joint 2", lo=lo2, hi=hi2, theta=th2, A=A2, g=g2, **L2.names())
+    hyps += box.lattice_hyps(k)
     hyps += k["margin_covers_link2"].at("the box's lattice", g1=g1, g2=g2, Rb=rb, Re=re, Delta=dl,
                                         moving1=L1.moving, moving2=L2.moving, G1=G1, G2=G2)
     for beta, where in ((th2, "theta2"), (t2c, "theta2'")):

@@ -51,8 +51,8 @@ from ._obl_safety_region import (
     _snapped_to_corners,
     _weighted,
     _wvec,
+    box_points,
     grown_coords,
-    lattice,
     margin_parts,
     region_kit,
 )
@@ -755,26 +755,17 @@ def _grown_in_region(kit: Kit, k: dict[str, Lemma], reading: ToolReading) -> Lem
     P = ToolPoint.named(reading, "tir")
     u, v = P.u, P.v
     re, r1, r2, dl = z3.Reals("tir.Re tir.r1 tir.r2 tir.Delta")
-    lo1, hi1, th1, A1, g1 = z3.Reals("tir.lo1 tir.hi1 tir.theta1 tir.A1 tir.g1")
-    lo2, hi2, th2, A2, g2 = z3.Reals("tir.lo2 tir.hi2 tir.theta2 tir.A2 tir.g2")
     rb = l1 + re
-    L1 = lattice("tir.joint1", lo1, hi1, th1, A1, g1)
-    L2 = lattice("tir.joint2", lo2, hi2, th2, A2, g2)
-    t1c, t2c = L1.theta_c, L2.theta_c
-    c1, G1, c2, G2 = L1.c, L1.G, L2.c, L2.G
+    box = box_points("tir")
+    (lo1, hi1, th1, A1, g1), (lo2, hi2, th2, A2, g2) = box.joint1, box.joint2
+    L1, L2, alphas, phis, at, pts = box.L1, box.L2, box.alphas, box.phis, box.at, box.pts
+    t2c, c1, G1, c2, G2 = L2.theta_c, L1.c, L1.G, L2.c, L2.G
     c1e = c1 + G1
+    X0, X1, X2, A, B = box.named
+    Ks = box.corners
 
     def Pt(alpha: z3.ArithRef, phi: z3.ArithRef) -> Vec:
         return _point2(b, l1, alpha, phi, u, v)
-    alphas = (c1, c1, c1e, c1e)
-    phis = (c1 + c2, (c1 + c2) + G2, c1e + c2, (c1e + c2) + G2)
-    at = [("X0", th1, th1 + th2, "theta"), ("X1", t1c, t1c + th2, "(theta1', theta2)"),
-          ("X2", t1c, t1c + t2c, "theta'"), ("A", c1, c1 + t2c, "(c1, theta2')"),
-          ("B", c1e, c1e + t2c, "(c1 + G1, theta2')")]
-    at += [(f"K{i}", a, ph, f"corner {i}") for i, (a, ph) in enumerate(zip(alphas, phis))]
-    pts = {n: _v(f"tir.{n}") for n, *_ in at}
-    X0, X1, X2, A, B = (pts[n] for n in ("X0", "X1", "X2", "A", "B"))
-    Ks = [pts[f"K{i}"] for i in range(4)]
     key = "Delta = impl.sweep_margin(arm, tool, g, moving), read on terms"
     moving = (L1.moving, L2.moving)
     mct = k["margin_covers_tool"]
@@ -788,9 +779,7 @@ def _grown_in_region(kit: Kit, k: dict[str, Lemma], reading: ToolReading) -> Lem
     ]
     hyps += [(f"{n} = the tool's point (u, v) at {where} (named)", _veq(pts[n], Pt(a, ph)))
              for n, a, ph, where in at]
-    hyps += L1.defs + L2.defs
-    hyps += k["lattice"].at("joint 1", lo=lo1, hi=hi1, theta=th1, A=A1, g=g1, **L1.names())
-    hyps += k["lattice"].at("joint 2", lo=lo2, hi=hi2, theta=th2, A=A2, g=g2, **L2.names())
+    hyps += box.lattice_hyps(k)
     hyps += mct.at("the box's lattice", g1=g1, g2=g2, Re=re, Delta=dl, moving1=L1.moving,
                    moving2=L2.moving, G1=G1, G2=G2)
     # (Where link2_in_region has reach_link2's instances.)
