@@ -313,18 +313,34 @@ def _composition(variant: str) -> Any:
     return composition_vc(variant)
 
 
+@functools.cache
+def _composition_text(variant: str) -> Any:
+    """Z3's text of the composition's hypotheses, its negated goal and its one-cell pins,
+    printed once a process (``_z3text.Printed``): each control's two checks are cut from it."""
+    from ._z3text import Printed
+
+    vc = _composition(variant)
+    return Printed([h for _, h in vc.hypotheses] + [z3.Not(vc.goal)]
+                   + [c == v for c, v in vc.counter_witness])
+
+
 def _without(variant: str, index: int) -> tuple[str, str]:
     from ._obligation import _solver, _why_unknown
 
     vc = _composition(variant)
+    printed = _composition_text(variant)
+    n = len(vc.hypotheses)
     rest = [h for i, (_, h) in enumerate(vc.hypotheses) if i != index]
+    kept = [i for i in range(n) if i != index] + [n]        # the other hypotheses, the goal
     answers = []
     for label, pins, ms, rlimit in (
             ("with the one-cell pins", vc.counter_witness, PREMISE_PINNED_MS,
              PREMISE_PINNED_RLIMIT),
             ("without pins", (), PREMISE_FREE_MS, PREMISE_FREE_RLIMIT)):
+        # The same text as printing these formulas, byte for byte (Z3's search depends on it).
+        text = printed.text(kept + [n + 1 + k for k in range(len(pins))])
         s = _solver(ms, formulas=rest + [z3.Not(vc.goal)] + [c == v for c, v in pins],
-                    rlimit=rlimit)
+                    text=text, rlimit=rlimit)
         r = s.check()
         if r == z3.sat:
             return "refuted", f"a counter-model {label}"

@@ -8,16 +8,20 @@ answer is cvc5's: ``unsat``, ``sat`` or ``unknown`` with its explanation (``time
 cvc5 not installed, a parse error). Only ``unsat`` confirms a proof (``sat`` a refutation); an
 answer contradicting Z3's is a disagreement, which the caller makes a FAILED verdict.
 ``Cvc5Pool`` runs the queries in the background (one worker, fed by a thread), so cvc5 works
-on the other core while the prove run goes on with Z3.
+on the other core while the prove run goes on with Z3, and runs a text it was given before only
+once (two obligations can state the same VC).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import json
 import os
 import select
 import subprocess
 import sys
+import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
@@ -38,7 +42,7 @@ _START_S = 2.0
 class Cvc5Answer:
     answer: str          # unsat | sat | unknown
     reason: str = ""     # cvc5's explanation of unknown, or why it did not run
-    seconds: float = 0.0
+    seconds: float = 0.0  # the worker's time on it; 0.0 for an answer shared with an earlier query
 
 
 def cvc5_version() -> str | None:
@@ -112,17 +116,52 @@ class Cvc5Worker:
 
 class Cvc5Pool:
     """cvc5 in the background: ``submit`` queues a query for one worker (a thread waiting on
-    the worker process), so cvc5 runs on while the caller goes on with Z3."""
+    the worker process), so cvc5 runs on while the caller goes on with Z3.
+
+    A text submitted again with the same limit, in the pool's life, is not run again: it gets
+    the first submission's answer, with ``seconds`` 0.0 (the time was spent once, on the
+    first). The answer is the same by construction: the same text, under the same options
+    (``_serve`` sets nothing else) and the same limit, is the same query (the rule that lets a
+    run take an undecided statement's answer from the lock, docs/model.md §6.4). That includes
+    an ``unknown`` because the worker was killed or died: the second gets it too."""
 
     def __init__(self, timeout_ms: int = CVC5_TIMEOUT_MS) -> None:
         self.timeout_ms = timeout_ms
         self._worker = Cvc5Worker()
         self._ex = ThreadPoolExecutor(max_workers=1, thread_name_prefix="cvc5")
+        self._asked: dict[tuple[str, int], Future[Cvc5Answer]] = {}
+        self._lock = threading.Lock()     # so that submit is safe from any thread
+
+    @staticmethod
+    def _key(text: str, timeout_ms: int) -> tuple[str, int]:
+        # The digest, not the text: a pool's life can see every VC of a prove run.
+        return hashlib.sha256(text.encode()).hexdigest(), timeout_ms
 
     def submit(self, text: str, timeout_ms: int | None = None) -> Future[Cvc5Answer]:
-        """Queue ``text``; ``timeout_ms`` (default the pool's) is cvc5's limit on it."""
-        return self._ex.submit(self._worker.check, text,
-                               self.timeout_ms if timeout_ms is None else timeout_ms)
+        """Queue ``text``; ``timeout_ms`` (default the pool's) is cvc5's limit on it. A text
+        and limit queued before are not run again (see the class): the Future gets the first
+        one's answer with ``seconds`` 0.0."""
+        ms = self.timeout_ms if timeout_ms is None else timeout_ms
+        key = self._key(text, ms)
+        with self._lock:
+            first = self._asked.get(key)
+            if first is None:
+                fut = self._ex.submit(self._worker.check, text, ms)
+                self._asked[key] = fut
+                return fut
+        # A Future of its own, so that the time spent counts once in the caller's sums.
+        again: Future[Cvc5Answer] = Future()
+
+        def share(done: Future[Cvc5Answer]) -> None:
+            try:
+                a = done.result()
+            except BaseException as exc:  # noqa: BLE001 - passed on to the waiter as it is
+                again.set_exception(exc)
+                return
+            again.set_result(dataclasses.replace(a, seconds=0.0))
+
+        first.add_done_callback(share)
+        return again
 
     def close(self) -> None:
         self._ex.shutdown(wait=True)

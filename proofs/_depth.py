@@ -32,9 +32,26 @@ from __future__ import annotations
 
 import z3
 
-from ._smtlib import Mode, NotStandard, smtlib_query
+from ._smtlib import (
+    Mode,
+    NotStandard,
+    _app_arg,
+    _app_decl,
+    _app_num_args,
+    _ast_id,
+    _ast_kind,
+    _decl_kind,
+    _get_sort,
+    _is_algebraic,
+    _is_numeral_ast,
+    _ptr,
+    _quantifier_body,
+    _sort_kind,
+    smtlib_query,
+)
 
-__all__ = ["DEPTH_RLIMIT", "DEPTH_TIMEOUT_MS", "LEVELS", "deepest", "is_nonlinear", "vc_depth"]
+__all__ = ["DEPTH_RLIMIT", "DEPTH_TIMEOUT_MS", "LEVELS", "NonlinearMemo", "deepest", "is_nonlinear",
+           "vc_depth"]
 
 #: Per abstraction check; the abstractions are small, or they fail fast.
 DEPTH_TIMEOUT_MS = 3_000
@@ -88,46 +105,113 @@ def deepest(levels: list[str]) -> str | None:
     return max(levels, key=LEVELS.index) if levels else None
 
 
-_NONLINEAR_OPS = (z3.Z3_OP_MUL, z3.Z3_OP_DIV, z3.Z3_OP_IDIV, z3.Z3_OP_MOD, z3.Z3_OP_REM,
-                  z3.Z3_OP_POWER)
+_NONLINEAR_OPS = frozenset((z3.Z3_OP_MUL, z3.Z3_OP_DIV, z3.Z3_OP_IDIV, z3.Z3_OP_MOD,
+                            z3.Z3_OP_REM, z3.Z3_OP_POWER))
+_CONSTANT_OPS = frozenset((z3.Z3_OP_UMINUS, z3.Z3_OP_MUL, z3.Z3_OP_ADD, z3.Z3_OP_SUB,
+                           z3.Z3_OP_DIV, z3.Z3_OP_TO_REAL))
 
 
-def _constant_value(e: z3.ExprRef) -> bool:
-    """A numeral, or arithmetic of numerals only (e.g. -(1/2), 3 * 7)."""
-    if z3.is_rational_value(e) or z3.is_int_value(e) or z3.is_algebraic_value(e):
-        return True
-    if z3.is_app(e) and e.num_args() > 0 and e.decl().kind() in (
-            z3.Z3_OP_UMINUS, z3.Z3_OP_MUL, z3.Z3_OP_ADD, z3.Z3_OP_SUB, z3.Z3_OP_DIV,
-            z3.Z3_OP_TO_REAL):
-        return all(_constant_value(c) for c in e.children())
-    return False
+class NonlinearMemo:
+    """What ``is_nonlinear`` found of formulas already scanned, for later calls: VCs of one
+    obligation share most hypotheses, each then scanned once. It holds the formulas it knows
+    (so their AST ids, its keys, name them for its life), in any number of contexts. The
+    flag (docs/model.md §6.4) is the same with a memo or without."""
+
+    __slots__ = ("_known",)
+
+    def __init__(self) -> None:
+        self._known: dict[tuple[int, int], tuple[z3.ExprRef, bool]] = {}
+
+    def __len__(self) -> int:
+        return len(self._known)
 
 
-def is_nonlinear(formulas: list[z3.ExprRef]) -> bool:
+class _Scan:
+    """One call's scan: a DAG walk over the C API (``_smtlib``'s direct calls), every AST
+    visited once (keyed by its pointer: all are reachable from formulas the caller holds)."""
+
+    def __init__(self, ctx: z3.Context) -> None:
+        self.c = _ptr(ctx.ref())
+        self.seen: set[int] = set()
+        self.constant: dict[int, bool] = {}
+
+    def _constant_value(self, a: int) -> bool:
+        """A numeral, or arithmetic of numerals only (e.g. -(1/2), 3 * 7)."""
+        out = self.constant.get(a)
+        if out is None:
+            out = self.constant[a] = self._constant(a)
+        return out
+
+    def _constant(self, a: int) -> bool:
+        c = self.c
+        kind = _ast_kind(c, a)
+        if kind not in (z3.Z3_APP_AST, z3.Z3_NUMERAL_AST):
+            return False
+        sk = _sort_kind(c, _get_sort(c, a))
+        # z3.is_int_value / is_rational_value / is_algebraic_value: an Int or Real numeral,
+        # or a Real algebraic number.
+        if (sk == z3.Z3_INT_SORT or sk == z3.Z3_REAL_SORT) and (
+                _is_numeral_ast(c, a) or (sk == z3.Z3_REAL_SORT and _is_algebraic(c, a))):
+            return True
+        n = _app_num_args(c, a)
+        if n > 0 and _decl_kind(c, _app_decl(c, a)) in _CONSTANT_OPS:
+            return all(self._constant_value(_app_arg(c, a, i)) for i in range(n))
+        return False
+
+    def nonlinear(self, root: int) -> bool:
+        """Whether the term ``root`` holds nonlinear arithmetic, skipping the subterms an
+        earlier root of this scan reached (each was found linear, or the scan would have
+        stopped)."""
+        c = self.c
+        seen = self.seen
+        todo = [root]
+        while todo:
+            a = todo.pop()
+            if a in seen:
+                continue
+            seen.add(a)
+            kind = _ast_kind(c, a)
+            if kind == z3.Z3_QUANTIFIER_AST:
+                todo.append(_quantifier_body(c, a))
+                continue
+            if kind != z3.Z3_APP_AST and kind != z3.Z3_NUMERAL_AST:
+                continue
+            n = _app_num_args(c, a)
+            args = [_app_arg(c, a, i) for i in range(n)]
+            if n >= 2:
+                op = _decl_kind(c, _app_decl(c, a))
+                if op in _NONLINEAR_OPS and (
+                        sum(not self._constant_value(x) for x in args) >= 2
+                        if op == z3.Z3_OP_MUL else not self._constant_value(args[1])):
+                    return True
+            todo.extend(args)
+        return False
+
+
+def _formula_key(f: z3.ExprRef) -> tuple[int, int]:
+    # AST ids are per context: two contexts number their terms alike.
+    c = _ptr(f.ctx.ref())
+    return c, _ast_id(c, _ptr(f.as_ast()))
+
+
+def is_nonlinear(formulas: list[z3.ExprRef], memo: NonlinearMemo | None = None) -> bool:
     """Whether the formulas hold nonlinear arithmetic: a product of two non-constant terms, or a
     division, modulus or power whose divisor or exponent is not a numeral (quantifier bodies
     included). This is not what ``depth`` measures (quantifier instantiation): a VC can be
-    ground and nonlinear, or full and linear."""
-    seen: set[int] = set()
-    todo = list(formulas)
-    while todo:
-        e = todo.pop()
-        key = e.get_id()
-        if key in seen:
-            continue
-        seen.add(key)
-        if z3.is_quantifier(e):
-            todo.append(e.body())
-            continue
-        if not z3.is_app(e):
-            continue
-        kind = e.decl().kind()
-        if kind in _NONLINEAR_OPS and e.num_args() >= 2:
-            args = e.children()
-            if kind == z3.Z3_OP_MUL:
-                if sum(not _constant_value(a) for a in args) >= 2:
-                    return True
-            elif not _constant_value(args[1]):
-                return True
-        todo.extend(e.children())
+    ground and nonlinear, or full and linear. ``memo`` (one per obligation, say) keeps each
+    formula's answer for later calls; the answer is the same with it or without."""
+    scans: dict[int, _Scan] = {}
+    for f in formulas:
+        key = _formula_key(f)
+        if memo is not None and key in memo._known:
+            answer = memo._known[key][1]
+        else:
+            scan = scans.get(key[0])
+            if scan is None:
+                scan = scans[key[0]] = _Scan(f.ctx)
+            answer = scan.nonlinear(_ptr(f.as_ast()))
+            if memo is not None:
+                memo._known[key] = (f, answer)
+        if answer:
+            return True
     return False

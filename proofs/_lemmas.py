@@ -20,7 +20,8 @@ import z3
 from ._obligation import VC, Obligation, Z3Query
 from ._z3vec import Hyp, concrete
 
-__all__ = ["CARRIED", "PROVED", "Lemma", "Pairs", "dedupe", "lemma", "obligation_vc", "pairs"]
+__all__ = ["CARRIED", "PROVED", "Lemma", "Pairs", "Substitution", "dedupe", "lemma",
+           "obligation_vc", "pairs"]
 
 #: A lemma's trigonometric facts (A3, assumed at any point): a proof that uses the lemma carries
 #: them, substituted, into its own hypotheses. Its instances of other proved lemmas ("by ...")
@@ -30,6 +31,38 @@ CARRIED = ("A3 ",)
 PROVED = "by "
 
 Pairs = Sequence[tuple[z3.ExprRef, z3.ExprRef]]
+
+
+class Substitution:
+    """``z3.substitute(f, *pairs)`` for many terms f at the same pairs: the same Z3 call
+    (``Z3_substitute``, simultaneous), so the same term, but the pairs are checked (expressions of
+    equal sorts, as z3.substitute checks them) and laid out once, not at every call, where
+    z3.substitute's per-call check of the sorts dominated the cost of a proof's many
+    substitutions at a lemma's hundreds of names."""
+
+    def __init__(self, pairs: Pairs) -> None:
+        self.pairs = tuple(pairs)        # held: the arrays below point into these terms
+        for p in self.pairs:
+            if not (isinstance(p, tuple) and len(p) == 2 and z3.is_expr(p[0])
+                    and z3.is_expr(p[1])):
+                raise TypeError(f"a substitution pair is two Z3 expressions, not {p!r}")
+            # Sorts are hash-consed: equal iff the same Z3 object (z3's SortRef.eq), compared
+            # without wrapping each in a SortRef.
+            ctx = p[0].ctx_ref()
+            if (z3.Z3_get_sort(ctx, p[0].as_ast()).value
+                    != z3.Z3_get_sort(ctx, p[1].as_ast()).value):
+                raise TypeError(f"substitution of {p[0]} ({p[0].sort()}) by {p[1]} "
+                                f"({p[1].sort()}): the sorts differ")
+        n = len(self.pairs)
+        self._from = (z3.Ast * n)(*[a.as_ast() for a, _ in self.pairs])
+        self._to = (z3.Ast * n)(*[b.as_ast() for _, b in self.pairs])
+
+    def __call__(self, f: Any) -> Any:
+        if not z3.is_expr(f):
+            raise TypeError(f"substitution in {f!r}, not a Z3 expression")
+        # z3.substitute's own last line, the pairs' arrays built above.
+        return z3.z3._to_expr_ref(z3.Z3_substitute(f.ctx.ref(), f.as_ast(), len(self.pairs),
+                                                   self._from, self._to), f.ctx)
 
 
 @dataclass(frozen=True)
@@ -49,8 +82,10 @@ class Lemma:
         Sound: the lemma's VC is proved with those facts and its instances of proved lemmas
         as hypotheses, and the instances hold where the norms are |v|^2 (for an abstract
         lemma) or are none (for a concrete one)."""
+        at_pairs = Substitution(pairs)
+
         def sub(f: Any) -> Any:
-            return z3.substitute(f, *pairs) if pairs else f
+            return at_pairs(f) if pairs else f
         carried = [(n, h) for n, h in self.hyps if n.startswith(CARRIED)]
         rest = [h for n, h in self.hyps if not n.startswith(CARRIED + (PROVED,))]
         out = [(f"{n} [{at}]", sub(h)) for n, h in carried]
@@ -89,12 +124,16 @@ def lemma(name: str, hyps: Sequence[Hyp], goal: z3.BoolRef, key: str, *, abstrac
 
 
 def dedupe(hyps: Sequence[Hyp]) -> tuple[Hyp, ...]:
+    """``hyps`` without the repeats of a formula (the first kept), names' spaces normalised."""
     out: list[Hyp] = []
-    seen: list[z3.BoolRef] = []
+    # z3.eq is identity of the hash-consed terms of one context: their (context, id) while they
+    # are alive (``out`` holds them), looked up in a set rather than compared pairwise.
+    seen: set[tuple[int, int]] = set()
     for n, h in hyps:
-        if any(z3.eq(h, s) for s in seen):
+        key = (id(h.ctx), h.get_id())
+        if key in seen:
             continue
-        seen.append(h)
+        seen.add(key)
         out.append((" ".join(n.split()), h))
     return tuple(out)
 

@@ -182,11 +182,17 @@ def _points_vc(tool_points: Any) -> VC:
     env = {str(v): rnd.uniform(0.1, 1.0) for v in (*T.arm.base, *T.arm.links, T.t1, T.t2, T.grow,
                                                   *[c for q in T.verts for c in q])}
     goal = []
+    at_g: list[tuple[float, float]] | None = None
     for u, v in T.frame:
         want = T.at(u, v)
         m = (_value(want[0], env), _value(want[1], env))
-        k = min(range(len(G)), key=lambda i: abs(_value(G[i][0], env) - m[0])
-                + abs(_value(G[i][1], env) - m[1]))
+        if at_g is None:
+            # The code's points' values, once: read where the search first reads them (after
+            # the first model point, G1 first), since a symbol's value is set by the order in
+            # which symbols are first read; env only grows, so they never change after.
+            at_g = [(_value(x, env), _value(y, env)) for x, y in G]
+        at = at_g
+        k = min(range(len(G)), key=lambda i: abs(at[i][0] - m[0]) + abs(at[i][1] - m[1]))
         goal.append(z3.And(want[0] == names[k][0], want[1] == names[k][1]))
     hyps = ((key, z3.And(*[z3.And(n[0] == g[0], n[1] == g[1]) for n, g in zip(names, G)])),)
     return VC("tool_points", hyps, z3.And(*goal), key_premise=key)

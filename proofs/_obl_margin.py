@@ -273,15 +273,28 @@ def _convex_norm_certificate(e: z3.ArithRef, x: Vec, y: Vec, lam: z3.ArithRef) -
     ), name="SOS certificate of convex_norm")
 
 
-def _abstract_norms(f: z3.ExprRef, sq: z3.FuncDeclRef) -> z3.ExprRef:
-    """f with every u*u + v*v (as _n2 builds it) replaced by sq(u, v)."""
+def _abstract_norms(f: z3.ExprRef, sq: z3.FuncDeclRef,
+                    memo: dict[int, z3.ExprRef] | None = None) -> z3.ExprRef:
+    """f with every u*u + v*v (as _n2 builds it) replaced by sq(u, v). A subterm shared in f's
+    DAG is rewritten once (``memo``, by Z3's id: the rewrite of a term is a function of it)."""
+    memo = {} if memo is None else memo
+    key = f.get_id()
+    if key in memo:
+        return memo[key]
+    out = _abstract_norms_at(f, sq, memo)
+    memo[key] = out
+    return out
+
+
+def _abstract_norms_at(f: z3.ExprRef, sq: z3.FuncDeclRef, memo: dict[int, z3.ExprRef]
+                       ) -> z3.ExprRef:
     if z3.is_add(f) and f.num_args() == 2:
         l, r = f.arg(0), f.arg(1)
         if (z3.is_mul(l) and z3.is_mul(r) and l.num_args() == 2 and r.num_args() == 2
                 and z3.eq(l.arg(0), l.arg(1)) and z3.eq(r.arg(0), r.arg(1))):
             return sq(l.arg(0), r.arg(0))
     if z3.is_app(f) and f.num_args() > 0:
-        kids = [_abstract_norms(c, sq) for c in f.children()]
+        kids = [_abstract_norms(c, sq, memo) for c in f.children()]
         return f.decl()(*kids)
     if z3.is_quantifier(f):
         raise ValueError("no quantifiers expected in the margin lemma")

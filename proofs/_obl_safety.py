@@ -58,7 +58,7 @@ from ..spec.z3defs import (
 )
 from ._lemmas import CARRIED as _CARRIED
 from ._lemmas import PROVED as _PROVED
-from ._lemmas import Lemma, lemma
+from ._lemmas import Lemma, Substitution, lemma
 from ._lemmas import dedupe as _dedupe
 from ._obl_safety_principal import Principal, in_box, principal_lemmas, principal_steps, step_window
 from ._obl_safety_region import (
@@ -529,8 +529,10 @@ def region_statement_vc(arm: ArmModel, x: int, kit: Kit | None = None,
     missing = [n for n in _DERIVED[x] if n not in names]
     if missing:
         raise KeyError(f"{lem.vc.name} has no hypotheses {missing}: _DERIVED is out of date")
+    at_pairs = Substitution(pairs)
+
     def sub(f: z3.ExprRef) -> z3.ExprRef:
-        return concrete(z3.substitute(f, *pairs))
+        return concrete(at_pairs(f))
     defs = [(f"{n} [{lem.vc.name}'s named quantity]", sub(h)) for n, h in lem.hyps
             if n not in _DERIVED[x] and not n.startswith(_CARRIED + (_PROVED,))]
     # The corners, weights and local coordinates link{x+1}_in_region's conclusion names.

@@ -40,7 +40,7 @@ import numpy as np
 import z3
 
 from .. import spec
-from ._lemmas import Lemma, dedupe, lemma
+from ._lemmas import Lemma, Substitution, dedupe, lemma
 from ._obl_arc_chord import ArcChord
 from ._obl_groups import GROUP_CERTIFICATE
 from ._obl_safety_region import (
@@ -385,34 +385,6 @@ def _has_root(term: z3.ExprRef) -> bool:
 
 # --- numbers, to check a reading against the code's floats --------------------------------------
 
-def _value(t: z3.ExprRef, env: dict[str, float], memo: dict[int, Any] | None = None) -> Any:
-    """A term's value: constants from ``env`` (by name), Cos/Sin as math's, powers (roots) as
-    floats; its DAG walked once."""
-    memo = {} if memo is None else memo
-    key = t.get_id()
-    if key in memo:
-        return memo[key]
-    if z3.is_rational_value(t):
-        out: Any = float(t.as_fraction())
-    elif z3.is_true(t) or z3.is_false(t):
-        out = z3.is_true(t)
-    elif z3.is_const(t):
-        out = env[t.decl().name()]
-    else:
-        kids = [_value(c, env, memo) for c in t.children()]
-        d = t.decl()
-        if d.eq(_COS):
-            out = math.cos(kids[0])
-        elif d.eq(_SIN):
-            out = math.sin(kids[0])
-        elif d.kind() in _OPS:
-            out = _OPS[d.kind()](*kids)
-        else:
-            raise ValueError(f"no value for {d}")
-    memo[key] = out
-    return out
-
-
 _OPS: dict[int, Callable[..., Any]] = {
     z3.Z3_OP_ADD: lambda *a: sum(a), z3.Z3_OP_SUB: lambda a, *b: a - sum(b),
     z3.Z3_OP_MUL: lambda *a: math.prod(a), z3.Z3_OP_DIV: lambda a, b: a / b,
@@ -420,6 +392,67 @@ _OPS: dict[int, Callable[..., Any]] = {
     z3.Z3_OP_GE: lambda a, b: a >= b, z3.Z3_OP_LT: lambda a, b: a < b,
     z3.Z3_OP_GT: lambda a, b: a > b, z3.Z3_OP_ITE: lambda c, a, b: a if c else b,
     z3.Z3_OP_POWER: lambda a, b: a ** b, z3.Z3_OP_TO_REAL: float}
+
+
+@dataclass(frozen=True)
+class _Program:
+    """Terms' values at many environments, their DAG walked once (``_compile``): steps in
+    dependency order, each node once: ``(None, value)`` for a number or a truth value, ``(None,
+    name)`` for a constant (``name`` a str, looked up in the environment), ``(op, child steps)``
+    otherwise (every node is evaluated, an If's branches too); ``out`` the terms' steps."""
+
+    steps: tuple[tuple[Callable[..., Any] | None, Any], ...]
+    out: tuple[int, ...]
+
+
+def _compile(terms: Sequence[z3.ExprRef]) -> _Program:
+    """The program of ``terms``: constants by name, Cos/Sin as math's, powers (roots) as floats,
+    the arithmetic of ``_OPS`` (ValueError for any other operation)."""
+    index: dict[int, int] = {}
+    steps: list[tuple[Callable[..., Any] | None, Any]] = []
+
+    def walk(t: z3.ExprRef) -> int:
+        key = t.get_id()
+        if key in index:
+            return index[key]
+        d = t.decl()
+        kind = d.kind()
+        step: tuple[Callable[..., Any] | None, Any]
+        if kind == z3.Z3_OP_ANUM:                 # a rational numeral
+            step = (None, float(t.as_fraction()))
+        elif kind in (z3.Z3_OP_TRUE, z3.Z3_OP_FALSE):
+            step = (None, kind == z3.Z3_OP_TRUE)
+        elif t.num_args() == 0:
+            step = (None, str(d.name()))
+        else:
+            kids = tuple(walk(c) for c in t.children())
+            if kind == z3.Z3_OP_UNINTERPRETED and d.eq(_COS):
+                op: Callable[..., Any] = math.cos
+            elif kind == z3.Z3_OP_UNINTERPRETED and d.eq(_SIN):
+                op = math.sin
+            elif kind in _OPS:
+                op = _OPS[kind]
+            else:
+                raise ValueError(f"no value for {d}")
+            step = (op, kids)
+        index[key] = len(steps)
+        steps.append(step)
+        return index[key]
+    out = tuple(walk(t) for t in terms)
+    return _Program(tuple(steps), out)
+
+
+def _run(prog: _Program, env: dict[str, float]) -> list[Any]:
+    """The values of the program's terms, constants from ``env`` (by name)."""
+    vals: list[Any] = []
+    for op, arg in prog.steps:
+        if op is not None:
+            vals.append(op(*[vals[i] for i in arg]))
+        elif isinstance(arg, str):
+            vals.append(env[arg])
+        else:
+            vals.append(arg)
+    return [vals[i] for i in prog.out]
 
 
 def _sample_tools() -> list[tuple[tuple[float, float], tuple[tuple[float, float], ...]]]:
@@ -448,6 +481,13 @@ def check_tool_reading(reading: ToolReading, *, reach: Callable[..., Any] | None
     flagset = ((True, True), (True, False), (False, True), (False, False))
     margins = {f: reading.margin((g1, g2), re_sym, f) for f in flagset}
     sym_pts = reading.points(alpha, beta, delta)
+    # Each term compiled once for the sample tools and values below; a name is set from a
+    # term's value before a later term reads it, as the steps come.
+    roots = [(_name(h.arg(0).arg(0)), _compile([h.arg(1).arg(1)])) for _, h in reading.roots]
+    maxes = [(_name(h.arg(0)), _compile([h.arg(1)])) for _, h in reading.max_defs]
+    reach_prog = _compile([reading.base, reading.far])
+    margin_prog = _compile([margins[f] for f in flagset])
+    pts_prog = _compile([c for p in sym_pts for c in p])
     for links, poly in _sample_tools():
         arm = spec.Arm(base=(0.25, -0.5), links=links, width=0.06, omega=(1.0, 1.0),
                        tool=spec.Tool(poly))
@@ -455,26 +495,23 @@ def check_tool_reading(reading: ToolReading, *, reach: Callable[..., Any] | None
                _name(t.l2): links[1]}
         for (vx, vy), (x, y) in zip(t.verts, poly):
             env[_name(vx)], env[_name(vy)] = x, y
-        for _, h in reading.roots:               # s >= 0 and s * s == arg: s = sqrt(arg)
-            env[_name(h.arg(0).arg(0))] = math.sqrt(_value(h.arg(1).arg(1), env))
-        for _, h in reading.max_defs:
-            env[_name(h.arg(0))] = _value(h.arg(1), env)
-        got = (_value(reading.base, env), _value(reading.far, env))
+        for name, prog in roots:                 # s >= 0 and s * s == arg: s = sqrt(arg)
+            env[name] = math.sqrt(_run(prog, env)[0])
+        for name, prog in maxes:
+            env[name] = _run(prog, env)[0]
+        got = tuple(_run(reach_prog, env))
         want = reach(arm, 2)
         _close(got, want, f"link_reach on {poly}")
         env[_name(re_sym)] = want[1]
         for gg in ((0.02, 0.02), (0.5, 0.01), (3.14, 1.0)):
             env[_name(g1)], env[_name(g2)] = gg
-            for flags in flagset:
-                _close([_value(margins[flags], env)], [margin(arm, 2, gg, flags)],
-                       f"sweep_margin{gg, flags}")
+            for flags, value in zip(flagset, _run(margin_prog, env)):
+                _close([value], [margin(arm, 2, gg, flags)], f"sweep_margin{gg, flags}")
         for a, b_, d in ((0.3, -1.1, 0.01), (2.0, 0.7, 0.2)):
             env[_name(alpha)], env[_name(beta)], env[_name(delta)] = a, b_, d
-            memo: dict[int, Any] = {}
-            pts = [(_value(x, env, memo), _value(y, env, memo)) for x, y in sym_pts]
             want_pts = np.asarray(rectangles(arm, np.array(a), np.array(b_), 2, grow=d)
                                   ).reshape(-1, 2)
-            _close([c for p in pts for c in p], list(want_pts.ravel()),
+            _close(_run(pts_prog, env), list(want_pts.ravel()),
                    f"link_rectangles at {a, b_}, grow {d}")
 
 
@@ -727,11 +764,12 @@ def tool_points_vc(reading: ToolReading) -> VC:
     env: dict[str, float] = {}
     for sym in (*t.b, t.l1, t.l2, *[c for p in t.verts for c in p], alpha, beta, dl):
         env[_name(sym)] = float(rnd.uniform(0.1, 1.0))
-    memo: dict[int, Any] = {}
-    got = [(_value(x, env, memo), _value(y, env, memo)) for x, y in G]
+    # impl's points, then the wanted ones, valued in one walk of their terms.
+    values = _run(_compile([c for p in G for c in p] + [c for _, M in want for c in M]), env)
+    points = list(zip(values[0::2], values[1::2]))
+    got, at_want = points[:len(G)], points[len(G):]
     goal = []
-    for (k, _, _), M in want:
-        m = (_value(M[0], env, memo), _value(M[1], env, memo))
+    for ((k, _, _), M), m in zip(want, at_want):
         near = min(range(len(G)), key=lambda i: abs(got[i][0] - m[0]) + abs(got[i][1] - m[1]),
                    default=None)
         target = names[near] if near is not None else _v(f"tpt.none{k}")
@@ -1042,8 +1080,10 @@ def tool_statement_vc(tag: str, tk: ToolKit, *, hull: Callable[..., Any] | None 
     if missing:
         raise KeyError(f"tool_in_region has no hypotheses {missing}: _TOOL_DERIVED is out of date")
 
+    at_pairs = Substitution(pairs)
+
     def sub(f: z3.ExprRef) -> z3.ExprRef:
-        return concrete(z3.substitute(f, *pairs))
+        return concrete(at_pairs(f))
     point = {n for n, _ in ToolPoint.named(reading, "tir").hyps()}
     defs = [(f"{n} [tool_in_region's named quantity]", sub(h)) for n, h in lem.hyps
             if n not in _TOOL_DERIVED and n not in point

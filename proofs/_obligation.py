@@ -176,7 +176,16 @@ class CheckQuery:
 
 def check_source(*objs: Callable[..., Any]) -> str:
     """The source text of the functions a check runs: hashed, so editing the check is a change."""
-    return "\n".join(inspect.getsource(o).rstrip() for o in objs)
+    return "\n".join(source_of(o) for o in objs)
+
+
+@functools.lru_cache(maxsize=1024)
+def source_of(obj: Callable[..., Any]) -> str:
+    """``inspect.getsource(obj)``, trailing space stripped, read once a process: the seven checks
+    of each workcell hash the same functions' source, and reading one re-tokenises its file
+    (``inspect.getblock``), a second of CPU over a prove. A run reads the files as they are
+    when first asked, as inspect's own line cache already does."""
+    return inspect.getsource(obj).rstrip()
 
 
 Query = Z3Query | CheckQuery
@@ -487,10 +496,9 @@ def rlimit_count(s: z3.Solver) -> int:
 
 def _text_of(formulas: Sequence[z3.BoolRef]) -> str:
     """Z3's SMT-LIB text of ``formulas`` (declarations, then one assert each, in order)."""
-    s = z3.Solver()
-    for f in formulas:
-        s.add(f)
-    return str(s.sexpr())
+    from ._z3text import text_of
+
+    return text_of(formulas)
 
 
 def _stats(s: z3.Solver, into: dict[str, float]) -> None:
@@ -766,12 +774,18 @@ def _default_render(model: z3.ModelRef) -> str:
 
 def _check_texts(query: Z3Query) -> list[tuple[str, str]]:
     """Per VC, Z3's text of its vacuity check (the hypotheses, the witness pinned) and of its
-    proof check (the hypotheses, the goal negated): ``_text_of`` of those formulas, in order."""
+    proof check (the hypotheses, the goal negated): ``_text_of`` of those formulas, in order,
+    byte for byte, both cut from one print of the hypotheses, the pins and the negated goal
+    (``_z3text``: printing is most of the cost, and the hypotheses would be printed twice)."""
+    from ._z3text import Printed
+
     out = []
     for vc in query.vcs:
         hyps = [h for _, h in vc.hypotheses]
-        out.append((_text_of(hyps + [c == v for c, v in vc.witness]),
-                    _text_of(hyps + [z3.Not(vc.goal)])))
+        pins = [c == v for c, v in vc.witness]
+        printed = Printed(hyps + pins + [z3.Not(vc.goal)])
+        n, m = len(hyps), len(pins)
+        out.append((printed.text(range(n + m)), printed.text([*range(n), n + m])))
     return out
 
 

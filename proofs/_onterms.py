@@ -111,6 +111,13 @@ def _min_terms(*args: Any) -> Any:
 _BUILTINS = {"max": _max_terms, "min": _min_terms}
 
 
+@functools.lru_cache(maxsize=256)
+def _dedented_source(fn: Callable[..., Any]) -> str:
+    """``fn``'s source, dedented, read once a process (each reading re-tokenises its file; the
+    same few functions are read on terms hundreds of times in a prove)."""
+    return textwrap.dedent(inspect.getsource(fn))
+
+
 class _Reader:
     """Evaluates one function's body on the given arguments: the subset ``heights_overlap`` and
     ``height_gap`` are written in (a docstring, ``if``/``else`` whose branches return, ``return``;
@@ -120,7 +127,7 @@ class _Reader:
     else is refused, naming the line."""
 
     def __init__(self, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
-        src = textwrap.dedent(inspect.getsource(fn))
+        src = _dedented_source(fn)
         tree = ast.parse(src)
         node = tree.body[0]
         if not isinstance(node, ast.FunctionDef) or node.decorator_list:

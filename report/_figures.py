@@ -129,12 +129,25 @@ def _render(fig: Any) -> npt.NDArray[np.uint8]:
     fw, fh = fig.get_size_inches()
     wide = Bbox.from_extents(-MARGIN_IN, -MARGIN_IN, fw + MARGIN_IN, fh + MARGIN_IN)
     pixels = _draw_box(fig, wide)
-    box = fig.get_tightbbox(fig.canvas.get_renderer()).padded(plt.rcParams["savefig.pad_inches"])
+    # Measured with the renderer of that draw: its text metrics are cached already (a fresh
+    # renderer at the figure's size measures every text again, a fifth of a picture's time)
+    # and, as the dpi is the same, they are the same numbers (docs/model.md §8;
+    # tests/report/test_figure_box.py).
+    box = fig.get_tightbbox(_drawn_renderer(fig)).padded(plt.rcParams["savefig.pad_inches"])
     w, h = int(box.width * DPI), int(box.height * DPI)        # RendererAgg truncates the same
     c0, r0 = round((box.x0 + MARGIN_IN) * DPI), round((fh + MARGIN_IN - box.y1) * DPI)
     if c0 >= 0 and r0 >= 0 and c0 + w <= pixels.shape[1] and r0 + h <= pixels.shape[0]:
         return pixels[r0:r0 + h, c0:c0 + w].copy()
     return _draw_box(fig, box)
+
+
+def _drawn_renderer(fig: Any) -> Any:
+    """The renderer of the figure's last draw (``_draw_box``'s), if it drew at DPI; else the
+    canvas's renderer at the figure's own size."""
+    renderer = getattr(fig.canvas, "renderer", None)
+    if renderer is None or getattr(renderer, "dpi", None) != fig.dpi:
+        return fig.canvas.get_renderer()
+    return renderer
 
 
 def _draw_box(fig: Any, box: Any) -> npt.NDArray[np.uint8]:

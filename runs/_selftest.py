@@ -29,7 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import CertificateViolation, CfmpaError, ContractViolation
-from ..impl import build_dr, search_opt_path
+from ..impl import build_dr, search_opt_path, search_opt_path_fast
 from ..scenarios import SELFCHECK_WORKCELLS
 from ..spec import (
     J1,
@@ -197,10 +197,38 @@ def _worse_path(shape: tuple[int, ...], cells: bytes, start: Cell, goal: Cell) -
     for k in range(1, len(best.path) - 1):
         more = dr.copy()
         more[min(k, N), best.path[k][0], best.path[k][1]] = 1   # more blocked: still valid
+        # Whether a blocked cell makes the optimum worse depends only on the least (J1, J2)
+        # and whether a path exists, which every kernel computes alike (docs/model.md §5;
+        # tests/impl/test_kernels.py): the fast kernel screens each cell in a fraction of a
+        # millisecond, and the spec's search, whose path is the fault's, runs only on a cell
+        # the screen finds worse. A screen that missed a worse cell would show as a different
+        # path (tests/runs/test_selftest_screen.py).
+        screen = search_opt_path_fast(more, start, goal)
+        if screen.status is not SearchStatus.FOUND or (screen.J1, screen.J2) <= (best.J1,
+                                                                                 best.J2):
+            continue
         alt = opt_path(more, start, goal)
         if alt.status is SearchStatus.FOUND and (alt.J1, alt.J2) > (best.J1, best.J2):
             return SearchResult.found(alt.path, J1(alt.path), J2(alt.path))
     raise FaultNotMade("no single blocked cell makes the optimum worse")
+
+
+def _opt_path_of(dr: DR, start: Cell, goal: Cell) -> SearchResult:
+    """The spec's ``opt_path(dr, start, goal)``, searched once per table, start and goal
+    (``_opt_path_cached``): a fault's search runs in full and in sampled mode on the same D_R
+    (docs/model.md §7.3), and the spec's search is the slow one."""
+    if dr.dtype != np.uint8:            # only D_R's own type is keyed by its bytes
+        return opt_path(dr, start, goal)
+    return _opt_path_cached(dr.shape, dr.tobytes(), (int(start[0]), int(start[1])),
+                            (int(goal[0]), int(goal[1])))
+
+
+@functools.lru_cache(maxsize=2)
+def _opt_path_cached(shape: tuple[int, ...], cells: bytes, start: Cell, goal: Cell
+                     ) -> SearchResult:
+    """The spec's opt_path on the table ``cells`` (its bytes) of ``shape``: keyed by every cell,
+    so a table that differs anywhere is searched anew."""
+    return opt_path(np.frombuffer(cells, dtype=np.uint8).reshape(shape), start, goal)
 
 
 def _forged_witness(s: Scenario, v: Variant, g: Grid) -> Mutant:
@@ -251,7 +279,7 @@ def _early_arrival(s: Scenario, v: Variant, g: Grid) -> Mutant:
         # Waiting at the goal is not checked: the goal is taken as free at every step.
         blind = dr.copy()
         blind[:, goal[0], goal[1]] = 0
-        r = opt_path(blind, start, goal)
+        r = _opt_path_of(blind, start, goal)
         _require(r.status is SearchStatus.FOUND, "no path even with the goal always free")
         p = list(r.path)
         later = [k for k in range(len(p), N + 1) if dr[k, goal[0], goal[1]]]
@@ -269,7 +297,7 @@ def _rest_layer(s: Scenario, v: Variant, g: Grid) -> Mutant:
         N = dr.shape[0] - 1
         blind = dr.copy()
         blind[N] = 0                        # the rest layer is ignored
-        r = opt_path(blind, start, goal)
+        r = _opt_path_of(blind, start, goal)
         _require(r.status is SearchStatus.FOUND, "no path even with R ignored")
         p = list(r.path)
         in_r = [k for k in range(N, len(p)) if dr[N, p[k][0], p[k][1]]]
