@@ -110,3 +110,23 @@ def test_only_selects_controls_by_id_or_by_their_composition():
     picked = collect_controls(["Safety.tight.composition"])
     assert picked and all(c.checker == "Safety.tight.composition" for c in picked)
     assert collect_controls(["Thm1"]) == []
+
+
+def test_premise_controls_wall_clock_is_only_a_net(monkeypatch):
+    """Each premise control's check runs under its resource limit with the wall clock as the
+    same net the obligations' checks have (``_limits.wall_net_ms``): a loaded machine must not
+    end a check on the clock before its resource count. Seeded fault: the bare 10 s (the limit
+    ``without[35]`` once hit under load) fails this."""
+    from cfmpa.proofs import _obligation as O
+    from cfmpa.proofs._limits import WALL_NET_FACTOR
+
+    seen = []
+    real = O._solver
+
+    def spy(timeout_ms, *a, **k):
+        seen.append((timeout_ms, k.get("rlimit")))
+        return real(timeout_ms, *a, **k)
+    monkeypatch.setattr(O, "_solver", spy)
+    C._without("modified", 9)
+    assert seen and all(ms >= WALL_NET_FACTOR * C.PREMISE_PINNED_MS and rl is not None
+                        for ms, rl in seen)
