@@ -10,7 +10,7 @@ checks, the walk back, the witness), the back-pointers and the labels (``BackPoi
 ``WitnessLabels``, ``hold_waits``) are the reference's own; this module gives the driver its two
 phases. What differs is how the labels are computed:
 
-- DAG steps 1..N: the reference's ``_step`` arithmetic (the same ``_min_plus_gap``, the same
+- DAG steps 1..N: the reference's ``_step`` arithmetic (the same ``_best_moves``, the same
   int64 sums clamped to INF) on the box of cells within s - 1 moves of the start only, shifted
   into the box of s moves: outside it every key is INF in the reference too (a move changes each
   coordinate by at most 1), and the labels are put on that box (``WitnessLabels.put``).
@@ -38,10 +38,12 @@ from ._search import (
     BackPointers,
     FreeLayers,
     WitnessLabels,
-    _min_plus_gap,
+    _best_moves,
     _targets,
+    goal_finish,
     hold_waits,
     search_by_phases,
+    settled_buckets,
 )
 
 __all__ = ["search_opt_path_numpy"]
@@ -101,13 +103,7 @@ def _step(keys: IntArray, box: tuple[int, int, int, int], nbox: tuple[int, int, 
     """The reference's ``_step`` from the keys on ``box`` (3, 3, rows, cols) to those on
     ``nbox``, a box one cell larger on every side (clipped to the grid), holding every cell a
     move reaches from ``box``: the same sums, the same least previous move on ties."""
-    t, arg2 = _min_plus_gap(keys.transpose(1, 0, 2, 3))
-    best, arg1 = _min_plus_gap(t.transpose(1, 0, 2, 3))
-    a = arg2.astype(np.uint8)
-    packed = a[:, 0] | (a[:, 1] << 2) | (a[:, 2] << 4)
-    arg2_chosen = (packed[None] >> (2 * arg1).astype(np.uint8)) & 3
-    pred_here = (arg1 * 3 + arg2_chosen).astype(np.int8)
-    best += (_NORM.reshape(3, 3) << SHIFT)[:, :, None, None]
+    best, pred_here = _best_moves(keys)
     r0, r1, c0, c1 = box
     R0, R1, C0, C1 = nbox
     h, w = R1 - R0, C1 - C0
@@ -155,23 +151,10 @@ def _static_phase(free_rest: npt.NDArray[np.bool_], initial: IntArray, goal: Cel
     cuts = np.flatnonzero(j1[1:] != j1[:-1]) + 1
     for part in np.split(reached, cuts) if reached.size else ():
         buckets[int(keys[part[0]] >> SHIFT)] = [part]
-    b = 0
     answer = None
-    while buckets:
-        chunk = buckets.pop(b, None)
-        b += 1
-        if chunk is None:
-            continue
-        bucket = b - 1
-        u = chunk[0] if len(chunk) == 1 else np.concatenate(chunk)
-        u = u[~done[u] & ((keys[u] >> SHIFT) == bucket)]
-        if u.size == 0:
-            continue
-        done[u] = True
-        if answer is None and done[goal_states].any():
-            finish = np.where(done[goal_states], keys[goal_states] + _NORM, INF)
-            last = int(np.argmin(finish))  # smallest move on ties
-            answer = int(finish[last]), last, pred, from_static
+    for bucket, u in settled_buckets(buckets, keys, done, unique=False):
+        if answer is None and (finished := goal_finish(keys, done, goal_states)) is not None:
+            answer = *finished, pred, from_static
             if labels is None:
                 return answer
         cells = u % M

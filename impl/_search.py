@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from typing import IO, Any
 
@@ -46,6 +46,8 @@ INF = np.int64(1) << np.int64(61)
 WAIT = MOVES.index((0, 0))
 #: |d|_1 of the move with index (di + 1, dj + 1).
 _STEP_J1 = np.add.outer(np.abs(np.arange(-1, 2)), np.abs(np.arange(-1, 2))).astype(np.int64)
+#: |d|_1 per move d (MOVES order): what stopping after d adds to J2.
+_MOVE_NORM = np.abs(np.asarray(MOVES, dtype=np.int64)).sum(axis=1)
 
 
 def _prepare(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness: bool
@@ -374,24 +376,10 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell,
 
     buckets: dict[int, list[IntArray]] = {}
     _push(buckets, np.flatnonzero(keys < INF), keys)
-    b = 0
     answer = None
-    while buckets:
-        chunk = buckets.pop(b, None)
-        b += 1
-        if chunk is None:
-            continue
-        bucket = b - 1
-        u = np.unique(np.concatenate(chunk))
-        u = u[~done[u] & ((keys[u] >> SHIFT) == bucket)]
-        if u.size == 0:
-            continue
-        done[u] = True
-        if answer is None and done[goal_states].any():
-            # Stopping after move d adds |d|_1 to J2 (the low bits of the key).
-            finish = np.where(done[goal_states], keys[goal_states] + norm, INF)
-            last = int(np.argmin(finish))  # smallest move on ties
-            answer = int(finish[last]), last, pred, from_static
+    for _, u in settled_buckets(buckets, keys, done, unique=True):
+        if answer is None and (finished := goal_finish(keys, done, goal_states)) is not None:
+            answer = *finished, pred, from_static
             if labels is None:
                 return answer
         # Expand every move but the wait from the settled frontier.
@@ -412,6 +400,38 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell,
     if labels is not None:
         labels.put(labels.N, hold_waits(keys.reshape(9, m, n)))
     return answer
+
+
+def settled_buckets(buckets: dict[int, list[IntArray]], keys: IntArray, done: BoolArray, *,
+                    unique: bool) -> Iterator[tuple[int, IntArray]]:
+    """Dial's order over ``buckets`` (J1 -> lists of states; later ones may be added between
+    yields): (J1, its states not yet done whose key still has that J1), each marked done as it
+    is yielded; with ``unique`` each state once and in ascending order."""
+    b = 0
+    while buckets:
+        chunk = buckets.pop(b, None)
+        b += 1
+        if chunk is None:
+            continue
+        u = chunk[0] if len(chunk) == 1 else np.concatenate(chunk)
+        if unique:
+            u = np.unique(u)
+        u = u[~done[u] & ((keys[u] >> SHIFT) == b - 1)]
+        if u.size == 0:
+            continue
+        done[u] = True
+        yield b - 1, u
+
+
+def goal_finish(keys: IntArray, done: BoolArray, goal_states: IntArray) -> tuple[int, int] | None:
+    """(key of the best path stopping at the goal, its last move) once a goal state is done, else
+    None. Stopping after move d adds |d|_1 to J2 (the low bits of the key); ties go to the
+    smallest move."""
+    if not done[goal_states].any():
+        return None
+    finish = np.where(done[goal_states], keys[goal_states] + _MOVE_NORM, INF)
+    last = int(np.argmin(finish))
+    return int(finish[last]), last
 
 
 def _improve(keys: IntArray, pred: npt.NDArray[np.int8], from_static: BoolArray,
@@ -476,17 +496,7 @@ def _step(keys: IntArray, block_next: IntArray) -> tuple[IntArray, npt.NDArray[n
     |d - p|_1 splits by coordinate, so the min over the 9 previous moves is two mins over 3.
     """
     m, n = keys.shape[2:]
-    # Over p2 (moved to the front): t[d2, p1] = min_p2 keys[p1, p2] + |d2 - p2|.
-    t, arg2 = _min_plus_gap(keys.transpose(1, 0, 2, 3))
-    # Over p1: best[d1, d2] = min_p1 t[d2, p1] + |d1 - p1|. Both keep the smallest index on
-    # ties, so the chosen (p1, p2) is the lexicographically smallest optimal previous move.
-    best, arg1 = _min_plus_gap(t.transpose(1, 0, 2, 3))
-    # arg2[d2, arg1[d1, d2]], gathered by packing the three 2-bit p2 choices of each d2 in a byte
-    a = arg2.astype(np.uint8)
-    packed = a[:, 0] | (a[:, 1] << 2) | (a[:, 2] << 4)
-    arg2_chosen = (packed[None] >> (2 * arg1).astype(np.uint8)) & 3
-    pred_here = (arg1 * 3 + arg2_chosen).astype(np.int8)
-    best += (_STEP_J1 << SHIFT)[:, :, None, None]
+    best, pred_here = _best_moves(keys)
     new = np.full((3, 3, m, n), INF, dtype=np.int64)
     pred = np.full((3, 3, m, n), -1, dtype=np.int8)  # read only where new < INF
     for d1 in range(3):
@@ -499,6 +509,23 @@ def _step(keys: IntArray, block_next: IntArray) -> tuple[IntArray, npt.NDArray[n
     np.add(new, block_next, out=new)
     np.minimum(new, INF, out=new)
     return new, pred
+
+
+def _best_moves(keys: IntArray) -> tuple[IntArray, npt.NDArray[np.int8]]:
+    """Per move d and cell c of ``keys`` (3, 3, ...): min_p keys[p, c] + (|d|_1 << SHIFT) +
+    |d - p|_1 and the least minimising previous move p (as an index 0..8), before the move."""
+    # Over p2 (moved to the front): t[d2, p1] = min_p2 keys[p1, p2] + |d2 - p2|.
+    t, arg2 = _min_plus_gap(keys.transpose(1, 0, 2, 3))
+    # Over p1: best[d1, d2] = min_p1 t[d2, p1] + |d1 - p1|. Both keep the smallest index on
+    # ties, so the chosen (p1, p2) is the lexicographically smallest optimal previous move.
+    best, arg1 = _min_plus_gap(t.transpose(1, 0, 2, 3))
+    # arg2[d2, arg1[d1, d2]], gathered by packing the three 2-bit p2 choices of each d2 in a byte
+    a = arg2.astype(np.uint8)
+    packed = a[:, 0] | (a[:, 1] << 2) | (a[:, 2] << 4)
+    arg2_chosen = (packed[None] >> (2 * arg1).astype(np.uint8)) & 3
+    pred_here = (arg1 * 3 + arg2_chosen).astype(np.int8)
+    best += (_STEP_J1 << SHIFT)[:, :, None, None]
+    return best, pred_here
 
 
 def _min_plus_gap(x: IntArray) -> tuple[IntArray, npt.NDArray[np.int8]]:

@@ -122,9 +122,6 @@ class NonlinearMemo:
     def __init__(self) -> None:
         self._known: dict[tuple[int, int], tuple[z3.ExprRef, bool]] = {}
 
-    def __len__(self) -> int:
-        return len(self._known)
-
 
 class _Scan:
     """One call's scan: a DAG walk over the C API (``_smtlib``'s direct calls), every AST

@@ -559,6 +559,7 @@ def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> Smo
     and the test with it replaced by true have the same models); None if that does not work."""
     from ._limits import wall_net_ms
 
+    net = wall_net_ms(SMOKE_TIMEOUT_MS, SMOKE_RLIMIT)
     sig = [(c, v) for c, v in sm.lemma_witness]
     f = z3.substitute(z3.And(*[h for _, h in sm.hypotheses], z3.Not(sm.goal)), *sig)
     used = []
@@ -566,7 +567,7 @@ def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> Smo
         closed = z3.substitute(lemma, *sig)
         if z3.eq(z3.substitute(f, (closed, z3.BoolVal(True))), f):
             continue                    # not in this test
-        s = _solver(wall_net_ms(SMOKE_TIMEOUT_MS, SMOKE_RLIMIT), ctx, rlimit=SMOKE_RLIMIT)
+        s = _solver(net, ctx, rlimit=SMOKE_RLIMIT)
         s.add(z3.Not(closed.translate(ctx)))
         r = s.check()
         _stats(s, stats)
@@ -574,7 +575,7 @@ def _smoke_by_lemmas(sm: Smoke, stats: dict[str, float], ctx: z3.Context) -> Smo
             return None
         f = z3.substitute(f, (closed, z3.BoolVal(True)))
         used.append(lname)
-    s = _solver(wall_net_ms(SMOKE_TIMEOUT_MS, SMOKE_RLIMIT), ctx, rlimit=SMOKE_RLIMIT)
+    s = _solver(net, ctx, rlimit=SMOKE_RLIMIT)
     s.add(f.translate(ctx))
     r = s.check()
     _stats(s, stats)
@@ -596,7 +597,7 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
     ``_check_texts``, printed by the caller; printed here if not given), its depth, statement
     hash and cvc5 replay; the Proof's fields, cvc5's futures and the VCs to certify."""
     from ._cvc5 import CVC5_TIMEOUT_MS
-    from ._depth import deepest, is_nonlinear, vc_depth
+    from ._depth import NonlinearMemo, deepest, is_nonlinear, vc_depth
     from ._limits import wall_net_ms, z3_rlimit
 
     if not q.vcs:
@@ -616,6 +617,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
         texts = _check_texts(q)
     limit = z3_rlimit(ob.id)
     net = wall_net_ms(ob.timeout_ms, limit)
+    # The VCs of one obligation share most hypotheses: each is scanned once (docs/model.md §6.4).
+    scanned = NonlinearMemo()
     for vc, (vac_text, proof_text) in zip(q.vcs, texts, strict=True):
         hyps = [h for _, h in vc.hypotheses]
         # Vacuity: the hypotheses (with the optional witness pinned) must have a model.
@@ -665,7 +668,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
         results.append(VCResult(vc.name, str(vac), str(ans), depth=depth, sha256=sha,
                                 cvc5=cvc5, cvc5_reason=why,
                                 solvers=("z3",) if str(ans) == want else (), note=note,
-                                nonlinear=is_nonlinear(hyps + [vc.goal]), cvc5_from_pin=pinned,
+                                nonlinear=is_nonlinear(hyps + [vc.goal], scanned),
+                                cvc5_from_pin=pinned,
                                 rlimit_count=counts))
     smoke = [_smoke(sm, stats) for sm in q.smoke]      # each in a context of its own
     dead = [r.name for r in smoke if r.answer == "unsat"]

@@ -116,8 +116,7 @@ _raw_error_msg = _entry("Z3_get_error_msg", ctypes.c_char_p, (_P, _U))
 
 def _check(c: int) -> None:
     """Raise z3.Z3Exception if the last call on context ``c`` failed (as z3py does)."""
-    if _raw_error_code is None or _raw_error_msg is None:
-        return      # the fallback: z3py's wrappers check themselves
+    assert _raw_error_code is not None and _raw_error_msg is not None   # see _native
     err = _raw_error_code(c)
     if err != z3.Z3_OK:
         raise z3.Z3Exception(_raw_error_msg(c, err).decode(sys.getdefaultencoding(), "replace"))
@@ -127,8 +126,8 @@ def _native(name: str, restype: Any, *argtypes: Any, checked: bool = True
             ) -> Callable[..., Any]:
     """Z3's C function ``name``: pointers as ints, strings decoded (as z3py decodes them)."""
     fn = _entry(name, restype, argtypes)
-    if fn is None or _raw_error_code is None:
-        return _via_z3py(name, argtypes)
+    if fn is None or _raw_error_code is None or _raw_error_msg is None:
+        return _via_z3py(name, argtypes)       # z3py's wrappers check themselves
     raw = fn
     if restype is ctypes.c_char_p:
         def text(*args: Any) -> str:
@@ -294,10 +293,10 @@ class _Printer:
     formulas, which the caller holds for the printer's life, so within one query a pointer names
     one term (Z3 shares equal terms: equal terms, equal pointers), as its AST id would."""
 
-    def __init__(self, ctx: z3.Context, mode: Mode, open_premises: bool = False,
-                 nodes: _Nodes | None = None) -> None:
+    def __init__(self, ctx: z3.Context, mode: Mode, open_premises: bool,
+                 nodes: _Nodes) -> None:
         self.c = _ptr(ctx.ref())
-        self.cache = _Nodes(ctx) if nodes is None else nodes
+        self.cache = nodes
         self.known = self.cache.nodes
         self.mode = mode
         self.open_premises = open_premises

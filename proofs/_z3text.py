@@ -54,9 +54,6 @@ def text_of(formulas: Sequence[z3.BoolRef]) -> str:
     return str(s.sexpr())
 
 
-_print = text_of
-
-
 def commands(text: str) -> list[str] | None:
     """The top-level commands of Z3's text, each as printed (its newlines inside kept), or None
     if the text is not commands each starting a line and separated by one newline."""
@@ -98,7 +95,8 @@ def _plain_commands(text: str) -> list[str] | None:
     if len(depth) and (depth.min() < 0 or depth[-1] != 0):
         return None
     ends = np.flatnonzero((depth == 0) & (step == -1))
-    starts = np.flatnonzero((depth == 1) & (step == 1) & (np.concatenate(([0], depth[:-1])) == 0))
+    # An opening parenthesis that reaches depth 1 was read at depth 0: a command starts there.
+    starts = np.flatnonzero((depth == 1) & (step == 1))
     if len(starts) != len(ends):
         return None
     out = [text[a:e + 1] for a, e in zip(starts.tolist(), ends.tolist())]
@@ -187,7 +185,7 @@ class Printed:
 
     def __init__(self, formulas: Sequence[z3.BoolRef]) -> None:
         self.formulas = list(formulas)
-        self.full = _print(self.formulas)
+        self.full = text_of(self.formulas)
         self.reprints = 0
         self._asserts: list[str] = []
         self._uses: list[frozenset[str]] = []       # per formula, the declared names it needs
@@ -255,7 +253,7 @@ class Printed:
         if idx == list(range(len(self.formulas))):
             return self.full
         if not idx:
-            return _print([])
+            return text_of([])
         if not self._exact:
             return self._reprint(idx)
         order: list[str] = []
@@ -284,7 +282,7 @@ class Printed:
         process per formula), or None if that print is not what the whole list's says of it."""
         if k not in self._own:
             self.reprints += 1
-            cmds = commands(_print([self.formulas[k]]))
+            cmds = commands(text_of([self.formulas[k]]))
             own: list[str] | None = None
             if cmds is not None and cmds[-1] == self._asserts[k]:
                 decls = [_TOKEN.findall(c) for c in cmds[:-1]]
@@ -297,4 +295,4 @@ class Printed:
 
     def _reprint(self, idx: list[int]) -> str:
         self.reprints += 1
-        return _print([self.formulas[k] for k in idx])
+        return text_of([self.formulas[k] for k in idx])

@@ -443,13 +443,18 @@ class _Forked:
         """("value" | "error", the value or exception, the check's (start, end)); once. ``kill``:
         end the child first (the caller is being interrupted)."""
         data = b""
+        read = False
         try:
-            if kill:
-                os.kill(self._pid, signal.SIGKILL)
-            else:
+            if not kill:
                 with os.fdopen(self._rfd, "rb", closefd=False) as fh:
                     data = fh.read(_ANSWER_LIMIT + 1)
+                read = True
         finally:
+            # Killed when asked, when the read was interrupted (the wait would otherwise last
+            # the whole check) and when the answer is over the bound (it stops reading).
+            if not read or len(data) > _ANSWER_LIMIT:
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(self._pid, signal.SIGKILL)
             os.close(self._rfd)
             _, status = os.waitpid(self._pid, 0)
         if kill:

@@ -12,8 +12,9 @@ regions, leaving to ``expected_cells`` the cells no bound decides (tests check t
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -225,7 +226,7 @@ def _block_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, b
     for links in left:
         d1 = np.full(m, np.inf)        # inf: more than free_at (the boxes' gap shows it)
         for a in (links[p] for p, q in pairs if q == 0):
-            close = np.flatnonzero(_box_gap(shapely.bounds(a), b1) <= free_at)
+            close = np.flatnonzero(_box_gap(shapely.bounds(a), b1.T) <= free_at)
             d1[close] = np.minimum(d1[close], shapely.distance(a, r1[close]))   # exact
         link1.append(d1)
     # The link-2 and tool pairs, the principal's outer parts first: the cells they block are
@@ -250,11 +251,13 @@ def _block_bounds(s: Scenario, variant: Variant | str, grid: Grid, eps: float, b
             yield k, i0, i1, meets, unsure & ~meets
 
 
-def _box_gap(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """The larger per-axis gap between box a (4,) and boxes b (K, 4), (xmin, ymin, xmax, ymax):
-    at most the distance between anything inside them."""
-    return np.maximum(np.maximum(a[0] - b[:, 2], b[:, 0] - a[2]),
-                      np.maximum(a[1] - b[:, 3], b[:, 1] - a[3]))
+def _box_gap(a: Sequence[Any] | npt.NDArray[np.float64],
+             b: Sequence[npt.NDArray[np.float64]] | npt.NDArray[np.float64]
+             ) -> npt.NDArray[np.float64]:
+    """The larger per-axis gap between box a (xmin, ymin, xmax, ymax) and boxes b (their xmin,
+    ymin, xmax, ymax, (K,) each): at most the distance between anything inside them."""
+    bx0, by0, bx1, by1 = b
+    return np.maximum(np.maximum(a[0] - bx1, bx0 - a[2]), np.maximum(a[1] - by1, by0 - a[3]))
 
 
 class _Link2:
@@ -396,11 +399,9 @@ class _Link2:
 
 def _box_gap_of(ax: npt.NDArray[np.float64], ay: npt.NDArray[np.float64],
                 box: tuple[npt.NDArray[np.float64], ...]) -> npt.NDArray[np.float64]:
-    """The larger per-axis gap between the box of corners (ax, ay) and boxes (xmin, ymin, xmax,
-    ymax), each (K,): at most the distance between anything inside them."""
-    bx0, by0, bx1, by1 = box
-    return np.maximum(np.maximum(ax.min() - bx1, bx0 - ax.max()),
-                      np.maximum(ay.min() - by1, by0 - ay.max()))
+    """``_box_gap`` from the box of corners (ax, ay) to boxes (xmin, ymin, xmax, ymax), each
+    (K,)."""
+    return _box_gap((ax.min(), ay.min(), ax.max(), ay.max()), box)
 
 
 def _extent_sep(nu: npt.NDArray[np.float64], nv: npt.NDArray[np.float64],

@@ -352,21 +352,19 @@ def _form_failures(s: int, j1: Array, j2: Array, a: Array) -> list[Failure]:
     return []
 
 
-def _check_edges(free: Array, j1: Array, j2: Array,
-                 form: list[Failure] | None = None) -> list[Failure]:
-    """witness.edge, layer by layer on the box of the labelled free states (plus one cell).
-    With ``form``, witness.form too, each layer as it is read (``_form_failures``): its first
-    failure is put in ``form`` and the edges' check stops there (the form's is reported)."""
+def _check_edges(free: Array, j1: Array, j2: Array, form: list[Failure]) -> list[Failure]:
+    """witness.edge, layer by layer on the box of the labelled free states (plus one cell), and
+    witness.form, each layer as it is read (``_form_failures``): its first failure is put in
+    ``form`` and the edges' check stops there (the form's is reported)."""
     N, m, n = free.shape[0] - 1, free.shape[1], free.shape[2]
     none = np.iinfo(j1.dtype).max
     first, count = None, 0
     for s in range(N + 1):
         t = min(s + 1, N)
         unlabelled = j1[s] == none
-        if form is not None:
-            form += _form_failures(s, j1, j2, unlabelled)
-            if form:
-                return []
+        form += _form_failures(s, j1, j2, unlabelled)
+        if form:
+            return []
         src = ~unlabelled & free[s]                          # labelled free states (9, m, n)
         box = _box(src.any(axis=0))
         if box is None:

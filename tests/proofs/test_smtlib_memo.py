@@ -28,19 +28,6 @@ _quote = _smtlib._quote
 # --- the reference: every node read through z3py's checked wrappers, one query at a time ------
 
 _C = z3  # the C API, as z3 exports it
-_NARY = {z3.Z3_OP_AND: "and", z3.Z3_OP_OR: "or", z3.Z3_OP_ADD: "+", z3.Z3_OP_MUL: "*",
-         z3.Z3_OP_SUB: "-", z3.Z3_OP_DISTINCT: "distinct"}
-_FIXED = {z3.Z3_OP_NOT: "not", z3.Z3_OP_IMPLIES: "=>", z3.Z3_OP_XOR: "xor", z3.Z3_OP_ITE: "ite",
-          z3.Z3_OP_EQ: "=", z3.Z3_OP_IFF: "=", z3.Z3_OP_LE: "<=", z3.Z3_OP_GE: ">=",
-          z3.Z3_OP_LT: "<", z3.Z3_OP_GT: ">", z3.Z3_OP_UMINUS: "-", z3.Z3_OP_DIV: "/",
-          z3.Z3_OP_IDIV: "div", z3.Z3_OP_MOD: "mod", z3.Z3_OP_TO_REAL: "to_real",
-          z3.Z3_OP_TO_INT: "to_int", z3.Z3_OP_IS_INT: "is_int"}
-_CONNECTIVE = {z3.Z3_OP_AND, z3.Z3_OP_OR, z3.Z3_OP_NOT, z3.Z3_OP_IMPLIES, z3.Z3_OP_XOR,
-               z3.Z3_OP_TRUE, z3.Z3_OP_FALSE, z3.Z3_OP_IFF}
-
-
-def _quote(name: str) -> str:
-    return "|" + name.replace("|", "/").replace("\\", "/") + "|"
 
 
 class _RefPrinter:

@@ -53,13 +53,17 @@ def _same_picture(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 @pytest.mark.parametrize("below", [None, 0.4, 2.5], ids=["inside", "in-margin", "far-below"])
-def test_render_frames_the_picture_as_savefig_tight(below):
+def test_render_frames_the_picture_as_savefig_tight(below, monkeypatch):
     # None and 0.4 in: one draw, cropped; 2.5 in is past MARGIN_IN: the second draw.
     assert below is None or (below < F.MARGIN_IN) == (below == 0.4)
     want = _savefig_tight(_figure(below))
     fig = _figure(below)
+    draws = []
+    draw = F._draw_box
+    monkeypatch.setattr(F, "_draw_box", lambda f, box: draws.append(box) or draw(f, box))
     got = F._render(fig)
     F.plt.close(fig)
+    assert len(draws) == (2 if below == 2.5 else 1)
     assert got.dtype == np.uint8 and got.shape == want.shape
     assert _same_picture(got, want)
 

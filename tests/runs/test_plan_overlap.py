@@ -318,3 +318,15 @@ def test_the_bench_stage_note_counts_the_overlap_once():
     scope: dict = {"Any": object}
     exec(compile("from __future__ import annotations\n" + planted, "planted", "exec"), scope)
     assert scope["stage_note"](forked, 1.0).endswith("(interpreter, imports, files) -0.10 s")
+
+
+def test_an_answer_over_the_bound_is_an_error_and_leaves_no_worker(monkeypatch):
+    # The parent reads at most the bound (plus one byte) and ends the worker, which would
+    # otherwise wait on a pipe nobody reads; an answer within the bound is read back whole.
+    monkeypatch.setattr(_contracts, "_ANSWER_LIMIT", 1 << 12)
+    kind, value, _ = _contracts._Forked(lambda: b"x" * (1 << 20)).answer()
+    assert kind == "error" and "over" in str(value)
+    assert _no_children()
+    kind, value, (t0, t1) = _contracts._Forked(lambda: b"x" * 100).answer()
+    assert (kind, value) == ("value", b"x" * 100) and t0 <= t1
+    assert _no_children()
