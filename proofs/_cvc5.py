@@ -10,6 +10,12 @@ answer contradicting Z3's is a disagreement, which the caller makes a FAILED ver
 ``Cvc5Pool`` runs the queries in the background (one worker, fed by a thread), so cvc5 works
 on the other core while the prove run goes on with Z3, and runs a text it was given before only
 once (two obligations can state the same VC).
+
+A query runs under a strategy (``STRATEGIES``: cvc5's search options, never its logic or its
+limits), the default one unless proofs/obligations.lock names another for the statement
+(``_pins.cvc5_strategies``, chosen by measurement: bench/tune_cvc5.py, docs/model.md §6.4). The
+worker reads the options back from cvc5 and says which it ran under; an answer under other
+options than asked is not taken.
 """
 
 from __future__ import annotations
@@ -26,7 +32,8 @@ import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
-__all__ = ["CVC5_TIMEOUT_MS", "Cvc5Answer", "Cvc5Pool", "Cvc5Worker", "cvc5_version"]
+__all__ = ["CVC5_TIMEOUT_MS", "DEFAULT_STRATEGY", "STRATEGIES", "Cvc5Answer", "Cvc5Pool",
+           "Cvc5Worker", "cvc5_version", "strategy_flags"]
 
 #: cvc5's time limit per query. A run replays only the statements cvc5 decided when they were
 #: pinned (``_pins.cvc5_skips``: the others' answer is the pinned one), so a query that runs
@@ -38,6 +45,21 @@ CVC5_TIMEOUT_MS = 5_000
 #: query 4.3 -> 2.4 s (``Exact.gap_formula``'s gap, which ran close to the 5 s limit, 0.6 s).
 #: The lock's answers of the queries cvc5 does not decide were pinned under these options.
 OPTIONS: tuple[tuple[str, str], ...] = (("decision", "justification"),)
+#: The strategies a statement can be replayed under, by name: each a set of cvc5 options that
+#: steer its search (the SAT solver's decisions; the nonlinear solver's relevance filter) and
+#: change neither what is asserted, nor the logic, nor the time limit; so an answer under any of
+#: them is cvc5's answer on the same query. Measured over the 291 queries cvc5 decides (CPU, a
+#: process each): no one strategy is the quickest on all (Safety.tool_region's far_vertex: 2.3 s
+#: under justification, 0.1 s under internal; Monitor.reference_speeds' gap_path1: 1.7 s, and a
+#: timeout under internal), so the lock names, per statement, the one measured quickest
+#: (bench/tune_cvc5.py).
+STRATEGIES: dict[str, tuple[tuple[str, str], ...]] = {
+    "justification": OPTIONS,
+    "internal": (("decision", "internal"),),
+    "internal-relevance": (("decision", "internal"), ("nl-rlv", "always")),
+}
+#: A statement the lock names no strategy for runs under this one.
+DEFAULT_STRATEGY = "justification"
 #: How long past its own limit a query may run before the worker is killed.
 _GRACE_S = 1.0
 #: The worker's start-up (importing cvc5), allowed on top on a query that starts it.
@@ -49,6 +71,21 @@ class Cvc5Answer:
     answer: str          # unsat | sat | unknown
     reason: str = ""     # cvc5's explanation of unknown, or why it did not run
     seconds: float = 0.0  # the worker's time on it; 0.0 for an answer shared with an earlier query
+    strategy: str = DEFAULT_STRATEGY   # the options it ran under (STRATEGIES)
+    cpu_seconds: float = 0.0   # the worker's CPU on it (read and solve; what a strategy saves)
+
+
+def strategy_flags(strategy: str) -> str:
+    """cvc5's command-line flags of ``strategy`` (a replay of a saved query: docs/model.md
+    §6.4), e.g. ``--decision=internal --nl-rlv=always``; ValueError for an unknown name."""
+    return " ".join(f"--{k}={v}" for k, v in _options(strategy))
+
+
+def _options(strategy: str) -> tuple[tuple[str, str], ...]:
+    try:
+        return STRATEGIES[strategy]
+    except KeyError:
+        raise ValueError(f"strategy={strategy!r} is not one of {sorted(STRATEGIES)}") from None
 
 
 def cvc5_version() -> str | None:
@@ -89,18 +126,23 @@ class Cvc5Worker:
                     f.close()
             self.proc = None
 
-    def check(self, text: str, timeout_ms: int = CVC5_TIMEOUT_MS) -> Cvc5Answer:
+    def check(self, text: str, timeout_ms: int = CVC5_TIMEOUT_MS,
+              strategy: str = DEFAULT_STRATEGY) -> Cvc5Answer:
+        """cvc5's answer on ``text`` under ``strategy`` (ValueError for an unknown one)."""
+        options = _options(strategy)
         t0 = time.monotonic()
-        a = self._check(text, timeout_ms)
-        return Cvc5Answer(a.answer, a.reason, time.monotonic() - t0)
+        a = self._check(text, timeout_ms, options)
+        return Cvc5Answer(a.answer, a.reason, time.monotonic() - t0, strategy, a.cpu_seconds)
 
-    def _check(self, text: str, timeout_ms: int) -> Cvc5Answer:
+    def _check(self, text: str, timeout_ms: int,
+               options: tuple[tuple[str, str], ...] = OPTIONS) -> Cvc5Answer:
         if cvc5_version() is None:
             return Cvc5Answer("unknown", "cvc5 is not installed")
         proc, started = self._start()
         assert proc.stdin is not None and proc.stdout is not None
         try:
-            proc.stdin.write(json.dumps({"text": text, "ms": timeout_ms}) + "\n")
+            proc.stdin.write(json.dumps({"text": text, "ms": timeout_ms,
+                                         "options": [list(o) for o in options]}) + "\n")
             proc.stdin.flush()
         except (BrokenPipeError, OSError):
             self.close()
@@ -117,7 +159,19 @@ class Cvc5Worker:
             self.close()
             return Cvc5Answer("unknown", "the cvc5 worker died")
         doc = json.loads(line)
-        return Cvc5Answer(doc["answer"], doc.get("reason", ""))
+        return _taken(doc, options)
+
+
+def _taken(doc: dict[str, object], options: tuple[tuple[str, str], ...]) -> Cvc5Answer:
+    """The worker's reply as an answer, if it ran under ``options`` (the values it read back
+    from cvc5, ``ran``); otherwise unknown, saying what it ran under instead."""
+    ran = doc.get("ran")
+    want = {k: v for k, v in options}
+    if doc.get("answer") in ("sat", "unsat") and ran != want:
+        return Cvc5Answer("unknown", f"cvc5 ran under {ran!r}, not the options asked, {want!r}")
+    cpu = doc.get("cpu_s")
+    return Cvc5Answer(str(doc["answer"]), str(doc.get("reason", "")),
+                      cpu_seconds=float(cpu) if isinstance(cpu, (int, float)) else 0.0)
 
 
 class Cvc5Pool:
@@ -135,7 +189,7 @@ class Cvc5Pool:
         self.timeout_ms = timeout_ms
         self._worker = Cvc5Worker()
         self._ex = ThreadPoolExecutor(max_workers=1, thread_name_prefix="cvc5")
-        self._asked: dict[tuple[str, int], Future[Cvc5Answer]] = {}
+        self._asked: dict[tuple[str, int, str], Future[Cvc5Answer]] = {}
         self._lock = threading.Lock()     # so that submit is safe from any thread
 
     @staticmethod
@@ -143,16 +197,19 @@ class Cvc5Pool:
         # The digest, not the text: a pool's life can see every VC of a prove run.
         return hashlib.sha256(text.encode()).hexdigest(), timeout_ms
 
-    def submit(self, text: str, timeout_ms: int | None = None) -> Future[Cvc5Answer]:
-        """Queue ``text``; ``timeout_ms`` (default the pool's) is cvc5's limit on it. A text
-        and limit queued before are not run again (see the class): the Future gets the first
-        one's answer with ``seconds`` 0.0."""
+    def submit(self, text: str, timeout_ms: int | None = None,
+               strategy: str = DEFAULT_STRATEGY) -> Future[Cvc5Answer]:
+        """Queue ``text``; ``timeout_ms`` (default the pool's) is cvc5's limit on it, under
+        ``strategy`` (ValueError now for an unknown one). A text, limit and strategy queued
+        before are not run again (see the class): the Future gets the first one's answer with
+        ``seconds`` 0.0."""
         ms = self.timeout_ms if timeout_ms is None else timeout_ms
-        key = self._key(text, ms)
+        _options(strategy)
+        key = (*self._key(text, ms), strategy)
         with self._lock:
             first = self._asked.get(key)
             if first is None:
-                fut = self._ex.submit(self._worker.check, text, ms)
+                fut = self._ex.submit(self._worker.check, text, ms, strategy)
                 self._asked[key] = fut
                 return fut
         # A Future of its own, so that the time spent counts once in the caller's sums.
@@ -186,16 +243,19 @@ def _serve() -> None:
 
     for line in sys.stdin:
         q = json.loads(line)
+        cpu0 = time.process_time()
         try:
             tm = cvc5.TermManager()
             s = cvc5.Solver(tm)
             s.setOption("tlimit-per", str(int(q["ms"])))
-            for name, value in OPTIONS:
+            options = [tuple(o) for o in q.get("options", OPTIONS)]
+            for name, value in options:
                 s.setOption(name, value)
             p = cvc5.InputParser(s)
             p.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, q["text"], "vc")
             sm = p.getSymbolManager()
             res = None
+            out: dict[str, object]
             while True:
                 cmd = p.nextCommand()
                 if cmd.isNull():
@@ -214,8 +274,12 @@ def _serve() -> None:
                 why = str(res.getUnknownExplanation()).rsplit(".", 1)[-1].lower()
                 out = {"answer": "unknown",
                        "reason": f"{why} at {int(q['ms'])} ms" if why == "timeout" else why}
+            # Read back after the query (which could set options of its own), so the caller
+            # sees what cvc5 ran under (``_taken``).
+            out["ran"] = {name: s.getOption(name) for name, _ in options}
         except Exception as exc:  # noqa: BLE001 - a parse or API error is an answer, not a crash
             out = {"answer": "unknown", "reason": f"cvc5 error: {exc}"}
+        out["cpu_s"] = round(time.process_time() - cpu0, 4)
         sys.stdout.write(json.dumps(out) + "\n")
         sys.stdout.flush()
 

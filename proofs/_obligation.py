@@ -244,6 +244,8 @@ class VCResult:
     #: Z3's resource count on the vacuity check and on the proof check (each in a context of
     #: its own, so a function of the statement alone): what ``_limits`` calibrates from.
     rlimit_count: tuple[int, ...] = ()
+    #: The cvc5 strategy the replay ran under (``_cvc5.STRATEGIES``); "" when not replayed.
+    cvc5_strategy: str = ""
 
 
 @dataclass(frozen=True)
@@ -373,13 +375,15 @@ class _Pending:
 
 
 def discharge_pending(ob: Obligation, pool: Any, skip: dict[str, str] | None = None,
-                      recheck: bool = False) -> _Pending:
+                      recheck: bool = False, strategies: dict[str, str] | None = None
+                      ) -> _Pending:
     """Run one obligation with Z3 (or sympy, or the data check), handing each VC's standard
     SMT-LIB to ``pool`` (a ``_cvc5.Cvc5Pool``) for the replay; the statements in ``skip`` (hash
     -> why: cvc5 did not decide them when they were pinned) are not replayed: their answer is
     the pinned one (``VCResult.cvc5_from_pin``), unless ``recheck`` (``--recheck-undecided``)
-    replays them too (docs/model.md §6). Z3 decides every VC either way. ``settle()`` gives
-    the Proof. Any exception is a FAILED verdict that says why."""
+    replays them too (docs/model.md §6); ``strategies`` (hash -> name, ``_pins.cvc5_strategies``)
+    the cvc5 strategy of a statement, else ``_cvc5.DEFAULT_STRATEGY``. Z3 decides every VC
+    either way. ``settle()`` gives the Proof. Any exception is a FAILED verdict that says why."""
     t0 = time.perf_counter()
     text = ""
     futures: list[Any] = []
@@ -391,7 +395,8 @@ def discharge_pending(ob: Obligation, pool: Any, skip: dict[str, str] | None = N
         texts = _check_texts(query) if isinstance(query, Z3Query) else []
         text = render_query(ob, query, texts)
         if isinstance(query, Z3Query):
-            fields, futures, certs = _run_z3(ob, query, pool, skip or {}, recheck, texts)
+            fields, futures, certs = _run_z3(ob, query, pool, skip or {}, recheck, texts,
+                                             strategies or {})
         else:
             outcome = _guarded(query.run, ob.timeout_ms)
             fields = _check_fields(ob, outcome)
@@ -591,12 +596,13 @@ def _short_text(f: z3.ExprRef, width: int = 50) -> str:
 
 
 def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck: bool = False,
-            texts: Sequence[tuple[str, str]] | None = None
+            texts: Sequence[tuple[str, str]] | None = None,
+            strategies: dict[str, str] | None = None
             ) -> tuple[dict[str, Any], list[Any], list[Any]]:
     """Z3's answers on each VC's vacuity and proof checks (``texts``: their Z3 text,
     ``_check_texts``, printed by the caller; printed here if not given), its depth, statement
     hash and cvc5 replay; the Proof's fields, cvc5's futures and the VCs to certify."""
-    from ._cvc5 import CVC5_TIMEOUT_MS
+    from ._cvc5 import CVC5_TIMEOUT_MS, DEFAULT_STRATEGY, strategy_flags
     from ._depth import NonlinearMemo, deepest, is_nonlinear, vc_depth
     from ._limits import wall_net_ms, z3_rlimit
 
@@ -646,8 +652,11 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
         std, sha, note = standard_smtlib(vc)
         key = vc.name if vc.name not in pins else f"{vc.name}#{len(pins) + 1}"
         pins[key] = sha
+        chosen = (strategies or {}).get(sha, DEFAULT_STRATEGY)
         if std is not None:
-            standard += [f"; VC {vc.name}: proof check (expect {want})",
+            # The replay's options in the comment: `cvc5 <flags> <file>` re-runs it as it ran.
+            standard += [f"; VC {vc.name}: proof check (expect {want}); cvc5 "
+                         + strategy_flags(chosen),
                          std.replace("(exit)\n", "(reset)\n")]
         depth = None
         if ans == z3.unsat and ob.expected is Verdict.PROVED:
@@ -656,7 +665,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
         # A statement cvc5 did not decide when pinned: its pinned answer (the same text gets
         # the same answer), re-run only when asked; a decided one is re-run every time.
         pinned = replay and sha in skip and not recheck
-        futures.append(pool.submit(std) if replay and not pinned else None)
+        strategy = chosen if replay else ""
+        futures.append(pool.submit(std, strategy=strategy) if replay and not pinned else None)
         certs.append(vc if vc.certificate is not None else None)
         cvc5 = why = ""
         if pinned:
@@ -670,7 +680,7 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
                                 solvers=("z3",) if str(ans) == want else (), note=note,
                                 nonlinear=is_nonlinear(hyps + [vc.goal], scanned),
                                 cvc5_from_pin=pinned,
-                                rlimit_count=counts))
+                                rlimit_count=counts, cvc5_strategy=strategy))
     smoke = [_smoke(sm, stats) for sm in q.smoke]      # each in a context of its own
     dead = [r.name for r in smoke if r.answer == "unsat"]
     undecided = [r.name for r in smoke if r.answer == "unknown"]

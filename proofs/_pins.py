@@ -27,7 +27,11 @@ fails every run (``check_kinds``) until the lock is edited by hand, as an expect
 answered on each VC when it was pinned (``cvc5``; not part of the comparison): a run replays
 in cvc5 only the statements cvc5 decided then (``cvc5_skips``: a decided one is a check, re-run
 every time), since the same text gets the same answer; the others' answer is taken from the lock
-and said so per VC; ``--repin`` and ``--recheck-undecided`` replay every one again.
+and said so per VC; ``--repin`` and ``--recheck-undecided`` replay every one again. An entry
+may name, per VC, the cvc5 strategy its replay runs under (``cvc5_strategy``, only where it is
+not ``_cvc5.DEFAULT_STRATEGY``; not part of the comparison): the one measured quickest for that
+statement (bench/tune_cvc5.py), found by the statement's hash (``cvc5_strategies``), so a changed
+statement runs under the default until measured again; ``--repin`` keeps what each VC ran under.
 """
 
 from __future__ import annotations
@@ -38,11 +42,14 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
+from ..errors import InputError
 from ..files import JsonStyle, write_json
+from ._cvc5 import DEFAULT_STRATEGY, STRATEGIES
 from ._obligation import Proof
 
-__all__ = ["LOCK", "KindOf", "Mismatch", "check_kinds", "check_pins", "cvc5_skips", "load_lock",
-           "pin_entry", "pin_key", "repin"]
+__all__ = ["LOCK", "KindOf", "Mismatch", "check_kinds", "check_pins", "cvc5_skips",
+           "cvc5_strategies", "load_lock", "pin_entry", "pin_key", "record_cvc5_strategies",
+           "repin"]
 
 #: The lock file shipped with the package (package data), next to this module.
 LOCK = Path(__file__).with_name("obligations.lock")
@@ -53,7 +60,7 @@ Mismatch = tuple[str, str]     # (obligation id, what differs)
 #: An obligation id -> (its kind, why): proofs/_runner.py's kind_of and DEFINITIONAL.
 KindOf = Callable[[str], tuple[str, str]]
 #: What an entry holds besides its statement (not part of the statement's comparison).
-_NOT_STATEMENT = ("cvc5", "kind", "kind_why")
+_NOT_STATEMENT = ("cvc5", "cvc5_strategy", "kind", "kind_why")
 
 
 def pin_key(ident: str) -> str:
@@ -73,6 +80,10 @@ def pin_entry(p: Proof) -> dict[str, Any]:
         entry["vcs"] = dict(sorted(p.pins.items()))
         entry["cvc5"] = {v.name: v.cvc5 if v.cvc5 in ("sat", "unsat")
                          else f"undecided: {_reason_class(v.cvc5_reason)}" for v in p.vcs}
+        chosen = {v.name: v.cvc5_strategy for v in p.vcs
+                  if v.cvc5_strategy not in ("", DEFAULT_STRATEGY)}
+        if chosen:
+            entry["cvc5_strategy"] = chosen
     return entry
 
 
@@ -105,6 +116,62 @@ def cvc5_skips(lock: dict[str, dict[str, Any]]) -> dict[str, str]:
             if isinstance(a, str) and a.startswith("undecided"):
                 out[sha] = a.removeprefix("undecided: ")
     return out
+
+
+def cvc5_strategies(lock: dict[str, dict[str, Any]], source: str | Path | None = None
+                    ) -> dict[str, str]:
+    """Statement hash -> the cvc5 strategy the lock names for it (``cvc5_strategy``; a
+    statement not named runs under ``_cvc5.DEFAULT_STRATEGY``). InputError (naming ``source``,
+    the lock) for a name that is not one of ``_cvc5.STRATEGIES`` or a VC the entry does not
+    pin."""
+    where = None if source is None else str(source)
+    out: dict[str, str] = {}
+    for key, entry in lock.items():
+        chosen = entry.get("cvc5_strategy") or {}
+        if not isinstance(chosen, dict):
+            raise InputError(f"{key}.cvc5_strategy", chosen, "must map VC names to strategies",
+                             source=where)
+        vcs = entry.get("vcs") or {}
+        for name, strategy in chosen.items():
+            if strategy not in STRATEGIES:
+                raise InputError(f"{key}.cvc5_strategy.{name}", strategy,
+                                 f"is not one of {', '.join(sorted(STRATEGIES))}", source=where)
+            if name not in vcs:
+                raise InputError(f"{key}.cvc5_strategy.{name}", strategy,
+                                 "names a VC the entry does not pin", source=where)
+            out[vcs[name]] = strategy
+    return out
+
+
+def record_cvc5_strategies(choices: dict[tuple[str, str], tuple[str, str]],
+                           path: str | Path | None = None) -> list[str]:
+    """Write into the lock, per (entry key, VC name), the strategy its replay runs under and
+    cvc5's answer under it (``sat``, ``unsat`` or ``undecided: why``), as measured
+    (bench/tune_cvc5.py); the default strategy is written as no entry. Statements and kinds are
+    untouched. Returns a line per change; KeyError for a VC the lock does not pin."""
+    f = Path(path) if path is not None else LOCK
+    doc = json.loads(f.read_text(encoding="utf-8"))
+    obs = doc["obligations"]
+    lines = []
+    for (key, name), (strategy, answer) in sorted(choices.items()):
+        entry = obs[key]
+        if name not in entry.get("vcs", {}):
+            raise KeyError(f"{key} pins no VC {name!r}")
+        chosen = dict(entry.get("cvc5_strategy") or {})
+        before = (chosen.get(name, DEFAULT_STRATEGY), entry.get("cvc5", {}).get(name))
+        if strategy == DEFAULT_STRATEGY:
+            chosen.pop(name, None)
+        else:
+            chosen[name] = strategy
+        if chosen:
+            entry["cvc5_strategy"] = chosen
+        else:
+            entry.pop("cvc5_strategy", None)
+        entry.setdefault("cvc5", {})[name] = answer
+        if before != (strategy, answer):
+            lines.append(f"{key} {name}: {before[0]} ({before[1]}) -> {strategy} ({answer})")
+    write_json(f, doc, JsonStyle.LOCK, ascii_only=False, allow_nan=True)   # keys sorted
+    return lines
 
 
 def load_lock(path: str | Path | None = None) -> dict[str, dict[str, Any]]:

@@ -36,7 +36,7 @@ from ._controls import Control, ControlResult, run_control
 from ._ledger import ASSUMPTIONS, Assumption
 from ._obl_scenario import CHECKS, scenario_check_id, scenario_files, scenario_obligations
 from ._obligation import Method, Obligation, Proof, Verdict, discharge_pending, failed_proof
-from ._pins import LOCK, Mismatch, check_kinds, check_pins, cvc5_skips, load_lock
+from ._pins import LOCK, Mismatch, check_kinds, check_pins, cvc5_skips, cvc5_strategies, load_lock
 from ._pins import repin as repin_lock
 from ._registry import (
     COLLECTORS,
@@ -214,6 +214,9 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
     # cvc5 replays the statements it decided when they were pinned; the undecided ones' answer
     # is the pinned one (--repin: every one replayed; --recheck-undecided: those too).
     skip = {} if repin else cvc5_skips(load_lock(lock_path))
+    # The strategy each statement's replay runs under (the lock's choice, also with --repin,
+    # which then writes it back: a choice is changed by measuring, bench/tune_cvc5.py).
+    strategies = cvc5_strategies(load_lock(lock_path), lock_path)
     t0 = time.perf_counter()
     told = GroupProgress(obligations, progress)
     if workers > 1 and len(obligations) + len(controls) > 1:
@@ -225,9 +228,11 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
         cost.update((i, float(o.get("seconds") or 0.0)) for i, o in previous.items())
         cost.update(_previous_control_seconds(out / "results.json"))
         proofs, checked = _discharge_side_by_side(obligations, skip, workers, cost, told,
-                                                  recheck=recheck_undecided, controls=controls)
+                                                  recheck=recheck_undecided, controls=controls,
+                                                  strategies=strategies)
     else:
-        proofs = _discharge_in_turn(obligations, skip, told, recheck=recheck_undecided)
+        proofs = _discharge_in_turn(obligations, skip, told, recheck=recheck_undecided,
+                                    strategies=strategies)
         checked = tuple(run_control(c) for c in controls)
         if controls:
             told.line("negative controls", len(checked), sum(c.seconds for c in checked))
@@ -303,7 +308,8 @@ class GroupProgress:
 
 
 def _discharge_in_turn(obligations: Sequence[Obligation], skip: dict[str, str],
-                       told: GroupProgress, recheck: bool = False) -> tuple[Proof, ...]:
+                       told: GroupProgress, recheck: bool = False,
+                       strategies: dict[str, str] | None = None) -> tuple[Proof, ...]:
     """Each obligation discharged in this process, one after another, cvc5 replaying behind Z3;
     each settled (``_Pending.settle``, the same Proof whenever it is called) as soon as its
     replays are done, so that a group's line comes when the group is, not at the end."""
@@ -319,7 +325,7 @@ def _discharge_in_turn(obligations: Sequence[Obligation], skip: dict[str, str],
 
     with Cvc5Pool() as pool:
         for i, o in enumerate(obligations):
-            pending[i] = discharge_pending(o, pool, skip, recheck)
+            pending[i] = discharge_pending(o, pool, skip, recheck, strategies)
             for j in [j for j, p in pending.items()
                       if all(f is None or f.done() for f in p.futures)]:
                 settle(j)
@@ -348,12 +354,14 @@ def _worker_start() -> None:
 
 def _worker_discharge(index: int) -> Proof:
     ob = _SHARED["obligations"][index]
-    return discharge_pending(ob, _SHARED["pool"], _SHARED["skip"], _SHARED["recheck"]).settle()
+    return discharge_pending(ob, _SHARED["pool"], _SHARED["skip"], _SHARED["recheck"],
+                             _SHARED["strategies"]).settle()
 
 
 def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, str], jobs: int,
                             cost: dict[str, float], told: GroupProgress | None = None,
-                            recheck: bool = False, controls: Sequence[Control] = ()
+                            recheck: bool = False, controls: Sequence[Control] = (),
+                            strategies: dict[str, str] | None = None
                             ) -> tuple[tuple[Proof, ...], tuple[ControlResult, ...]]:
     """Each obligation discharged, and each control run, in one of ``jobs`` forked processes,
     the longest (by the last run's seconds, ``cost`` by id) first so that they finish
@@ -366,7 +374,8 @@ def _discharge_side_by_side(obligations: Sequence[Obligation], skip: dict[str, s
     tasks = [("ob", i, obligations[i].id) for i in range(len(obligations))]
     tasks += [("control", j, controls[j].id) for j in range(len(controls))]
     tasks.sort(key=lambda t: -cost.get(t[2], 0.0))        # stable: the given order on ties
-    _SHARED.update(obligations=obligations, skip=skip, recheck=recheck, controls=controls)
+    _SHARED.update(obligations=obligations, skip=skip, recheck=recheck, controls=controls,
+                   strategies=strategies)
     out: list[Proof | None] = [None] * len(obligations)
     checked: list[ControlResult | None] = [None] * len(controls)
     try:
@@ -470,7 +479,8 @@ def _proof_json(p: Proof, ob: Obligation, change: str) -> dict[str, Any]:
         "vcs": [{"name": v.name, "vacuity": v.vacuity, "answer": v.answer, "depth": v.depth,
                  "sha256": v.sha256, "solvers": list(v.solvers), "cvc5": v.cvc5,
                  "cvc5_reason": v.cvc5_reason, "note": v.note, "nonlinear": v.nonlinear,
-                 "cvc5_from_pin": v.cvc5_from_pin, "rlimit_count": list(v.rlimit_count)}
+                 "cvc5_from_pin": v.cvc5_from_pin, "rlimit_count": list(v.rlimit_count),
+                 "cvc5_strategy": v.cvc5_strategy}
                 for v in p.vcs],
         "cvc5_tally": cvc5_tally(p),
         "depth": p.depth, "label": p.label, "solvers": list(p.solvers),

@@ -365,11 +365,12 @@ def test_a_group_is_told_as_it_ends_not_at_the_end(tmp_path: Path, monkeypatch):
     assert seen == [lines[0] + "\n"]
 
     # Seeded fault: every obligation settled only once all are discharged (the lines at the end).
-    def at_the_end(obligations, skip, told, recheck=False):
+    def at_the_end(obligations, skip, told, recheck=False, strategies=None):
         from cfmpa.proofs._cvc5 import Cvc5Pool
         from cfmpa.proofs._obligation import discharge_pending
         with Cvc5Pool() as pool:
-            pending = [discharge_pending(o, pool, skip) for o in obligations]
+            pending = [discharge_pending(o, pool, skip, strategies=strategies)
+                       for o in obligations]
         proofs = tuple(p.settle() for p in pending)
         for o, p in zip(obligations, proofs):
             told.done(o, p)

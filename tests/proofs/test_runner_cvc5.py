@@ -11,6 +11,7 @@ import time
 from concurrent.futures import Future
 from pathlib import Path
 
+import pytest
 import z3
 
 from cfmpa.proofs import (
@@ -43,9 +44,12 @@ class _Pool:
     def __init__(self, answer: str = "unsat") -> None:
         self.answer = answer
         self.asked: list[int | None] = []
+        self.strategies: list[str] = []
 
-    def submit(self, text: str, timeout_ms: int | None = None) -> Future:
+    def submit(self, text: str, timeout_ms: int | None = None,
+               strategy: str = "justification") -> Future:
         self.asked.append(timeout_ms)
+        self.strategies.append(strategy)
         f: Future = Future()
         f.set_result(Cvc5Answer(self.answer, ""))
         return f
@@ -186,3 +190,45 @@ def test_with_no_last_run_the_longest_time_limit_goes_first(tmp_path: Path):
     run = run_obligations(obs, tmp_path / "fresh", [o.id for o in obs], workers=2)
     assert [p.verdict for p in run.proofs] == [Verdict.PROVED] * 4
     assert "D.3" in log.read_text().split()[:2]      # given last, started first
+
+
+def test_a_statement_replays_under_the_strategy_the_lock_names(tmp_path: Path, monkeypatch):
+    import cfmpa.proofs._cvc5 as cvc5_mod
+    from cfmpa.errors import InputError
+
+    pool = _Pool()
+    monkeypatch.setattr(cvc5_mod, "Cvc5Pool", lambda: _Pool_cm(pool))
+    lock = tmp_path / "obligations.lock"
+    run_obligations([_ob()], tmp_path / "r", ["T.cvc5"], lock=lock, repin=True)
+    doc = json.loads(lock.read_text())
+    assert "cvc5_strategy" not in doc["obligations"]["T.cvc5"]     # the default is not written
+    assert pool.strategies == ["justification"] * 2
+    doc["obligations"]["T.cvc5"]["cvc5_strategy"] = {"b": "internal"}
+    lock.write_text(json.dumps(doc))
+    pool.strategies.clear()
+    run = run_obligations([_ob()], tmp_path / "r", ["T.cvc5"], lock=lock)
+    # Not part of the statement: no pin mismatch; b ran under the lock's choice, a the default.
+    assert run.ok and pool.strategies == ["justification", "internal"]
+    res = json.loads((tmp_path / "r" / "results.json").read_text())
+    (entry,) = [o for o in res["obligations"] if o["id"] == "T.cvc5"]
+    assert [v["cvc5_strategy"] for v in entry["vcs"]] == ["justification", "internal"]
+    # --repin keeps what each statement ran under.
+    run_obligations([_ob()], tmp_path / "r", ["T.cvc5"], lock=lock, repin=True)
+    assert json.loads(lock.read_text())["obligations"]["T.cvc5"]["cvc5_strategy"] == {
+        "b": "internal"}
+    # Seeded faults in the lock: a strategy that does not exist, a VC the entry does not pin.
+    for bad, what in (({"b": "fast"}, "T.cvc5.cvc5_strategy.b is not one of"),
+                      ({"c": "internal"}, "names a VC the entry does not pin")):
+        doc["obligations"]["T.cvc5"]["cvc5_strategy"] = bad
+        lock.write_text(json.dumps(doc))
+        with pytest.raises(InputError, match=what) as err:
+            run_obligations([_ob()], tmp_path / "r", ["T.cvc5"], lock=lock)
+        assert str(lock) in str(err.value)
+
+
+def test_a_changed_statement_runs_under_the_default_strategy():
+    sha = _shas()
+    pool = _Pool()
+    discharge_pending(_ob(), pool, {}, strategies={sha["a"]: "internal-relevance",
+                                                   "0" * 64: "internal"}).settle()
+    assert pool.strategies == ["internal-relevance", "justification"]

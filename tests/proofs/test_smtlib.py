@@ -108,7 +108,7 @@ def test_a_run_records_which_solvers_confirm_each_vc():
 class _Liar:
     """A second solver that answers sat to everything: a disagreement on every proved VC."""
 
-    def submit(self, text: str) -> Future:
+    def submit(self, text: str, strategy: str = "justification") -> Future:
         f: Future = Future()
         f.set_result(Cvc5Answer("sat", ""))
         return f
@@ -145,7 +145,7 @@ def test_an_sos_certificate_confirms_where_cvc5_does_not():
     vc = VC("amgm", (), 2 * x * y <= x * x + y * y, certificate=cert)
 
     class _Unknown:
-        def submit(self, text: str) -> Future:
+        def submit(self, text: str, strategy: str = "justification") -> Future:
             f: Future = Future()
             f.set_result(Cvc5Answer("unknown", "timeout"))
             return f
