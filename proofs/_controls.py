@@ -29,9 +29,11 @@ condition, must end ``error``.
 
 Premise controls: for each ``Safety.<variant>.composition`` and each of its hypotheses that is
 not an instance of a proved lemma, the composition without it. Expected: not proved, i.e. Z3
-finds a counter-model (``refuted``; with the composition's one-cell pins, then without them) or
-does not decide it within the control's budget (``unknown``: weaker evidence, said so). The
-budget is Z3's resource count (``PREMISE_PINNED_RLIMIT``, ``PREMISE_FREE_RLIMIT``), not the
+finds a counter-model (``refuted``; with the premise's own pins where
+``PREMISE_COUNTER_WITNESSES`` has some, then with the composition's one-cell pins, then without
+pins) or does not decide it within the control's budget (``unknown``: weaker evidence, said
+so). The budget is Z3's resource count (``PREMISE_OWN_RLIMIT``, ``PREMISE_PINNED_RLIMIT``,
+``PREMISE_FREE_RLIMIT``), not the
 wall clock (kept only as a safety net), so which controls end ``unknown`` does not depend on
 the machine's load. An
 instance of a proved lemma ("by time_step at t", "by motion at the step k") is a valid fact:
@@ -68,19 +70,58 @@ from ..spec import (
 from ._control_base import Control, ControlNotMade, _case, _rejected, _require
 from ._controls_wiring import wiring_controls, wiring_positive_controls
 
-__all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_FREE_MS", "PREMISE_FREE_RLIMIT",
+__all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_COUNTER_WITNESSES",
+           "PREMISE_FREE_MS", "PREMISE_FREE_RLIMIT", "PREMISE_OWN_MS", "PREMISE_OWN_RLIMIT",
            "PREMISE_PINNED_MS", "PREMISE_PINNED_RLIMIT", "checker_controls", "collect_controls",
-           "harness_controls", "positive_controls", "premise_controls", "run_control"]
+           "harness_controls", "positive_controls", "premise_controls", "premise_pins",
+           "run_control"]
 
 #: Z3's budget per premise control: with the composition's pins, then without them. The
 #: resource limits decide (deterministic: the same answer however loaded the machine); the
 #: wall-clock limits are a safety net only. With the pins, every counter-model of the bundled
 #: compositions is found within 1 250 000 (and every pinned check shown unsat within 550 000);
-#: without them, none of the six left is decided within 6 000 000.
+#: without them, none of the six left was decided within 6 000 000 (four of them now refuted
+#: by their own pins, below; the two of tight have no counter-model).
 PREMISE_PINNED_RLIMIT = 2_500_000
 PREMISE_FREE_RLIMIT = 1_000_000
 PREMISE_PINNED_MS = 10_000
 PREMISE_FREE_MS = 10_000
+#: Z3's budget for a premise's own pins (``PREMISE_COUNTER_WITNESSES``), tried first: each
+#: bundled one gives its counter-model within 110 000; one that no longer does (a statement
+#: changed) costs at most this before the one-cell pins are tried, as without it.
+PREMISE_OWN_RLIMIT = 500_000
+PREMISE_OWN_MS = 10_000
+
+#: A value as the pins write it: an integer, or a rational as text ("1/2").
+PinValue = int | str
+
+#: The principal's first joint from 0 to 3 at unit speed, unit steps (so Tf = 3), N = 3, at
+#: t = 0 (layer 0). The rest layer's box, layer N-1's (original [1, 3], modified [2, 3]), does not
+#: hold theta_L(0) = (0, 0): without the premise that places the principal's links (or tool) in
+#: layer k's regions, no hypothesis places them in a region BuiltDR tested, and a point of both
+#: arms is a counter-model. With one layer (the one-cell pins) the rest box is layer 0's and
+#: holds theta_L(t), and with two the original rest box [0, 2] does: no counter-model there.
+_THREE_LAYERS: tuple[tuple[str, PinValue], ...] = (
+    ("N", 3), ("dt", 1), ("L.omega.x", 1), ("L.omega.y", 1), ("L.start.x", 0),
+    ("L.start.y", 0), ("L.goal.x", 3), ("L.goal.y", 0), ("t", 0), ("kk", 0))
+_LINKS_IN_LAYER = ("(c) Safety.region_soundness: links 1 and 2 of the principal at theta_L(t) in "
+                   "layer k's regions (its box, k < N; at p)")
+_TOOL_IN_LAYER = ("(c) Safety.tool_region: the principal's tool at theta_L(t) in layer k's region "
+                  "(its box, k < N; at p)")
+
+#: Per-premise counter-model pins (docs/model.md §10.3): (variant, the hypothesis's name) ->
+#: (constant's name, value) pairs, which replace the one-cell pins of the same constants and
+#: join the others. Keyed by name, so a reordered composition cannot pin the wrong premise; a
+#: name no composition has is an error (``premise_pins``). Found by reasoning about what the
+#: dropped premise constrains, each checked by Z3 (tests/proofs/test_premise_pins.py). The
+#: tight composition needs neither ``omega_q > 0`` nor Tf's definition (its box is theta_L's
+#: own hull and its rest box the goal, whatever Tf is): no counter-model exists there.
+PREMISE_COUNTER_WITNESSES: dict[tuple[str, str], tuple[tuple[str, PinValue], ...]] = {
+    ("original", _LINKS_IN_LAYER): _THREE_LAYERS,
+    ("original", _TOOL_IN_LAYER): _THREE_LAYERS,
+    ("modified", _LINKS_IN_LAYER): _THREE_LAYERS,
+    ("modified", _TOOL_IN_LAYER): _THREE_LAYERS,
+}
 
 
 @dataclass(frozen=True)
@@ -313,18 +354,102 @@ def _composition(variant: str) -> Any:
     return composition_vc(variant)
 
 
+Pins = tuple[tuple[z3.ExprRef, z3.ExprRef], ...]
+
+
+def _constants(vc: Any) -> dict[str, z3.ExprRef]:
+    """The constants the composition's hypotheses and goal name, by name (a walk of its terms:
+    about 0.05 s, so only for a name its own pins do not give)."""
+    out: dict[str, z3.ExprRef] = {}
+    seen: set[int] = set()
+    stack = [h for _, h in vc.hypotheses] + [vc.goal]
+    while stack:
+        e = stack.pop()
+        if e.get_id() in seen:
+            continue
+        seen.add(e.get_id())
+        if z3.is_quantifier(e):
+            stack.append(e.body())
+        elif z3.is_const(e) and e.decl().kind() == z3.Z3_OP_UNINTERPRETED:
+            out[e.decl().name()] = e
+        else:
+            stack.extend(e.children())
+    return out
+
+
+def premise_pins(vc: Any, variant: str,
+                 table: dict[tuple[str, str], tuple[tuple[str, PinValue], ...]] | None = None
+                 ) -> dict[int, Pins]:
+    """The own pins of ``vc``'s premises (``table``, by default ``PREMISE_COUNTER_WITNESSES``,
+    its entries for ``variant``), by the premise's index now: each hypothesis found by its name,
+    each constant by its name, the one-cell pins of other constants kept (in their order, then
+    the own ones). A name ``vc`` lacks, a lemma's instance (not a control) or a value of no
+    number raises KeyError or ValueError naming it."""
+    entries = {name: pins for (v, name), pins in (
+        PREMISE_COUNTER_WITNESSES if table is None else table).items() if v == variant}
+    if not entries:
+        return {}
+    names = [n for n, _ in vc.hypotheses]
+    consts = {c.decl().name(): c for c, _ in (*vc.witness, *vc.counter_witness)}
+    out: dict[int, Pins] = {}
+    for name, pins in entries.items():
+        where = [i for i, n in enumerate(names) if n == name]
+        if len(where) != 1:
+            raise KeyError(f"PREMISE_COUNTER_WITNESSES: {vc.name} has {len(where)} hypotheses "
+                           f"named {name!r} (one expected)")
+        if name.startswith(LEMMA_INSTANCE):
+            raise KeyError(f"PREMISE_COUNTER_WITNESSES: {vc.name}'s {name!r} is a lemma's "
+                           "instance, not a premise control")
+        own: list[tuple[z3.ExprRef, z3.ExprRef]] = []
+        for cname, value in pins:
+            if cname not in consts:
+                consts = _constants(vc) | consts
+            if cname not in consts:
+                raise KeyError(f"PREMISE_COUNTER_WITNESSES: {vc.name} has no constant "
+                               f"{cname!r} (pins of {name!r})")
+            c = consts[cname]
+            try:
+                v = z3.IntVal(value) if c.sort() == z3.IntSort() else z3.RealVal(value)
+            except Exception as exc:  # noqa: BLE001 - z3 raises several kinds on a bad number
+                raise ValueError(f"PREMISE_COUNTER_WITNESSES: {cname} = {value!r} (pins of "
+                                 f"{name!r}) is not a number of its sort") from exc
+            own.append((c, v))
+        mine = {c.decl().name() for c, _ in own}
+        out[where[0]] = tuple((c, v) for c, v in vc.counter_witness
+                              if c.decl().name() not in mine) + tuple(own)
+    return out
+
+
+@functools.cache
+def _own_pins(variant: str) -> dict[int, Pins]:
+    return premise_pins(_composition(variant), variant)
+
+
 @functools.cache
 def _composition_text(variant: str) -> Any:
-    """Z3's text of the composition's hypotheses, its negated goal and its one-cell pins,
-    printed once a process (``_z3text.Printed``): each control's two checks are cut from it."""
+    """Z3's text of the composition's hypotheses, its negated goal, its one-cell pins and its
+    premises' own pins (each equation once), printed once a process (``_z3text.Printed``): each
+    control's checks are cut from it."""
     from ._z3text import Printed
 
     vc = _composition(variant)
-    return Printed([h for _, h in vc.hypotheses] + [z3.Not(vc.goal)]
-                   + [c == v for c, v in vc.counter_witness])
+    formulas = [h for _, h in vc.hypotheses] + [z3.Not(vc.goal)]
+    formulas += [c == v for c, v in vc.counter_witness]
+    ids = {f.get_id() for f in formulas}           # hash-consed: an equal formula, an equal id
+    for pins in _own_pins(variant).values():
+        for c, v in pins:
+            if (c == v).get_id() not in ids:
+                formulas.append(c == v)
+                ids.add(formulas[-1].get_id())
+    return Printed(formulas)
 
 
-def _without(variant: str, index: int) -> tuple[str, str]:
+def _without(variant: str, index: int, own: Sequence[tuple[str, PinValue]] | None = None
+             ) -> tuple[str, str]:
+    """The composition of ``variant`` without hypothesis ``index``: Z3 with the premise's own
+    pins (``own``, a test's, else ``PREMISE_COUNTER_WITNESSES``'s), then the one-cell pins,
+    then none; ``refuted`` at the first sat, ``proved`` if unsat without pins, else
+    ``unknown``."""
     from ._limits import wall_net_ms
     from ._obligation import _solver, _why_unknown
 
@@ -333,17 +458,26 @@ def _without(variant: str, index: int) -> tuple[str, str]:
     n = len(vc.hypotheses)
     rest = [h for i, (_, h) in enumerate(vc.hypotheses) if i != index]
     kept = [i for i in range(n) if i != index] + [n]        # the other hypotheses, the goal
+    if own is None:
+        mine = _own_pins(variant).get(index)
+    else:
+        mine = premise_pins(vc, variant, {(variant, vc.hypotheses[index][0]): tuple(own)})[index]
+    tries: list[tuple[str, Pins, int, int]] = []
+    if mine is not None:
+        tries.append(("with the premise's own pins", mine, PREMISE_OWN_MS, PREMISE_OWN_RLIMIT))
+    tries += [("with the one-cell pins", tuple(vc.counter_witness), PREMISE_PINNED_MS,
+               PREMISE_PINNED_RLIMIT), ("without pins", (), PREMISE_FREE_MS, PREMISE_FREE_RLIMIT)]
     answers = []
-    for label, pins, ms, rlimit in (
-            ("with the one-cell pins", vc.counter_witness, PREMISE_PINNED_MS,
-             PREMISE_PINNED_RLIMIT),
-            ("without pins", (), PREMISE_FREE_MS, PREMISE_FREE_RLIMIT)):
-        # The same text as printing these formulas, byte for byte (Z3's search depends on it).
-        text = printed.text(kept + [n + 1 + k for k in range(len(pins))])
+    for label, pins, ms, rlimit in tries:
+        eqs = [c == v for c, v in pins]
+        # The same text as printing these formulas, byte for byte (Z3's search depends on it);
+        # a test's own pins are printed for the check.
+        at = [next((k for k in range(n + 1, len(printed.formulas))
+                    if z3.eq(printed.formulas[k], e)), -1) for e in eqs]
+        text = printed.text(kept + at) if -1 not in at and at == sorted(at) else None
         # The resource limit decides; the wall clock, as for the obligations' checks, is only a
         # net, made as much longer (a loaded machine once stopped without[35] at 10 s).
-        s = _solver(wall_net_ms(ms, rlimit),
-                    formulas=rest + [z3.Not(vc.goal)] + [c == v for c, v in pins],
+        s = _solver(wall_net_ms(ms, rlimit), formulas=rest + [z3.Not(vc.goal)] + eqs,
                     text=text, rlimit=rlimit)
         r = s.check()
         if r == z3.sat:
@@ -366,6 +500,7 @@ def premise_controls() -> list[Control]:
 
     out = []
     for v in VARIANTS:
+        _own_pins(v)        # a pin keyed to a name the composition lacks fails here
         for i, (name, _) in enumerate(_composition(v).hypotheses):
             if name.startswith(LEMMA_INSTANCE):
                 continue

@@ -118,6 +118,12 @@ class VC:
     #: A sum-of-squares certificate of the goal from the hypotheses (``_sos.Certificate``),
     #: checked by sympy where cvc5 does not decide the VC.
     certificate: Any = None
+    #: The Z3 tactic whose solver runs the proof check, where Z3's default solver was measured
+    #: slow on this VC (docs/model.md §6.1), with its parameters (``z3_tactic_params``: name,
+    #: bool or int); None: Z3's default solver. How the check is run, not what it states: the
+    #: statement and its hash are the same; the saved query shows it (``(check-sat-using)``).
+    z3_tactic: str | None = None
+    z3_tactic_params: tuple[tuple[str, bool | int], ...] = ()
 
     def without(self, premise: str) -> VC:
         """This VC with one hypothesis removed (for negative tests)."""
@@ -450,10 +456,12 @@ def standard_smtlib(vc: VC) -> tuple[str | None, str, str]:
 
 def _solver(timeout_ms: int, ctx: z3.Context | None = None,
             formulas: Sequence[z3.BoolRef] = (), text: str | None = None,
-            rlimit: int | None = None) -> z3.Solver:
+            rlimit: int | None = None, tactic: str | None = None,
+            tactic_params: Sequence[tuple[str, bool | int]] = ()) -> z3.Solver:
     """A solver with a timeout; given ``formulas``, in a context of its own holding them, rebuilt
     from their SMT-LIB text (``text``, when the caller has printed it already: ``_text_of`` of
-    the same formulas, which it must be).
+    the same formulas, which it must be). ``tactic``: the solver of that Z3 tactic, given
+    ``tactic_params`` (``VC.z3_tactic``), instead of Z3's default solver; the same limits.
 
     Z3's search on quantified VCs depends on the order of the terms it holds: a VC proved in
     0.1 s ran out of its 20 s once a vacuity check had run in the same context, or after other
@@ -469,7 +477,11 @@ def _solver(timeout_ms: int, ctx: z3.Context | None = None,
         parsed = list(z3.parse_smt2_string(text, ctx=ctx))
         if len(parsed) != len(formulas):
             raise AssertionError(f"re-read {len(parsed)} assertions of {len(formulas)}")
-    s = z3.Solver(ctx=ctx)
+    if tactic is None:
+        s = z3.Solver(ctx=ctx)
+    else:
+        t = z3.Tactic(tactic, ctx=ctx)
+        s = (z3.With(t, **dict(tactic_params)) if tactic_params else t).solver()
     s.set("timeout", timeout_ms)
     if rlimit is not None:
         # Z3's resource limit, counted from where the check starts: deterministic, so the
@@ -638,7 +650,8 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
         elif vac == z3.unknown:
             unknowns.append(f"{vc.name} (vacuity check): {_why_unknown(s, limit)}")
         # The proof: hypotheses and the negated goal must have no model.
-        s = _solver(net, formulas=hyps + [z3.Not(vc.goal)], text=proof_text, rlimit=limit)
+        s = _solver(net, formulas=hyps + [z3.Not(vc.goal)], text=proof_text, rlimit=limit,
+                    tactic=vc.z3_tactic, tactic_params=vc.z3_tactic_params)
         ans = s.check()
         _stats(s, stats)
         counts = (vac_count, rlimit_count(s))
@@ -803,6 +816,18 @@ def _check_texts(query: Z3Query) -> list[tuple[str, str]]:
     return out
 
 
+def check_command(vc: VC) -> str:
+    """The SMT-LIB command that runs ``vc``'s proof check as ``_run_z3`` does: ``(check-sat)``
+    on Z3's default solver, or ``(check-sat-using T)`` with its tactic and parameters."""
+    if vc.z3_tactic is None:
+        return "(check-sat)"
+    if not vc.z3_tactic_params:
+        return f"(check-sat-using {vc.z3_tactic})"
+    opts = " ".join(f":{k} {str(v).lower() if isinstance(v, bool) else v}"
+                    for k, v in vc.z3_tactic_params)
+    return f"(check-sat-using (using-params {vc.z3_tactic} {opts}))"
+
+
 def render_query(ob: Obligation, query: Query,
                  texts: Sequence[tuple[str, str]] | None = None) -> str:
     """The replayable text of an obligation: SMT-LIB for Z3 (one block per check, then (reset)),
@@ -825,9 +850,11 @@ def render_query(ob: Obligation, query: Query,
     if limit is not None:
         options.append(f"(set-option :rlimit {limit})")
     for vc, pair in zip(query.vcs, texts, strict=True):
-        for label, body in zip(("vacuity (expect sat)", second), pair):
+        # The vacuity check runs on Z3's default solver, the proof check on the VC's tactic.
+        for label, body, check in zip(("vacuity (expect sat)", second), pair,
+                                      ("(check-sat)", check_command(vc))):
             names = ", ".join(n for n, _ in vc.hypotheses) or "none"
             # (reset) rather than push/pop: incremental mode would change Z3's tactics.
             out += ["", f"; VC {vc.name}: {label}; hypotheses: {names}",
-                    *options, body.rstrip(), "(check-sat)", "(reset)"]
+                    *options, body.rstrip(), check, "(reset)"]
     return "\n".join(out) + "\n"
