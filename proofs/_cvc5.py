@@ -1,8 +1,13 @@
 """The second solver: replay a VC's standard SMT-LIB 2.6 proof check in cvc5.
 
 cvc5 runs in a worker process (this module run as a script), fed one query at a time over a
-pipe: its own time limit (``tlimit-per``) is not always honoured by the nonlinear procedures, so
-the worker is killed after the limit plus a grace period and restarted for the next query. The
+pipe. Its limit is CPU time, the worker's own (read from /proc while waiting): on a loaded
+machine a query gets the same CPU before it is stopped as on a quiet one, so whether cvc5
+decides a statement does not depend on the load (a 2.2 s query ran out of a 5 s wall-clock limit
+at a load of 4.6). The worker is killed when it has spent the limit on a query, and restarted for
+the next; cvc5's own time limit (``tlimit-per``, wall clock, and not always honoured by the
+nonlinear procedures) is set to ``_limits.WALL_NET_FACTOR`` times the limit, a net, as the
+parent's wait is. Where /proc cannot be read, the limit is the wall clock, as cvc5's own. The
 answer is cvc5's: ``unsat``, ``sat`` or ``unknown`` with its explanation (``timeout``,
 ``incomplete``, ...), or ``unknown`` with the reason it could not run (``killed after ...``,
 cvc5 not installed, a parse error). Only ``unsat`` confirms a proof (``sat`` a refutation); an
@@ -60,8 +65,10 @@ STRATEGIES: dict[str, tuple[tuple[str, str], ...]] = {
 }
 #: A statement the lock names no strategy for runs under this one.
 DEFAULT_STRATEGY = "justification"
-#: How long past its own limit a query may run before the worker is killed.
+#: How long past its own limit a query may run before the worker is killed (wall-clock mode).
 _GRACE_S = 1.0
+#: How often the parent reads the worker's CPU time while it waits for an answer.
+_POLL_S = 0.05
 #: The worker's start-up (importing cvc5), allowed on top on a query that starts it.
 _START_S = 2.0
 
@@ -140,26 +147,72 @@ class Cvc5Worker:
             return Cvc5Answer("unknown", "cvc5 is not installed")
         proc, started = self._start()
         assert proc.stdin is not None and proc.stdout is not None
+        cpu0 = _cpu_seconds(proc.pid)
+        # With the CPU limit ours, cvc5's own (wall clock) is only the net.
+        wall_ms = timeout_ms if cpu0 is None else timeout_ms * _net_factor()
         try:
-            proc.stdin.write(json.dumps({"text": text, "ms": timeout_ms,
+            proc.stdin.write(json.dumps({"text": text, "ms": timeout_ms, "wall_ms": wall_ms,
                                          "options": [list(o) for o in options]}) + "\n")
             proc.stdin.flush()
         except (BrokenPipeError, OSError):
             self.close()
             return Cvc5Answer("unknown", "the cvc5 worker died")
-        limit = timeout_ms / 1000 + _GRACE_S + (_START_S if started else 0.0)
-        t0 = time.monotonic()
-        ready, _, _ = select.select([proc.stdout], [], [], limit)
-        if not ready:
+        why = _wait(proc, timeout_ms, started, cpu0)
+        if why:
             self.close()
-            return Cvc5Answer("unknown", f"killed after {time.monotonic() - t0:.1f} s "
-                              f"(cvc5 overran its {timeout_ms} ms limit)")
+            return Cvc5Answer("unknown", why)
         line = proc.stdout.readline()
         if not line:
             self.close()
             return Cvc5Answer("unknown", "the cvc5 worker died")
         doc = json.loads(line)
         return _taken(doc, options)
+
+
+def _net_factor() -> int:
+    from ._limits import WALL_NET_FACTOR
+
+    return WALL_NET_FACTOR
+
+
+def _cpu_seconds(pid: int) -> float | None:
+    """The CPU time (user + system) process ``pid`` has spent, from /proc; None where it cannot
+    be read (not Linux, or the process gone)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            stat = f.read(4096)
+        # The fields after the command's closing parenthesis (the command may hold spaces).
+        fields = stat[stat.rindex(b")") + 2:].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def _wait(proc: subprocess.Popen[str], timeout_ms: int, started: bool,
+          cpu0: float | None) -> str:
+    """Wait for the worker's answer to the query just sent: "" once it can be read, else why it
+    was stopped. ``cpu0``: the worker's CPU time before the query (None: the wall clock is the
+    limit, with ``_GRACE_S`` for cvc5's own to act first). A worker just started may spend
+    ``_START_S`` more (importing cvc5)."""
+    assert proc.stdout is not None
+    extra = _START_S if started else 0.0
+    t0 = time.monotonic()
+    if cpu0 is None:
+        ready, _, _ = select.select([proc.stdout], [], [], timeout_ms / 1000 + _GRACE_S + extra)
+        return "" if ready else (f"killed after {time.monotonic() - t0:.1f} s "
+                                 f"(cvc5 overran its {timeout_ms} ms limit)")
+    net = timeout_ms / 1000 * _net_factor() + _GRACE_S + extra
+    while True:
+        ready, _, _ = select.select([proc.stdout], [], [], _POLL_S)
+        if ready:
+            return ""
+        cpu = _cpu_seconds(proc.pid)
+        if cpu is not None and cpu - cpu0 > timeout_ms / 1000 + extra:
+            return (f"killed after {cpu - cpu0:.1f} s of CPU "
+                    f"(cvc5 overran its {timeout_ms} ms limit)")
+        if time.monotonic() - t0 > net:
+            return (f"killed after {time.monotonic() - t0:.1f} s "
+                    f"(cvc5 overran its {timeout_ms} ms limit's wall-clock net)")
 
 
 def _taken(doc: dict[str, object], options: tuple[tuple[str, str], ...]) -> Cvc5Answer:
@@ -247,7 +300,7 @@ def _serve() -> None:
         try:
             tm = cvc5.TermManager()
             s = cvc5.Solver(tm)
-            s.setOption("tlimit-per", str(int(q["ms"])))
+            s.setOption("tlimit-per", str(int(q.get("wall_ms", q["ms"]))))
             options = [tuple(o) for o in q.get("options", OPTIONS)]
             for name, value in options:
                 s.setOption(name, value)

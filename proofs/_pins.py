@@ -87,7 +87,7 @@ def pin_entry(p: Proof) -> dict[str, Any]:
     return entry
 
 
-_KILLED = re.compile(r"killed after [0-9.]+ s \(cvc5 overran its (\d+) ms limit\)")
+_KILLED = re.compile(r"killed after [0-9.]+ s (?:of CPU )?\(cvc5 overran its (\d+) ms limit\)")
 
 
 def _reason_class(reason: str | None) -> str:
