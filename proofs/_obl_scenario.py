@@ -40,7 +40,15 @@ from ..spec import (
     theorem_scope,
 )
 from ..spec import parts as part_indices
-from ._obligation import CheckOutcome, CheckQuery, Method, Obligation, Verdict, check_source
+from ._obligation import (
+    CheckOutcome,
+    CheckQuery,
+    Method,
+    Obligation,
+    Verdict,
+    check_source,
+    spec_closure_source,
+)
 
 __all__ = ["CHECKS", "scenario_check_id", "scenario_files", "scenario_obligations"]
 
@@ -238,6 +246,10 @@ def _query(path: Path, check: Callable[[Scenario], CheckOutcome], what: str
                            search_failures, check_witness, exact_path_gaps,
                            exact_path_gaps.__globals__["path_layer_cells"], path_violations,
                            exact_cells, exact_coverage_failures, is_path_reads)
+        # And the spec's modules they rest on, whole: the every-cell postcondition, the
+        # regions, the witness checker's helpers are called, not named, above.
+        src += "\n" + spec_closure_source(dr_shape_failures, dr_cell_failures, search_failures,
+                                          check_witness, exact_path_gaps, path_violations)
     else:
         src = check_source(check, Grid.time_readings, Grid.spacing_readings, decimal, make_grid,
                            spacing_conditions)

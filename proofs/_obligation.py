@@ -185,6 +185,48 @@ def check_source(*objs: Callable[..., Any]) -> str:
     return "\n".join(source_of(o) for o in objs)
 
 
+def spec_closure_source(*objs: Callable[..., Any]) -> str:
+    """A line per ``cfmpa.spec`` module the objects' modules import, directly or through one
+    another (``spec_closure``), with the sha256 of its whole source: what a check that judges
+    data by these functions rests on, down to the helpers they call, so that editing any of
+    them changes the check's text, a change to review that names the module (docs/model.md
+    §6.4); the hashes, not the sources, keep the saved text small."""
+    import hashlib
+
+    return "\n".join(f"# module {name} sha256 "
+                     + hashlib.sha256(_module_source(name).encode()).hexdigest()
+                     for name in spec_closure(*objs))
+
+
+def spec_closure(*objs: Callable[..., Any]) -> tuple[str, ...]:
+    """The names of the ``cfmpa.spec`` modules ``objs`` are defined in and those they import
+    within the package (its relative imports, at any depth of their code), sorted."""
+    import ast
+    import importlib
+
+    package = importlib.import_module("..spec", __package__).__name__
+    todo = [o.__module__ for o in objs if o.__module__.startswith(package + ".")]
+    seen: set[str] = set()
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        for node in ast.walk(ast.parse(_module_source(name))):
+            if isinstance(node, ast.ImportFrom) and node.level == 1:
+                # from ._x import f  |  from . import _x
+                todo += ([f"{package}.{node.module}"] if node.module else
+                         [f"{package}.{a.name}" for a in node.names])
+    return tuple(sorted(seen))
+
+
+@functools.lru_cache(maxsize=64)
+def _module_source(name: str) -> str:
+    import importlib
+
+    return inspect.getsource(importlib.import_module(name)).rstrip()
+
+
 @functools.lru_cache(maxsize=1024)
 def source_of(obj: Callable[..., Any]) -> str:
     """``inspect.getsource(obj)``, trailing space stripped, read once a process: the seven checks
