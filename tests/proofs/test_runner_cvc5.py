@@ -88,14 +88,20 @@ def test_recheck_undecided_replays_them_on_the_full_budget():
     assert cvc5_tally(pr) == "cvc5 decided 2 of 2 VCs"
 
 
-def test_the_summary_and_results_say_what_was_taken_from_the_lock(tmp_path: Path, monkeypatch):
+def _pinned(tmp_path: Path, monkeypatch) -> tuple[_Pool, Path, dict]:
+    """A stand-in pool in place of Cvc5Pool, and a lock pinned by a --repin run of ``_ob()``
+    through it: (the pool, the lock's path, the lock's JSON)."""
     import cfmpa.proofs._cvc5 as cvc5_mod
 
     pool = _Pool()
     monkeypatch.setattr(cvc5_mod, "Cvc5Pool", lambda: _Pool_cm(pool))
     lock = tmp_path / "obligations.lock"
     run_obligations([_ob()], tmp_path / "r", ["T.cvc5"], lock=lock, repin=True)
-    doc = json.loads(lock.read_text())
+    return pool, lock, json.loads(lock.read_text())
+
+
+def test_the_summary_and_results_say_what_was_taken_from_the_lock(tmp_path: Path, monkeypatch):
+    pool, lock, doc = _pinned(tmp_path, monkeypatch)
     doc["obligations"]["T.cvc5"]["cvc5"]["b"] = "undecided: timeout at 5000 ms"
     lock.write_text(json.dumps(doc))
     pool.asked.clear()
@@ -193,14 +199,9 @@ def test_with_no_last_run_the_longest_time_limit_goes_first(tmp_path: Path):
 
 
 def test_a_statement_replays_under_the_strategy_the_lock_names(tmp_path: Path, monkeypatch):
-    import cfmpa.proofs._cvc5 as cvc5_mod
     from cfmpa.errors import InputError
 
-    pool = _Pool()
-    monkeypatch.setattr(cvc5_mod, "Cvc5Pool", lambda: _Pool_cm(pool))
-    lock = tmp_path / "obligations.lock"
-    run_obligations([_ob()], tmp_path / "r", ["T.cvc5"], lock=lock, repin=True)
-    doc = json.loads(lock.read_text())
+    pool, lock, doc = _pinned(tmp_path, monkeypatch)
     assert "cvc5_strategy" not in doc["obligations"]["T.cvc5"]     # the default is not written
     assert pool.strategies == ["justification"] * 2
     doc["obligations"]["T.cvc5"]["cvc5_strategy"] = {"b": "internal"}
