@@ -14,6 +14,16 @@ written; this process then loads the kernels from the cache as they are called. 
 processes that start cold together (a campaign's workers) wait for one compile. With a warm cache
 it costs a few file reads and prints nothing. docs/model.md §7.5.
 
+A run that finds the cache cold uses the numpy kernels (``numpy_while_cold``). Finding the
+stamps takes numba's import (0.25 s: numba's cache folder and key come from it), pure cost in
+that first run; so a marker file (``_marker_path``: under NUMBA_CACHE_DIR, else this package's
+``__pycache__``), written once every group has been seen warm (after a compile, or by a run
+whose check found none cold), holds a fingerprint that needs no numba (cfmpa's and Python's
+versions, the groups' sources' sizes and times): a run that finds no matching marker is cold
+without importing numba, and the detached compile checks the stamps itself (compiling only
+what is cold) and writes the marker. A matching marker is only a hint: the stamps are checked
+as before. Where the marker's folder cannot be written, the stamps are checked every time.
+
 Loading from a warm cache: numba's FunctionCache refreshes its typing and target registries
 before the first load in a process (it imports and registers every implementation numba has:
 about 0.16 s CPU, a quarter of `cfmpa dr`'s whole process), which only a compile needs. So the
@@ -66,6 +76,8 @@ _READY = [False]          # this process has made sure (or is a compile process 
 _LOCK = threading.Lock()
 _LOADED: list[float] = []
 _NUMPY: list[bool] = []   # decided once per process: the fast kernels were cold (numpy in use)
+#: The marker's file name (see the module docstring).
+_MARKER = "cfmpa-kernels.warm"
 
 
 def ensure_compiled() -> None:
@@ -149,9 +161,20 @@ def numpy_while_cold() -> bool:
     says so, with a count; a later run uses the fast kernels once their stamps are warm."""
     if not _NUMPY:
         mode = os.environ.get(COMPILE_ENV, "background").strip().lower()
-        cold = [] if mode == "wait" or _READY[0] else cold_groups()
+        marker = _marker_path()
+        unseen = False
+        if mode == "wait" or _READY[0]:
+            cold = []
+        elif marker is not None and not _marker_matches(marker):
+            # Never seen warm here: cold, decided without numba's import (the detached
+            # compile checks the stamps and compiles only what is cold).
+            cold, unseen = list(GROUPS), True
+        else:
+            cold = cold_groups()
+            if not cold:
+                _write_marker()          # a cache warmed before the marker existed
         if cold:
-            started = _start_background(cold)
+            started = _start_background(cold, check_lock=not unseen)
             groups = f"{len(cold)} group{'s' if len(cold) > 1 else ''}"
             print(f"cfmpa: fast kernels not compiled for this machine yet: {groups} "
                   f"{'compiling' if started else 'being compiled'} in the background; this "
@@ -282,6 +305,8 @@ def _compile_cold() -> None:
             _warm(name)
         for name in cold:
             _write_stamp(name)
+        if not cold_groups():
+            _write_marker()
         print(f"cfmpa: fast kernels compiled in {time.perf_counter() - t0:.1f} s "
               "(cached for later runs)", file=sys.stderr, flush=True)
 
@@ -307,12 +332,14 @@ def _lock_free(folder: Path | None) -> bool:
     return True
 
 
-def _start_background(cold: list[str]) -> bool:
+def _start_background(cold: list[str], check_lock: bool = True) -> bool:
     """Start a detached process (its own session, lowest priority) that takes the compile lock
     and compiles the groups still cold then, as ``_compile_cold`` does (a process per group,
-    the stamps written); False when another holds the lock (a compile is under way) or the
-    process could not start (the next run tries again)."""
-    if not _lock_free(_cache_dir(_module(cold[0]))):
+    the stamps written, then the marker); False when another holds the lock (a compile is under
+    way: ``check_lock``, which imports numba to find the lock) or the process could not start
+    (the next run tries again). Without ``check_lock`` a second process started while a
+    compile runs waits for its lock, then finds nothing cold."""
+    if check_lock and not _lock_free(_cache_dir(_module(cold[0]))):
         return False
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)   # this process's cfmpa
@@ -330,8 +357,56 @@ def _start_background(cold: list[str]) -> bool:
 
 
 def _background() -> None:
-    """The detached compile process's work (it runs at the lowest priority)."""
+    """The detached compile process's work (it runs at the lowest priority): the cold groups
+    compiled, then the marker written once none is cold."""
     _compile_cold()
+    if not cold_groups():             # nothing was cold (another compiled it): marked here
+        _write_marker()
+
+
+def _marker_path() -> Path | None:
+    """The marker file: under NUMBA_CACHE_DIR when set, else this package's ``__pycache__``;
+    None where that folder (or, not made yet, its nearest existing parent) cannot be written
+    (the marker could never appear: the stamps are then checked every time)."""
+    env = os.environ.get("NUMBA_CACHE_DIR", "").strip()
+    folder = Path(env) if env else Path(__file__).resolve().parent / "__pycache__"
+    probe = folder
+    while not probe.exists():
+        if probe.parent == probe:
+            return None
+        probe = probe.parent
+    return folder / _MARKER if os.access(probe, os.W_OK) else None
+
+
+def _fingerprint() -> str:
+    """What the marker holds: cfmpa's and Python's versions and the groups' sources' sizes and
+    modification times, all read without importing numba."""
+    from .. import __version__
+
+    here = Path(__file__).resolve().parent
+    parts = [_STAMP_FORMAT, __version__, sys.version]
+    for name, mod in sorted(GROUPS.items()):
+        st = (here / f"{mod.lstrip('.')}.py").stat()
+        parts += [name, str(st.st_size), str(st.st_mtime_ns)]
+    return "\n".join(parts)
+
+
+def _marker_matches(path: Path) -> bool:
+    try:
+        return path.read_text() == _fingerprint()
+    except OSError:
+        return False
+
+
+def _write_marker() -> None:
+    path = _marker_path()
+    if path is None:
+        return
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    with contextlib.suppress(OSError):     # unwritable after all: the stamps are checked
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp.write_text(_fingerprint())
+        os.replace(tmp, path)
 
 
 def _compile_in_processes(names: list[str]) -> list[str]:

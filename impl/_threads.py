@@ -15,8 +15,6 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-import numba
-
 __all__ = ["kernel_threads", "set_kernel_threads", "shared"]
 
 #: Two where the machine has two cores or more; one in processes that run side by side (the
@@ -42,6 +40,8 @@ def shared(kernel: Callable[..., Any], *args: Any) -> None:
     NUMBA_NUM_THREADS): ``kernel`` is compiled with nogil=True, does share t of k and writes
     nothing another share writes. Share 0 runs on the calling thread; an exception in any share
     is raised here once all have ended."""
+    import numba  # here: kernel_threads alone (a run on the numpy kernels) needs none
+
     k = min(_THREADS[0], numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
     if k <= 1:
         kernel(0, 1, *args)

@@ -43,7 +43,7 @@ import numpy.typing as npt
 
 from ..errors import ContractViolation, InputError
 from ..files import jsonable
-from ..impl import build_dr, search_opt_path, search_opt_path_fast
+from ..impl import build_dr, search_opt_path
 from ..spec import (
     Failure,
     Grid,
@@ -297,6 +297,9 @@ def optimality_failures(dr: DR, start: Sequence[int], goal: Sequence[int],
     verified for that answer, and the mismatch is the failure."""
     start, goal = (int(start[0]), int(start[1])), (int(goal[0]), int(goal[1]))
     if witness is None and result.witness is None:
+        # Imported here: a run on the numpy kernels while the fast ones compile makes its own
+        # witness and never imports numba (docs/model.md §7.5).
+        from ..impl import search_opt_path_fast
         answer = search_opt_path_fast(dr, start, goal, with_witness=True)
         if answer.witness is None:                       # with_witness: never
             return _optimality(dr, start, goal, result, None, answer)

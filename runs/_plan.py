@@ -18,7 +18,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO, TypeVar
+from typing import TYPE_CHECKING, Any, TextIO, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -26,13 +26,7 @@ import numpy.typing as npt
 from .. import __version__
 from ..errors import ContractViolation, InputError
 from ..files import dumps_json, write_atomic_with, write_bytes_atomic
-from ..impl import (
-    build_dr_fast,
-    kernel_name,
-    load_fast_kernels,
-    search_opt_path,
-    search_opt_path_fast,
-)
+from ..impl import kernel_name, load_fast_kernels, search_opt_path
 from ..spec import (
     Certificate,
     Grid,
@@ -143,7 +137,7 @@ def z3_version() -> str:
 
 def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", seed: int = 0,
          sample: int | None = None, stop: bool = True, grid: Grid | None = None,
-         build: Builder = build_dr_fast, search: Searcher = search_opt_path_fast,
+         build: Builder | None = None, search: Searcher | None = None,
          kernel: str | None = None, witness: bool = False,
          overlap: bool | None = None) -> PlanResult:
     """Plan the subordinate's path for ``variant`` with BuiltDR and searchoptpath under contracts.
@@ -154,9 +148,10 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     undecided) is a violation. A violation raises ContractViolation; with ``stop=False``
     postcondition and certificate violations are recorded in ``contracts`` and the run goes on
     (a failed precondition always stops it). ``grid``, ``build`` and ``search`` replace the
-    scenario's grid and the kernels (by default the fast ones, bit-identical to the reference
-    and tested against it): for the reference itself, another implementation, or a seeded
-    fault. ``kernel`` names
+    scenario's grid and the kernels (None: the fast ones, bit-identical to the reference and
+    tested against it; imported only then, so that a run on the numpy kernels while the fast
+    ones compile never imports numba, docs/model.md §7.5): for the reference itself, another
+    implementation, or a seeded fault. ``kernel`` names
     them in plan.json ("fast", "reference"; by default told from ``build`` and ``search``, and
     "custom" for anything else). With the fast kernels, the first run in a process first calls
     them on a tiny input, so that timings_s.kernel_load holds numba's compile or cache-load time
@@ -173,10 +168,14 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     settings = Settings.of(contracts, seed, sample)
     g = grid or make_grid(s)
     enforce = settings.mode is not Mode.OFF
+    if build is None or search is None:
+        from ..impl import build_dr_fast, search_opt_path_fast
+        build = build_dr_fast if build is None else build
+        search = search_opt_path_fast if search is None else search
     kernel = kernel or kernel_name(build, search)
-    if (witness or settings.mode is Mode.FULL) and search in (search_opt_path,
-                                                              search_opt_path_fast):
-        search = functools.partial(search, with_witness=True)
+    if (witness or settings.mode is Mode.FULL) and _makes_witness(search):
+        # (Any: the two take with_witness, which Searcher's signature does not name.)
+        search = functools.partial(cast(Any, search), with_witness=True)
     t: dict[str, float] = {}
     if kernel == "fast":
         t["kernel_load"] = _load_fast_kernels()
@@ -192,6 +191,7 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
         if enforce:
             t["contracts_search"] = time.perf_counter() - t0 - t["search"]
         if witness and result.witness is None:
+            from ..impl import search_opt_path_fast
             made = search_opt_path_fast(dr, s.right.start_cell, s.right.goal_cell,
                                         with_witness=True)
             result = replace(result, witness=made.witness)
@@ -227,6 +227,16 @@ def plan(s: Scenario, variant: Variant | str, *, contracts: Mode | str = "off", 
     return PlanResult(scenario=s, variant=v, grid=g, dr=dr, search=result, certificate=cert,
                       contracts=record, timings_s=t, runs=tuple(runs), kernel=kernel,
                       settings=settings, exact=exact)
+
+
+def _makes_witness(search: Searcher) -> bool:
+    """Whether ``search`` is the reference or the fast search (they take ``with_witness``). The
+    fast one is looked for only if its module is loaded (a function of a module never imported
+    cannot be ``search``), so the check imports no numba."""
+    if search is search_opt_path:
+        return True
+    fast = sys.modules.get(search_opt_path.__module__.rsplit(".", 1)[0] + "._fast_search")
+    return fast is not None and search is getattr(fast, "search_opt_path_fast", None)
 
 
 def _load_fast_kernels() -> float:

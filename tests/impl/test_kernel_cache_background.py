@@ -23,6 +23,7 @@ def cold(monkeypatch, tmp_path):
     monkeypatch.setattr(kc, "_stamp_path", lambda name: tmp_path / f"cfmpa-{name}.stamp")
     monkeypatch.setattr(kc, "_cache_dir", lambda mod: tmp_path)
     monkeypatch.setattr(kc, "_key", lambda name: f"key-{name}")
+    monkeypatch.setattr(kc, "_marker_path", lambda: tmp_path / kc._MARKER)
     monkeypatch.setattr(kc, "_READY", [False])
     monkeypatch.setattr(kc, "_NUMPY", [])
     monkeypatch.setattr(kc, "_LOADED", [])
@@ -64,6 +65,7 @@ def test_a_warm_cache_keeps_the_fast_kernels(cold, capsys):
     calls, _ = cold
     for name in kc.GROUPS:
         kc._write_stamp(name)
+    kc._write_marker()                   # as the compile that warmed it leaves it
     assert _kernels.kernels("fast") == (build_dr_fast, search_opt_path_fast)
     assert capsys.readouterr().err == "" and calls["started"] == []
 
@@ -89,6 +91,7 @@ def test_seeded_fault_a_run_that_waits_is_caught(cold, monkeypatch):
 
 def test_no_second_compile_while_one_holds_the_lock(cold, capsys):
     calls, folder = cold
+    kc._write_marker()          # compiled here before: the stamps (now cold) are checked
     with open(folder / "cfmpa-kernels.lock", "a") as fh:
         fcntl.flock(fh, fcntl.LOCK_EX)
         assert kc.numpy_while_cold()
@@ -100,6 +103,70 @@ def test_no_second_compile_while_one_holds_the_lock(cold, capsys):
 
 def test_wait_compiled_gives_up_at_its_timeout(cold):
     assert kc.wait_compiled(timeout=0.0) is False
+
+
+def test_the_background_compile_marks_the_machine_and_a_marked_one_checks_its_stamps(cold, capsys):
+    calls, folder = cold
+    kc._background()
+    assert (folder / kc._MARKER).read_text() == kc._fingerprint()
+    capsys.readouterr()                  # the compile's own lines (the detached one's: nowhere)
+    # Marked and warm: the fast kernels, nothing started.
+    assert _kernels.kernels("fast") == (build_dr_fast, search_opt_path_fast)
+    assert calls["started"] == [] and capsys.readouterr().err == ""
+
+
+def test_an_unmarked_machine_is_cold_without_reading_the_stamps(cold, monkeypatch, capsys):
+    # Warm stamps, no marker (a cache warmed before the marker existed): one numpy run, and
+    # the background process, finding nothing cold, marks the machine for the next.
+    calls, folder = cold
+    for name in kc.GROUPS:
+        kc._write_stamp(name)
+
+    def numba_needed(*args):    # what the stamps' check would call: it imports numba
+        raise AssertionError("the stamps were read")
+    with monkeypatch.context() as m:
+        m.setattr(kc, "cold_groups", numba_needed)
+        m.setattr(kc, "_module", numba_needed)
+        assert kc.numpy_while_cold()
+    assert len(calls["started"]) == 1 and "3 groups compiling" in capsys.readouterr().err
+    kc._background()
+    assert calls["compiled"] == [] and (folder / kc._MARKER).exists()
+
+
+def test_a_stale_marker_is_no_marker(cold, monkeypatch):
+    calls, folder = cold
+    for name in kc.GROUPS:
+        kc._write_stamp(name)
+    kc._write_marker()
+    # A kernel source edited since (its size or time in the fingerprint): cold again.
+    monkeypatch.setattr(kc, "_fingerprint", lambda: "another fingerprint")
+    assert kc.numpy_while_cold() and len(calls["started"]) == 1
+
+
+def test_an_unwritable_marker_folder_means_the_stamps_are_checked(monkeypatch, tmp_path):
+    locked = tmp_path / "ro"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        monkeypatch.setenv("NUMBA_CACHE_DIR", str(locked / "numba"))
+        import os
+        assert kc._marker_path() is None or os.access(locked, os.W_OK)   # root may write
+        monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba"))
+        assert kc._marker_path() == tmp_path / "numba" / kc._MARKER
+    finally:
+        locked.chmod(0o700)
+
+
+def test_a_run_on_the_numpy_kernels_imports_no_numba():
+    # The planner's modules import the fast kernels (and numba) only when they are called.
+    import subprocess
+    import sys
+    code = ("import sys, cfmpa.runs._plan, cfmpa.runs._contracts, cfmpa.impl._threads\n"
+            "from cfmpa.impl._numpy_builtdr import build_dr_numpy\n"
+            "print('numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stdout.strip() == "False", out.stderr[-2000:]
 
 
 PROBE = """
