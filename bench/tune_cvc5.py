@@ -66,8 +66,8 @@ def choose(default: tuple[str, float], others: Mapping[str, tuple[str, float]],
 
 def statements(only: str | None) -> list[dict[str, Any]]:
     """Every Z3 VC with a standard text: its lock key, name, hash, text and Z3's answer."""
-    from cfmpa.proofs import Method, Verdict, collect_obligations
-    from cfmpa.proofs._obligation import standard_smtlib
+    from cfmpa.proofs import Method, collect_obligations
+    from cfmpa.proofs._obligation import proof_answer, standard_smtlib, vc_keys
     from cfmpa.proofs._pins import pin_key
 
     out, seen = [], set()
@@ -75,12 +75,10 @@ def statements(only: str | None) -> list[dict[str, Any]]:
         if ob.method is not Method.Z3 or pin_key(ob.id) in seen:
             continue
         seen.add(pin_key(ob.id))
-        want = "sat" if ob.expected is Verdict.REFUTED_AS_EXPECTED else "unsat"
-        names: list[str] = []
-        for vc in ob.build().vcs:
+        want = proof_answer(ob)
+        vcs = ob.build().vcs
+        for vc, name in zip(vcs, vc_keys(vcs), strict=True):
             text, sha, _ = standard_smtlib(vc)
-            name = vc.name if vc.name not in names else f"{vc.name}#{len(names) + 1}"
-            names.append(name)
             if text is not None:
                 out.append({"key": pin_key(ob.id), "vc": name, "sha256": sha, "text": text,
                             "want": want})
@@ -152,7 +150,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="write the choices of an earlier run's --out FILE into the lock")
     args = ap.parse_args(argv)
     from cfmpa.files import write_json
-    from cfmpa.proofs._pins import LOCK, load_lock
+    from cfmpa.proofs._pins import LOCK, cvc5_skips, cvc5_strategies, load_lock
 
     t0 = time.perf_counter()
     lock_path = Path(args.lock) if args.lock else LOCK
@@ -166,10 +164,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     rows = [r for r in statements(args.only)
             if pinned.get(r["key"], {}).get("vcs", {}).get(r["vc"]) == r["sha256"]]
+    skips, chosen = cvc5_skips(pinned), cvc5_strategies(pinned, lock_path)
     for r in rows:    # undecided under the default when pinned: not run again under it
-        entry = pinned[r["key"]]
-        r["undecided"] = (str(entry.get("cvc5", {}).get(r["vc"], "")).startswith("undecided")
-                          and r["vc"] not in entry.get("cvc5_strategy", {}))
+        r["undecided"] = r["sha256"] in skips and r["sha256"] not in chosen
     got = tune(rows, args.floor)
     write_json(args.out, {"seconds": round(time.perf_counter() - t0, 1), "floor_s": args.floor,
                           "ratio": RATIO, "margin_s": MARGIN_S, "new_decided_s": NEW_DECIDED_S,

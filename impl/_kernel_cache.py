@@ -16,13 +16,15 @@ it costs a few file reads and prints nothing. docs/model.md §7.5.
 
 A run that finds the cache cold uses the numpy kernels (``numpy_while_cold``). Finding the
 stamps takes numba's import (0.25 s: numba's cache folder and key come from it), pure cost in
-that first run; so a marker file (``_marker_path``: under NUMBA_CACHE_DIR, else this package's
-``__pycache__``), written once every group has been seen warm (after a compile, or by a run
-whose check found none cold), holds a fingerprint that needs no numba (cfmpa's and Python's
-versions, the groups' sources' sizes and times): a run that finds no matching marker is cold
-without importing numba, and the detached compile checks the stamps itself (compiling only
-what is cold) and writes the marker. A matching marker is only a hint: the stamps are checked
-as before. Where the marker's folder cannot be written, the stamps are checked every time.
+that first run; so a marker file (``_marker``: under NUMBA_CACHE_DIR, else this package's
+``__pycache__``), written once every group has been seen warm (by a compile, or by the
+detached process of one that found none cold), holds a fingerprint that needs no numba
+(cfmpa's and Python's versions, the groups' sources' sizes and times): a run that finds no
+matching marker is cold without importing numba, and the detached compile checks the stamps
+itself (compiling only what is cold) and writes the marker; while it runs it holds a start lock
+beside the marker, so the runs started meanwhile start no other. A matching marker is only a
+hint: the stamps are checked as before. Where the marker's folder cannot be written (or a
+source cannot be read), the stamps are checked every time.
 
 Loading from a warm cache: numba's FunctionCache refreshes its typing and target registries
 before the first load in a process (it imports and registers every implementation numba has:
@@ -76,8 +78,10 @@ _READY = [False]          # this process has made sure (or is a compile process 
 _LOCK = threading.Lock()
 _LOADED: list[float] = []
 _NUMPY: list[bool] = []   # decided once per process: the fast kernels were cold (numpy in use)
-#: The marker's file name (see the module docstring).
+#: The marker's file name (see the module docstring), and the lock beside it that a detached
+#: compile started on an unmarked machine holds for its life.
 _MARKER = "cfmpa-kernels.warm"
+_START_LOCK = "cfmpa-kernels-start.lock"
 
 
 def ensure_compiled() -> None:
@@ -161,20 +165,20 @@ def numpy_while_cold() -> bool:
     says so, with a count; a later run uses the fast kernels once their stamps are warm."""
     if not _NUMPY:
         mode = os.environ.get(COMPILE_ENV, "background").strip().lower()
-        marker = _marker_path()
-        unseen = False
+        marker = None if mode == "wait" or _READY[0] else _marker()
+        unseen = marker is not None and not _marker_matches(*marker)
         if mode == "wait" or _READY[0]:
             cold = []
-        elif marker is not None and not _marker_matches(marker):
+        elif unseen:
             # Never seen warm here: cold, decided without numba's import (the detached
             # compile checks the stamps and compiles only what is cold).
-            cold, unseen = list(GROUPS), True
+            cold = list(GROUPS)
         else:
             cold = cold_groups()
-            if not cold:
-                _write_marker()          # a cache warmed before the marker existed
         if cold:
-            started = _start_background(cold, check_lock=not unseen)
+            # Unseen: whether a compile runs is told by its start lock, beside the marker.
+            started = _start_background(cold, None if marker is None or not unseen
+                                        else marker[0].parent)
             groups = f"{len(cold)} group{'s' if len(cold) > 1 else ''}"
             print(f"cfmpa: fast kernels not compiled for this machine yet: {groups} "
                   f"{'compiling' if started else 'being compiled'} in the background; this "
@@ -229,7 +233,7 @@ def _key(name: str) -> str:
 
     from .. import __version__
 
-    source = Path(_module(name).__file__ or "")
+    source = _source(name)
     st = source.stat()
     h = hashlib.sha256()
     for part in (_STAMP_FORMAT, __version__, sys.version, numba.__version__,
@@ -262,8 +266,9 @@ def _write_stamp(name: str) -> None:
 
 
 @contextlib.contextmanager
-def _file_lock(folder: Path | None) -> Iterator[None]:
-    """Held by one process at a time (where fcntl and the folder allow it)."""
+def _file_lock(folder: Path | None, name: str = "cfmpa-kernels.lock") -> Iterator[None]:
+    """Held by one process at a time (where fcntl and the folder allow it): the compile lock,
+    or ``name``'s."""
     try:
         import fcntl
     except ImportError:   # pragma: no cover - not on Linux
@@ -274,7 +279,7 @@ def _file_lock(folder: Path | None) -> Iterator[None]:
         return
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        fh = open(folder / "cfmpa-kernels.lock", "a")   # noqa: SIM115 - closed below
+        fh = open(folder / name, "a")   # noqa: SIM115 - closed below
     except OSError:
         yield
         return
@@ -311,8 +316,9 @@ def _compile_cold() -> None:
               "(cached for later runs)", file=sys.stderr, flush=True)
 
 
-def _lock_free(folder: Path | None) -> bool:
-    """Whether no process holds the compile lock now (it is released again at once)."""
+def _lock_free(folder: Path | None, name: str = "cfmpa-kernels.lock") -> bool:
+    """Whether no process holds the compile lock (or ``name``'s) now (it is released again at
+    once)."""
     try:
         import fcntl
     except ImportError:   # pragma: no cover - not on Linux
@@ -321,7 +327,7 @@ def _lock_free(folder: Path | None) -> bool:
         return True
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        with open(folder / "cfmpa-kernels.lock", "a") as fh:
+        with open(folder / name, "a") as fh:
             try:
                 fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
@@ -332,14 +338,17 @@ def _lock_free(folder: Path | None) -> bool:
     return True
 
 
-def _start_background(cold: list[str], check_lock: bool = True) -> bool:
+def _start_background(cold: list[str], marker_folder: Path | None = None) -> bool:
     """Start a detached process (its own session, lowest priority) that takes the compile lock
     and compiles the groups still cold then, as ``_compile_cold`` does (a process per group,
-    the stamps written, then the marker); False when another holds the lock (a compile is under
-    way: ``check_lock``, which imports numba to find the lock) or the process could not start
-    (the next run tries again). Without ``check_lock`` a second process started while a
-    compile runs waits for its lock, then finds nothing cold."""
-    if check_lock and not _lock_free(_cache_dir(_module(cold[0]))):
+    the stamps written, then the marker); False when another compile is under way or the
+    process could not start (the next run tries again). Under way: the compile lock is held
+    (found through numba's cache folder, so numba is imported), or, given ``marker_folder``
+    (an unmarked machine, decided without numba), the start lock there, which the detached
+    process holds for its life."""
+    held = (_lock_free(marker_folder, _START_LOCK) if marker_folder is not None
+            else _lock_free(_cache_dir(_module(cold[0]))))
+    if not held:
         return False
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)   # this process's cfmpa
@@ -357,17 +366,33 @@ def _start_background(cold: list[str], check_lock: bool = True) -> bool:
 
 
 def _background() -> None:
-    """The detached compile process's work (it runs at the lowest priority): the cold groups
-    compiled, then the marker written once none is cold."""
-    _compile_cold()
-    if not cold_groups():             # nothing was cold (another compiled it): marked here
-        _write_marker()
+    """The detached compile process's work (it runs at the lowest priority), under the start
+    lock beside the marker: the cold groups compiled (``_compile_cold`` marks the machine), or,
+    none cold (another compiled them), the machine marked here."""
+    marker = _marker()
+    with _file_lock(None if marker is None else marker[0].parent, _START_LOCK):
+        _compile_cold()
+        if marker is not None and not _marker_matches(*marker) and not cold_groups():
+            _write_marker()
 
 
-def _marker_path() -> Path | None:
-    """The marker file: under NUMBA_CACHE_DIR when set, else this package's ``__pycache__``;
-    None where that folder (or, not made yet, its nearest existing parent) cannot be written
-    (the marker could never appear: the stamps are then checked every time)."""
+def _source(name: str) -> Path:
+    """The source file of group ``name``'s module, found without importing it (nor numba)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec(GROUPS[name], __package__)
+    if spec is None or spec.origin is None:
+        raise OSError(f"no source for {GROUPS[name]}")
+    return Path(spec.origin)
+
+
+def _marker() -> tuple[Path, str] | None:
+    """The marker file and the fingerprint it must hold: the file under NUMBA_CACHE_DIR when
+    set, else this package's ``__pycache__``; the fingerprint cfmpa's and Python's versions and
+    the groups' sources' sizes and modification times, all read without numba. None where the
+    folder (or, not made yet, its nearest existing parent) is not a folder this process can
+    write, or a source cannot be read: the marker could not appear, so the stamps are checked
+    every time (a machine never marked would otherwise be cold for ever)."""
     env = os.environ.get("NUMBA_CACHE_DIR", "").strip()
     folder = Path(env) if env else Path(__file__).resolve().parent / "__pycache__"
     probe = folder
@@ -375,37 +400,36 @@ def _marker_path() -> Path | None:
         if probe.parent == probe:
             return None
         probe = probe.parent
-    return folder / _MARKER if os.access(probe, os.W_OK) else None
-
-
-def _fingerprint() -> str:
-    """What the marker holds: cfmpa's and Python's versions and the groups' sources' sizes and
-    modification times, all read without importing numba."""
+    if not probe.is_dir() or not os.access(probe, os.W_OK):
+        return None
     from .. import __version__
 
-    here = Path(__file__).resolve().parent
     parts = [_STAMP_FORMAT, __version__, sys.version]
-    for name, mod in sorted(GROUPS.items()):
-        st = (here / f"{mod.lstrip('.')}.py").stat()
-        parts += [name, str(st.st_size), str(st.st_mtime_ns)]
-    return "\n".join(parts)
-
-
-def _marker_matches(path: Path) -> bool:
     try:
-        return path.read_text() == _fingerprint()
+        for name in sorted(GROUPS):
+            st = _source(name).stat()
+            parts += [name, str(st.st_size), str(st.st_mtime_ns)]
+    except OSError:
+        return None
+    return folder / _MARKER, "\n".join(parts)
+
+
+def _marker_matches(path: Path, fingerprint: str) -> bool:
+    try:
+        return path.read_text() == fingerprint
     except OSError:
         return False
 
 
 def _write_marker() -> None:
-    path = _marker_path()
-    if path is None:
+    marker = _marker()
+    if marker is None:
         return
+    path, fingerprint = marker
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
     with contextlib.suppress(OSError):     # unwritable after all: the stamps are checked
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp.write_text(_fingerprint())
+        tmp.write_text(fingerprint)
         os.replace(tmp, path)
 
 

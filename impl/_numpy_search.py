@@ -29,8 +29,10 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from ..spec import MOVES, Cell, SearchResult
+from ..spec import Cell, SearchResult
 from ._search import (
+    _MOVE_GAP,
+    _MOVE_NORM,
     INF,
     J2_MASK,
     SHIFT,
@@ -50,9 +52,7 @@ __all__ = ["search_opt_path_numpy"]
 
 IntArray = npt.NDArray[np.int64]
 
-_MOVE = np.asarray(MOVES, dtype=np.int64)
-_NORM = np.abs(_MOVE).sum(axis=1)                                               # |d|_1
-_GAP = np.abs(_MOVE[:, None, :] - _MOVE[None, :, :]).sum(axis=2)                # |d - p|_1
+_NORM, _GAP = _MOVE_NORM, _MOVE_GAP                                   # |d|_1, |d - p|_1
 #: The moves expanded at the capped step (every one but the wait), and per move its J1 part.
 _EXPAND = np.asarray([d for d in range(9) if d != WAIT], dtype=np.int64)
 _EXPAND_J1 = _NORM[_EXPAND] << SHIFT

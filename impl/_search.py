@@ -44,10 +44,13 @@ SHIFT = 31
 J2_MASK = (1 << SHIFT) - 1
 INF = np.int64(1) << np.int64(61)
 WAIT = MOVES.index((0, 0))
-#: |d|_1 of the move with index (di + 1, dj + 1).
-_STEP_J1 = np.add.outer(np.abs(np.arange(-1, 2)), np.abs(np.arange(-1, 2))).astype(np.int64)
+_MOVE = np.asarray(MOVES, dtype=np.int64)
 #: |d|_1 per move d (MOVES order): what stopping after d adds to J2.
-_MOVE_NORM = np.abs(np.asarray(MOVES, dtype=np.int64)).sum(axis=1)
+_MOVE_NORM = np.abs(_MOVE).sum(axis=1)
+#: |d - p|_1 per pair of moves [p, d]: what turning from p to d adds to J2.
+_MOVE_GAP = np.abs(_MOVE[:, None, :] - _MOVE[None, :, :]).sum(axis=2)
+#: |d|_1 of the move with index (di + 1, dj + 1) (MOVES runs over di, then dj, from -1 to 1).
+_STEP_J1 = _MOVE_NORM.reshape(3, 3)
 
 
 def _prepare(dr: npt.NDArray[np.integer], start: Cell, goal: Cell, with_witness: bool
@@ -368,9 +371,7 @@ def _static_phase(free_rest: BoolArray, initial: IntArray, goal: Cell,
     pred = np.full(9 * M, -1, dtype=np.int8)
     from_static = np.zeros(9 * M, dtype=bool)
     done = np.zeros(9 * M, dtype=bool)
-    move = np.asarray(MOVES, dtype=np.int64)
-    norm = np.abs(move).sum(axis=1)
-    gap = np.abs(move[:, None, :] - move[None, :, :]).sum(axis=2)  # gap[p, d] = |d - p|_1
+    norm, gap = _MOVE_NORM, _MOVE_GAP                # gap[p, d] = |d - p|_1
     targets = _targets(free_rest)
     goal_states = np.arange(9) * M + goal[0] * n + goal[1]
 

@@ -69,6 +69,7 @@ from ..spec import (
 )
 from ._control_base import Control, ControlNotMade, _case, _rejected, _require
 from ._controls_wiring import wiring_controls, wiring_positive_controls
+from ._z3vec import constants
 
 __all__ = ["Control", "ControlNotMade", "ControlResult", "PREMISE_COUNTER_WITNESSES",
            "PREMISE_FREE_MS", "PREMISE_FREE_RLIMIT", "PREMISE_OWN_MS", "PREMISE_OWN_RLIMIT",
@@ -360,21 +361,7 @@ Pins = tuple[tuple[z3.ExprRef, z3.ExprRef], ...]
 def _constants(vc: Any) -> dict[str, z3.ExprRef]:
     """The constants the composition's hypotheses and goal name, by name (a walk of its terms:
     about 0.05 s, so only for a name its own pins do not give)."""
-    out: dict[str, z3.ExprRef] = {}
-    seen: set[int] = set()
-    stack = [h for _, h in vc.hypotheses] + [vc.goal]
-    while stack:
-        e = stack.pop()
-        if e.get_id() in seen:
-            continue
-        seen.add(e.get_id())
-        if z3.is_quantifier(e):
-            stack.append(e.body())
-        elif z3.is_const(e) and e.decl().kind() == z3.Z3_OP_UNINTERPRETED:
-            out[e.decl().name()] = e
-        else:
-            stack.extend(e.children())
-    return out
+    return {c.decl().name(): c for c in constants(*(h for _, h in vc.hypotheses), vc.goal)}
 
 
 def premise_pins(vc: Any, variant: str,

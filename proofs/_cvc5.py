@@ -142,7 +142,7 @@ class Cvc5Worker:
         return Cvc5Answer(a.answer, a.reason, time.monotonic() - t0, strategy, a.cpu_seconds)
 
     def _check(self, text: str, timeout_ms: int,
-               options: tuple[tuple[str, str], ...] = OPTIONS) -> Cvc5Answer:
+               options: tuple[tuple[str, str], ...]) -> Cvc5Answer:
         if cvc5_version() is None:
             return Cvc5Answer("unknown", "cvc5 is not installed")
         proc, started = self._start()
@@ -300,8 +300,8 @@ def _serve() -> None:
         try:
             tm = cvc5.TermManager()
             s = cvc5.Solver(tm)
-            s.setOption("tlimit-per", str(int(q.get("wall_ms", q["ms"]))))
-            options = [tuple(o) for o in q.get("options", OPTIONS)]
+            s.setOption("tlimit-per", str(int(q["wall_ms"])))
+            options = [tuple(o) for o in q["options"]]
             for name, value in options:
                 s.setOption(name, value)
             p = cvc5.InputParser(s)

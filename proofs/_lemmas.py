@@ -110,16 +110,20 @@ class Lemma:
 
 def lemma(name: str, hyps: Sequence[Hyp], goal: z3.BoolRef, key: str, *, abstract: bool = False,
           names: dict[str, object] | None = None, witness: Pairs = (),
-          counter_witness: Pairs = ()) -> Lemma:
+          counter_witness: Pairs = (), z3_tactic: str | None = None) -> Lemma:
+    """The lemma ``hyps`` imply ``goal`` (``key`` the premise its negative test drops), as a VC
+    over the abstract norms (``abstract``) or the polynomials; ``z3_tactic``: the solver of its
+    proof check (``VC.z3_tactic``)."""
     hyps = dedupe(hyps)
     if key not in [n for n, _ in hyps]:
         raise KeyError(f"{name}: no hypothesis {key!r}")
     if abstract:
         vc = VC(name, hyps, goal, key_premise=key, witness=tuple(witness),
-                counter_witness=tuple(counter_witness))
+                counter_witness=tuple(counter_witness), z3_tactic=z3_tactic)
     else:
         vc = VC(name, tuple((n, concrete(h)) for n, h in hyps), concrete(goal), key_premise=key,
-                witness=tuple(witness), counter_witness=tuple(counter_witness))
+                witness=tuple(witness), counter_witness=tuple(counter_witness),
+                z3_tactic=z3_tactic)
     return Lemma(vc, hyps, goal, tuple((names or {}).items()))
 
 

@@ -191,40 +191,48 @@ def spec_closure_source(*objs: Callable[..., Any]) -> str:
     data by these functions rests on, down to the helpers they call, so that editing any of
     them changes the check's text, a change to review that names the module (docs/model.md
     §6.4); the hashes, not the sources, keep the saved text small."""
-    import hashlib
-
-    return "\n".join(f"# module {name} sha256 "
-                     + hashlib.sha256(_module_source(name).encode()).hexdigest()
+    return "\n".join(f"# module {name} sha256 {_module_facts(name)[0]}"
                      for name in spec_closure(*objs))
 
 
 def spec_closure(*objs: Callable[..., Any]) -> tuple[str, ...]:
     """The names of the ``cfmpa.spec`` modules ``objs`` are defined in and those they import
     within the package (its relative imports, at any depth of their code), sorted."""
-    import ast
-    import importlib
-
-    package = importlib.import_module("..spec", __package__).__name__
+    package = _spec_package()
     todo = [o.__module__ for o in objs if o.__module__.startswith(package + ".")]
     seen: set[str] = set()
     while todo:
         name = todo.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        for node in ast.walk(ast.parse(_module_source(name))):
-            if isinstance(node, ast.ImportFrom) and node.level == 1:
-                # from ._x import f  |  from . import _x
-                todo += ([f"{package}.{node.module}"] if node.module else
-                         [f"{package}.{a.name}" for a in node.names])
+        if name not in seen:
+            seen.add(name)
+            todo += _module_facts(name)[1]
     return tuple(sorted(seen))
 
 
-@functools.lru_cache(maxsize=64)
-def _module_source(name: str) -> str:
+def _spec_package() -> str:
     import importlib
 
-    return inspect.getsource(importlib.import_module(name)).rstrip()
+    return importlib.import_module("..spec", __package__).__name__
+
+
+@functools.lru_cache(maxsize=64)
+def _module_facts(name: str) -> tuple[str, tuple[str, ...]]:
+    """(the sha256 of module ``name``'s whole source, the spec modules it imports: its relative
+    imports at any depth of its code), read and parsed once a process: each of the 21
+    translation checks asks for the same twelve modules (0.1 s a time, parsed again)."""
+    import ast
+    import hashlib
+    import importlib
+
+    source = inspect.getsource(importlib.import_module(name)).rstrip()
+    package = _spec_package()
+    imports: list[str] = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom) and node.level == 1:
+            # from ._x import f  |  from . import _x
+            imports += ([f"{package}.{node.module}"] if node.module else
+                        [f"{package}.{a.name}" for a in node.names])
+    return hashlib.sha256(source.encode()).hexdigest(), tuple(imports)
 
 
 @functools.lru_cache(maxsize=1024)
@@ -649,6 +657,20 @@ def _short_text(f: z3.ExprRef, width: int = 50) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
+def proof_answer(ob: Obligation) -> str:
+    """What a proof check of ``ob`` must answer: sat for a refutation, else unsat."""
+    return "sat" if ob.expected is Verdict.REFUTED_AS_EXPECTED else "unsat"
+
+
+def vc_keys(vcs: Sequence[VC]) -> list[str]:
+    """Each VC's key in the lock and in results.json: its name, or, for a name an earlier VC of
+    the obligation has, the name and its position (``name#3``)."""
+    keys: list[str] = []
+    for vc in vcs:
+        keys.append(vc.name if vc.name not in keys else f"{vc.name}#{len(keys) + 1}")
+    return keys
+
+
 def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck: bool = False,
             texts: Sequence[tuple[str, str]] | None = None,
             strategies: dict[str, str] | None = None
@@ -672,14 +694,14 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
     vacuous: list[str] = []
     unknowns: list[str] = []
     refuted: list[tuple[str, str]] = []
-    want = "sat" if ob.expected is Verdict.REFUTED_AS_EXPECTED else "unsat"
+    want = proof_answer(ob)
     if texts is None:
         texts = _check_texts(q)
     limit = z3_rlimit(ob.id)
     net = wall_net_ms(ob.timeout_ms, limit)
     # The VCs of one obligation share most hypotheses: each is scanned once (docs/model.md §6.4).
     scanned = NonlinearMemo()
-    for vc, (vac_text, proof_text) in zip(q.vcs, texts, strict=True):
+    for vc, key, (vac_text, proof_text) in zip(q.vcs, vc_keys(q.vcs), texts, strict=True):
         hyps = [h for _, h in vc.hypotheses]
         # Vacuity: the hypotheses (with the optional witness pinned) must have a model.
         s = _solver(net, formulas=hyps + [c == v for c, v in vc.witness], text=vac_text,
@@ -705,7 +727,6 @@ def _run_z3(ob: Obligation, q: Z3Query, pool: Any, skip: dict[str, str], recheck
             unknowns.append(f"{vc.name}: {_why_unknown(s, limit)}")
         # The statement in standard SMT-LIB: pinned by its hash, replayed by cvc5.
         std, sha, note = standard_smtlib(vc)
-        key = vc.name if vc.name not in pins else f"{vc.name}#{len(pins) + 1}"
         pins[key] = sha
         chosen = (strategies or {}).get(sha, DEFAULT_STRATEGY)
         if std is not None:

@@ -87,7 +87,8 @@ def pin_entry(p: Proof) -> dict[str, Any]:
     return entry
 
 
-_KILLED = re.compile(r"killed after [0-9.]+ s (?:of CPU )?\(cvc5 overran its (\d+) ms limit\)")
+_KILLED = re.compile(r"killed after [0-9.]+ s (?:of CPU )?"
+                     r"\(cvc5 overran its (\d+) ms limit('s wall-clock net)?\)")
 
 
 def _reason_class(reason: str | None) -> str:
@@ -96,7 +97,7 @@ def _reason_class(reason: str | None) -> str:
     if not reason:
         return "not replayed"
     m = _KILLED.fullmatch(reason)
-    return f"overran its {m.group(1)} ms limit (killed)" if m else reason
+    return f"overran its {m.group(1)} ms limit{m.group(2) or ''} (killed)" if m else reason
 
 
 def _statement(entry: dict[str, Any]) -> dict[str, Any]:
@@ -127,14 +128,16 @@ def cvc5_strategies(lock: dict[str, dict[str, Any]], source: str | Path | None =
     where = None if source is None else str(source)
     out: dict[str, str] = {}
     for key, entry in lock.items():
-        chosen = entry.get("cvc5_strategy") or {}
-        if not isinstance(chosen, dict):
-            raise InputError(f"{key}.cvc5_strategy", chosen, "must map VC names to strategies",
-                             source=where)
-        vcs = entry.get("vcs") or {}
+        chosen = entry.get("cvc5_strategy") if isinstance(entry, dict) else None
+        if not chosen:
+            continue
+        vcs = entry.get("vcs")
+        if not isinstance(chosen, dict) or not isinstance(vcs, dict):
+            raise InputError(f"{key}.cvc5_strategy", _shown(chosen), "must map the names of "
+                             "the VCs the entry pins (its vcs) to strategies", source=where)
         for name, strategy in chosen.items():
-            if strategy not in STRATEGIES:
-                raise InputError(f"{key}.cvc5_strategy.{name}", strategy,
+            if not isinstance(strategy, str) or strategy not in STRATEGIES:
+                raise InputError(f"{key}.cvc5_strategy.{name}", _shown(strategy),
                                  f"is not one of {', '.join(sorted(STRATEGIES))}", source=where)
             if name not in vcs:
                 raise InputError(f"{key}.cvc5_strategy.{name}", strategy,
@@ -143,15 +146,25 @@ def cvc5_strategies(lock: dict[str, dict[str, Any]], source: str | Path | None =
     return out
 
 
+def _shown(value: object) -> object:
+    """``value`` as an error message shows it: a long one cut (a lock is read whole)."""
+    text = repr(value)
+    return value if len(text) <= 80 else text[:77] + "..."
+
+
 def record_cvc5_strategies(choices: dict[tuple[str, str], tuple[str, str]],
                            path: str | Path | None = None) -> list[str]:
     """Write into the lock, per (entry key, VC name), the strategy its replay runs under and
     cvc5's answer under it (``sat``, ``unsat`` or ``undecided: why``), as measured
     (bench/tune_cvc5.py); the default strategy is written as no entry. Statements and kinds are
-    untouched. Returns a line per change; KeyError for a VC the lock does not pin."""
+    untouched. Returns a line per change; KeyError for a VC the lock does not pin, ValueError
+    for a strategy not in ``_cvc5.STRATEGIES`` (nothing written then)."""
     f = Path(path) if path is not None else LOCK
     doc = json.loads(f.read_text(encoding="utf-8"))
     obs = doc["obligations"]
+    bad = sorted({st for st, _ in choices.values() if st not in STRATEGIES})
+    if bad:
+        raise ValueError(f"strategy={bad[0]!r} is not one of {sorted(STRATEGIES)}")
     lines = []
     for (key, name), (strategy, answer) in sorted(choices.items()):
         entry = obs[key]
@@ -182,7 +195,9 @@ def load_lock(path: str | Path | None = None) -> dict[str, dict[str, Any]]:
     except (OSError, ValueError):
         return {}
     obs = doc.get("obligations") if isinstance(doc, dict) else None
-    return dict(obs) if isinstance(obs, dict) else {}
+    # An entry that is not an object pins nothing (its id is then "not pinned").
+    return ({k: v for k, v in obs.items() if isinstance(v, dict)} if isinstance(obs, dict)
+            else {})
 
 
 def _short(h: object) -> str:

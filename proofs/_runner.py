@@ -213,10 +213,11 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
     lock_path = Path(lock) if lock is not None else LOCK
     # cvc5 replays the statements it decided when they were pinned; the undecided ones' answer
     # is the pinned one (--repin: every one replayed; --recheck-undecided: those too).
-    skip = {} if repin else cvc5_skips(load_lock(lock_path))
+    pinned = load_lock(lock_path)
+    skip = {} if repin else cvc5_skips(pinned)
     # The strategy each statement's replay runs under (the lock's choice, also with --repin,
     # which then writes it back: a choice is changed by measuring, bench/tune_cvc5.py).
-    strategies = cvc5_strategies(load_lock(lock_path), lock_path)
+    strategies = cvc5_strategies(pinned, lock_path)
     t0 = time.perf_counter()
     told = GroupProgress(obligations, progress)
     if workers > 1 and len(obligations) + len(controls) > 1:
@@ -242,9 +243,10 @@ def run_obligations(obligations: Sequence[Obligation], out_dir: str | Path,
         ran = {p.id for p in proofs}
         complete = set(FIXED_IDS) <= set(expected) <= ran
         repinned = tuple(repin_lock(proofs, lock_path, complete=complete, kind_of=kind_and_why))
-    pins = tuple(check_pins(proofs, load_lock(lock_path)))
+    pinned = load_lock(lock_path) if repin else pinned       # as --repin above rewrote it
+    pins = tuple(check_pins(proofs, pinned))
     # A kind is pinned like an expected verdict: --repin above kept every pinned one.
-    kinds = tuple(check_kinds(proofs, load_lock(lock_path), kind_and_why))
+    kinds = tuple(check_kinds(proofs, pinned, kind_and_why))
     changes = {}
     for p in proofs:
         old = previous.get(p.id)

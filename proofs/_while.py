@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import z3
 
 from ._obligation import VC, Smoke
+from ._z3vec import constants
 
 __all__ = [
     "Assign",
@@ -377,11 +378,4 @@ def _key(v: z3.ExprRef) -> tuple[str, str]:
 
 def _consts(e: z3.ExprRef) -> list[z3.ExprRef]:
     """The uninterpreted constants occurring in e."""
-    seen: dict[tuple[str, str], z3.ExprRef] = {}
-    todo = [e]
-    while todo:
-        x = todo.pop()
-        if z3.is_const(x) and x.decl().kind() == z3.Z3_OP_UNINTERPRETED:
-            seen.setdefault(_key(x), x)
-        todo.extend(x.children())
-    return list(seen.values())
+    return constants(e)

@@ -22,8 +22,8 @@ from ..spec import MAX_SPACING
 __all__ = [
     "COS", "DOT", "DT", "G_MAX", "N2", "SIN", "SQ", "Hyp", "Vec", "a3_cos_bound", "a3_cos_mono",
     "a3_cos_nonneg", "a3_diff", "a3_sin_nonneg", "a3_sum", "a3_unit", "abs_", "add", "comb",
-    "concrete", "diff_rule", "dot", "e", "j", "n2", "norm", "occurs", "rot", "same", "scale", "sub",
-    "sum_rule", "unit", "unit_poly", "vec", "veq", "within",
+    "concrete", "constants", "diff_rule", "dot", "e", "j", "n2", "norm", "occurs", "rot", "same",
+    "scale", "sub", "subterms", "sum_rule", "unit", "unit_poly", "vec", "veq", "within",
 ]
 
 Vec = tuple[z3.ArithRef, z3.ArithRef]
@@ -104,19 +104,29 @@ def within(x: z3.ArithRef, b: Any) -> z3.BoolRef:
     return z3.And(x <= b, -x <= b)
 
 
-def occurs(term: z3.ExprRef, inside: z3.ExprRef) -> bool:
-    """Whether ``term`` is a subterm of ``inside`` (each shared subterm visited once)."""
+def subterms(*roots: z3.ExprRef) -> Any:
+    """The subterms of ``roots``, each shared subterm once (a quantifier's children are its
+    body), depth first."""
     seen: set[int] = set()
-    todo = [inside]
+    todo = list(roots)
     while todo:
         x = todo.pop()
         if x.get_id() in seen:
             continue
         seen.add(x.get_id())
-        if z3.eq(x, term):
-            return True
+        yield x
         todo += x.children()
-    return False
+
+
+def occurs(term: z3.ExprRef, inside: z3.ExprRef) -> bool:
+    """Whether ``term`` is a subterm of ``inside`` (each shared subterm visited once)."""
+    return any(z3.eq(x, term) for x in subterms(inside))
+
+
+def constants(*roots: z3.ExprRef) -> list[z3.ExprRef]:
+    """The uninterpreted constants occurring in ``roots``, in the order first met."""
+    return [x for x in subterms(*roots)
+            if z3.is_const(x) and x.decl().kind() == z3.Z3_OP_UNINTERPRETED]
 
 
 # --- abstract norms -------------------------------------------------------------------------------

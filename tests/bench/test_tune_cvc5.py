@@ -82,3 +82,28 @@ def test_the_lock_records_the_choice_and_the_answer_under_it(tmp_path: Path):
     assert "cvc5_strategy" not in load_lock(lock)["A.b"]
     with pytest.raises(KeyError, match="pins no VC 'z'"):
         record_cvc5_strategies({("A.b", "z"): ("internal", "unsat")}, lock)
+    # A strategy that does not exist is never written (a run would then refuse the lock).
+    before = lock.read_text()
+    with pytest.raises(ValueError, match="strategy='fast' is not one of"):
+        record_cvc5_strategies({("A.b", "x"): ("fast", "unsat")}, lock)
+    assert lock.read_text() == before
+
+
+def test_a_switch_is_measured_again_and_the_slower_runs_kept(monkeypatch):
+    # The first measurements favour internal (0.5 s against 1.0 s); measured again, internal
+    # takes 0.9 s: with the slower run of each side kept, the default stays (0.9 > 0.7 x 1.0).
+    times = {"justification": [1.0, 1.0], "internal": [0.5, 0.9],
+             "internal-relevance": [2.0, 2.0]}
+
+    def measure(workers, strategy, text):
+        return "unsat", times[strategy].pop(0)
+    monkeypatch.setattr(T, "_measure", measure)
+    row = {"key": "A.b", "vc": "x", "sha256": "1" * 64, "text": "(check-sat)", "want": "unsat"}
+    import io
+    (got,) = T.tune([row], floor=0.15, log=io.StringIO())
+    assert got["default"] == ["unsat", 1.0] and got["others"]["internal"] == ["unsat", 0.9]
+    assert got["chosen"] == "justification" and got["answer"] == "unsat"
+    # A statement undecided when pinned is not run under the default again.
+    times.update({"internal": [0.3], "internal-relevance": [0.4]})
+    (got,) = T.tune([dict(row, undecided=True)], floor=0.15, log=io.StringIO())
+    assert got["default"] == ["unknown", 0.0] and got["chosen"] == "internal"

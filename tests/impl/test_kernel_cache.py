@@ -82,9 +82,7 @@ def test_the_stamp_follows_the_source_its_size_and_its_time(monkeypatch, tmp_pat
     source = tmp_path / "_fast_search.py"
     source.write_text("x = 1\n")
 
-    class Module:
-        __file__ = str(source)
-    monkeypatch.setattr(kc, "_module", lambda name: Module)
+    monkeypatch.setattr(kc, "_source", lambda name: source)
     first = kc._key("search")
     source.write_text("x = 2\n")                       # another source, the same size
     os.utime(source, ns=(0, 0))
@@ -99,9 +97,7 @@ def _same_size_and_time_told_apart(monkeypatch, tmp_path) -> bool:
     """Whether two sources of one size saved at one instant get different keys."""
     source = tmp_path / "_fast_search.py"
 
-    class Module:
-        __file__ = str(source)
-    monkeypatch.setattr(kc, "_module", lambda name: Module)
+    monkeypatch.setattr(kc, "_source", lambda name: source)
     keys = []
     for text in ("x = 1\n", "x = 2\n"):
         source.write_text(text)

@@ -23,7 +23,7 @@ def cold(monkeypatch, tmp_path):
     monkeypatch.setattr(kc, "_stamp_path", lambda name: tmp_path / f"cfmpa-{name}.stamp")
     monkeypatch.setattr(kc, "_cache_dir", lambda mod: tmp_path)
     monkeypatch.setattr(kc, "_key", lambda name: f"key-{name}")
-    monkeypatch.setattr(kc, "_marker_path", lambda: tmp_path / kc._MARKER)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))       # the marker and its lock
     monkeypatch.setattr(kc, "_READY", [False])
     monkeypatch.setattr(kc, "_NUMPY", [])
     monkeypatch.setattr(kc, "_LOADED", [])
@@ -108,7 +108,9 @@ def test_wait_compiled_gives_up_at_its_timeout(cold):
 def test_the_background_compile_marks_the_machine_and_a_marked_one_checks_its_stamps(cold, capsys):
     calls, folder = cold
     kc._background()
-    assert (folder / kc._MARKER).read_text() == kc._fingerprint()
+    marker = kc._marker()
+    assert marker is not None and marker[0] == folder / kc._MARKER
+    assert marker[0].read_text() == marker[1]
     capsys.readouterr()                  # the compile's own lines (the detached one's: nowhere)
     # Marked and warm: the fast kernels, nothing started.
     assert _kernels.kernels("fast") == (build_dr_fast, search_opt_path_fast)
@@ -121,6 +123,7 @@ def test_an_unmarked_machine_is_cold_without_reading_the_stamps(cold, monkeypatc
     calls, folder = cold
     for name in kc.GROUPS:
         kc._write_stamp(name)
+    (folder / kc._MARKER).write_text("a marker of other kernel sources")
 
     def numba_needed(*args):    # what the stamps' check would call: it imports numba
         raise AssertionError("the stamps were read")
@@ -130,7 +133,19 @@ def test_an_unmarked_machine_is_cold_without_reading_the_stamps(cold, monkeypatc
         assert kc.numpy_while_cold()
     assert len(calls["started"]) == 1 and "3 groups compiling" in capsys.readouterr().err
     kc._background()
-    assert calls["compiled"] == [] and (folder / kc._MARKER).exists()
+    marker = kc._marker()
+    assert calls["compiled"] == [] and marker is not None
+    assert marker[0].read_text() == marker[1]
+
+
+def test_an_unmarked_run_starts_no_compile_while_one_holds_the_start_lock(cold, capsys):
+    calls, folder = cold
+    with open(folder / kc._START_LOCK, "a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        assert kc.numpy_while_cold()
+        fcntl.flock(fh, fcntl.LOCK_UN)
+    assert calls["started"] == []
+    assert "3 groups being compiled in the background" in capsys.readouterr().err
 
 
 def test_a_stale_marker_is_no_marker(cold, monkeypatch):
@@ -138,23 +153,27 @@ def test_a_stale_marker_is_no_marker(cold, monkeypatch):
     for name in kc.GROUPS:
         kc._write_stamp(name)
     kc._write_marker()
-    # A kernel source edited since (its size or time in the fingerprint): cold again.
-    monkeypatch.setattr(kc, "_fingerprint", lambda: "another fingerprint")
+    # A kernel source edited since (its size and time in the fingerprint): cold again.
+    edited = folder / "_fast_search.py"
+    edited.write_text("# another source\n")
+    real = kc._source
+    monkeypatch.setattr(kc, "_source", lambda name: edited if name == "search" else real(name))
     assert kc.numpy_while_cold() and len(calls["started"]) == 1
 
 
-def test_an_unwritable_marker_folder_means_the_stamps_are_checked(monkeypatch, tmp_path):
-    locked = tmp_path / "ro"
-    locked.mkdir()
-    locked.chmod(0o500)
-    try:
-        monkeypatch.setenv("NUMBA_CACHE_DIR", str(locked / "numba"))
-        import os
-        assert kc._marker_path() is None or os.access(locked, os.W_OK)   # root may write
-        monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba"))
-        assert kc._marker_path() == tmp_path / "numba" / kc._MARKER
-    finally:
-        locked.chmod(0o700)
+def test_an_unwritable_marker_folder_means_the_stamps_are_checked(cold, monkeypatch):
+    # No marker can appear there: read the stamps (warm here), rather than cold for ever.
+    calls, folder = cold
+    for name in kc.GROUPS:
+        kc._write_stamp(name)
+    with monkeypatch.context() as m:
+        m.setattr(kc.os, "access", lambda path, mode: False)
+        assert kc._marker() is None
+        assert not kc.numpy_while_cold() and calls["started"] == []
+    # A file where the folder should be, likewise.
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(folder / "a-file" / "numba"))
+    (folder / "a-file").write_text("")
+    assert kc._marker() is None
 
 
 def test_a_run_on_the_numpy_kernels_imports_no_numba():

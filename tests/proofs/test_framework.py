@@ -135,3 +135,14 @@ def test_refuted_obligations_label_their_second_check_as_a_refutation():
     assert refuted.verdict is Verdict.REFUTED_AS_EXPECTED
     assert "refutation (expect sat" in refuted.smtlib and "expect unsat" not in refuted.smtlib
     assert "proof (expect unsat)" in discharge(_ob(q)).smtlib
+
+
+def test_a_repeated_vc_name_is_keyed_by_its_position():
+    # The lock's and results.json's key of each VC (the prove run and bench/tune_cvc5.py both
+    # read them from vc_keys).
+    import z3 as _z3
+
+    from cfmpa.proofs._obligation import vc_keys
+    x = _z3.Int("x")
+    vcs = [VC(n, (), x == x) for n in ("a", "b", "a", "a")]
+    assert vc_keys(vcs) == ["a", "b", "a#3", "a#4"]

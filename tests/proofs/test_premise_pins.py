@@ -75,8 +75,18 @@ def test_an_inconsistent_pin_costs_only_its_budget(monkeypatch):
     # Planted: dt = 0 contradicts dt > 0 (a statement that changed under its pin): the own try
     # ends unsat, never refuted, and the one-cell and free tries run as before.
     index = 6               # the postcondition, refuted with the one-cell pins
-    outcome, detail = C._without("modified", index, own=(("dt", 0),))
+    limits: list[int | None] = []
+    real = O._solver
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        limits.append(kwargs.get("rlimit"))
+        return real(*args, **kwargs)
+    with monkeypatch.context() as m:
+        m.setattr(O, "_solver", spy)
+        outcome, detail = C._without("modified", index, own=(("dt", 0),))
     assert (outcome, detail) == ("refuted", "a counter-model with the one-cell pins")
+    # The own pins were tried, on their own budget, before the one-cell pins.
+    assert limits == [C.PREMISE_OWN_RLIMIT, C.PREMISE_PINNED_RLIMIT]
     monkeypatch.setattr(C, "PREMISE_OWN_RLIMIT", 1)
     outcome, detail = C._without("modified", index, own=C._THREE_LAYERS)
     assert outcome == "refuted" and detail == "a counter-model with the one-cell pins"

@@ -219,6 +219,7 @@ def test_a_statement_replays_under_the_strategy_the_lock_names(tmp_path: Path, m
         "b": "internal"}
     # Seeded faults in the lock: a strategy that does not exist, a VC the entry does not pin.
     for bad, what in (({"b": "fast"}, "T.cvc5.cvc5_strategy.b is not one of"),
+                      ({"b": ["internal"]}, "T.cvc5.cvc5_strategy.b is not one of"),
                       ({"c": "internal"}, "names a VC the entry does not pin")):
         doc["obligations"]["T.cvc5"]["cvc5_strategy"] = bad
         lock.write_text(json.dumps(doc))

@@ -33,12 +33,12 @@ def test_an_edit_to_a_called_helper_changes_the_translation_checks_text(monkeypa
         return text + "\n# edited\n" if getattr(obj, "__name__", "") == (
             "cfmpa.spec._builtdr_post") else text
 
-    _obligation._module_source.cache_clear()
+    _obligation._module_facts.cache_clear()
     monkeypatch.setattr(_obligation.inspect, "getsource", edited)
     try:
         after = _content()
     finally:
-        _obligation._module_source.cache_clear()
+        _obligation._module_facts.cache_clear()
     assert after != before
     changed = set(after.splitlines()) - set(before.splitlines())
     assert len(changed) == 1 and "cfmpa.spec._builtdr_post" in changed.pop()

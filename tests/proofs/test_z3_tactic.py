@@ -87,8 +87,9 @@ def test_proof_check_runs_on_the_tactic_unsat_and_vacuity_still_sat(ident):
 
 
 def test_a_solver_that_ignores_the_tactic_is_caught(monkeypatch):
-    """The planted fault: ``_solver`` dropping the tactic. convex_norm's proof check then runs
-    on Z3's default solver, over the bound (and, under a limit of 3 M, ends unknown)."""
+    """The bound's calibration, with the fault planted here: ``_solver`` dropping the tactic.
+    convex_norm's proof check then runs on Z3's default solver, over TACTIC_VCS's bound (and,
+    under a limit of 3 M, ends unknown), so the test above goes red on that fault."""
     real = _obligation._solver
 
     def ignoring(*args, tactic=None, tactic_params=(), **kwargs):
